@@ -1,0 +1,95 @@
+/* steadystep: springs and softness, the pure math (no ODE types).
+ *
+ * A soft constraint row is a spring-damper: stiffness k and damping c. ODE wants it as ERP and CFM for the length h
+ * of each step. These functions convert between the two and are usable by any engine with ODE's ERP/CFM
+ * definitions (Bullet's contacts use the same ones). Units are SI; for an angular row read N·m/rad for N/m,
+ * N·m·s/rad for N·s/m and kg·m² for kg.
+ *
+ * Three mappings from a spring to softness at step h:
+ *  - SS_MAPPING_SPRING, the article's: erp = hk/(hk+c), cfm = 1/(hk+c). ODE's step then solves exactly the
+ *    implicit-Euler step of the spring, m(v'-v)/h = -k(x + h v') - c v', x' = x + h v', at any h: consistent
+ *    stiffness and damping at every frame rate. Implicit Euler adds numerical damping of about h·k/2 per unit mass.
+ *  - SS_MAPPING_MATCHED: for a row of effective mass m, the erp and cfm whose discrete poles equal exp(s·h) of the
+ *    exact poles s of m x'' + c x' + k x = 0. At a constant h the sampled motion decays and oscillates exactly as
+ *    the continuous spring does. erp is often above 1 (ODE accepts that). Needs c > 0.
+ *  - SS_MAPPING_EXACT: like matched, and also uses the previous step length, because the velocity ODE carries into
+ *    a step is the slope (x_n - x_(n-1))/h_prev over the previous step. The sampled motion of a lone linear
+ *    spring-damper then equals the exact solution under any sequence of step lengths. See docs/exact-mappings.md.
+ */
+#ifndef STEADYSTEP_SPRING_H
+#define STEADYSTEP_SPRING_H
+
+#include "steadystep/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** A spring-damper. */
+typedef struct ssSpring {
+  double stiffness; /* k, N/m (N·m/rad for angular rows), >= 0 */
+  double damping;   /* c, N·s/m (N·m·s/rad for angular rows), >= 0; k and c not both 0 */
+} ssSpring;
+
+/** ODE's softness of one constraint row for one step. */
+typedef struct ssSoftness {
+  double erp; /* error reduction parameter, non-dimensional; (0, 1] for the spring mapping, may exceed 1 */
+  double cfm; /* constraint force mixing, m/(N·s) for a linear row (what ODE multiplies the force by), > 0 */
+} ssSoftness;
+
+/** How a spring becomes softness at a step. */
+typedef enum ssMapping {
+  SS_MAPPING_SPRING = 0,  /* the article's mapping: implicit Euler of the spring */
+  SS_MAPPING_MATCHED = 1, /* exact poles at a constant step; needs the row's effective mass and c > 0 */
+  SS_MAPPING_EXACT = 2,   /* exact samples under varying steps; also needs the previous step length */
+} ssMapping;
+
+/** The article's mapping: erp = hk/(hk+c), cfm = 1/(hk+c) at step length step_s (s, > 0).
+ *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (k < 0, c < 0, step_s <= 0), SS_ERROR_NO_SPRING (k = c = 0). */
+ssStatus ssSoftnessFromSpring(ssSpring spring, double step_s, ssSoftness* out);
+
+/** The inverse: the spring that erp, cfm tuned at a fixed step step_s stand for: k = erp/(h·cfm), c = (1-erp)/cfm.
+ *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (erp outside (0, 1], cfm <= 0, step_s <= 0). */
+ssStatus ssSpringFromSoftness(ssSoftness softness, double step_s, ssSpring* out);
+
+/** A spring from its undamped natural frequency (Hz, > 0), damping ratio (>= 0, 1 = critical) and the effective
+ *  mass it moves (kg or kg·m², > 0): k = m·w², c = 2·zeta·m·w with w = 2π·f, as Jolt's SpringSettings does.
+ *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE. */
+ssStatus ssSpringFromFrequency(double frequency_hz, double damping_ratio, double mass, ssSpring* out);
+
+/** The undamped natural frequency (Hz) and damping ratio of a spring acting on mass (> 0). A pure damper (k = 0)
+ *  has frequency 0 and an infinite damping ratio.
+ *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE, SS_ERROR_NO_SPRING. */
+ssStatus ssFrequencyFromSpring(ssSpring spring, double mass, double* frequency_hz, double* damping_ratio);
+
+/** The matched mapping for a row of effective mass `mass` (kg or kg·m², > 0) at step_s. With the discrete poles
+ *  z1, z2 = exp(s1·h), exp(s2·h): P = z1·z2 = exp(-c·h/m), S = z1 + z2, erp = (1 + P - S)/(1 - P),
+ *  cfm = h·P/(m·(1 - P)). Under-, critically and over-damped springs are all handled.
+ *  Errors: as ssSoftnessFromSpring, SS_ERROR_OUT_OF_RANGE for mass <= 0,
+ *  SS_ERROR_NO_FINITE_MAPPING for c = 0 (an undamped spring has poles on the unit circle: cfm would be infinite). */
+ssStatus ssMatchedSoftness(ssSpring spring, double mass, double step_s, ssSoftness* out);
+
+/** The exact mapping: erp, cfm such that ODE's step from x_(n-1), x_n (previous step previous_step_s) lands on the
+ *  exact solution's sample x_(n+1) after step_s. previous_step_s = 0 means there is no usable history (the first
+ *  step, or after a teleport): then the step maps the body's true velocity exactly.
+ *  Errors: as ssMatchedSoftness; SS_ERROR_OUT_OF_RANGE for previous_step_s < 0;
+ *  SS_ERROR_NO_FINITE_MAPPING when this pair of step lengths would need cfm <= 0 (a much shorter step after a
+ *  long one on a lightly damped spring): the caller may fall back to the matched mapping for that step. */
+ssStatus ssExactSoftness(ssSpring spring, double mass, double step_s, double previous_step_s, ssSoftness* out);
+
+/** One entry point for all mappings: mass is ignored by SS_MAPPING_SPRING, previous_step_s by all but EXACT.
+ *  Errors: those of the chosen mapping, SS_ERROR_UNSUPPORTED for an unknown mapping value. */
+ssStatus ssSoftnessFor(ssMapping mapping, ssSpring spring, double mass, double step_s, double previous_step_s,
+                       ssSoftness* out);
+
+/** The mapping's name: "spring", "matched", "exact"; NULL for an unknown value. */
+const char* ssMappingName(ssMapping mapping);
+
+/** Checks a spring: finite, k >= 0, c >= 0, not both 0. Errors as ssSoftnessFromSpring. */
+ssStatus ssValidateSpring(ssSpring spring);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,39 @@
+/* steadystep: error values.
+ *
+ * Every fallible function returns an ssStatus. On failure nothing was changed (no output written, no ODE state
+ * touched) and ssLastError() returns one line that names the offending value, e.g.
+ * "step_s = -0.01 s: must be positive". The message is kept per thread until the next failure on that thread.
+ */
+#ifndef STEADYSTEP_STATUS_H
+#define STEADYSTEP_STATUS_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum ssStatus {
+  SS_OK = 0,
+  SS_ERROR_NOT_FINITE = 1,        /* a NaN or an infinity where a finite number is needed */
+  SS_ERROR_OUT_OF_RANGE = 2,      /* a finite number outside its valid range (h <= 0, k < 0, erp > 1, ...) */
+  SS_ERROR_NO_SPRING = 3,         /* k = c = 0: no spring and no damper, so no softness exists */
+  SS_ERROR_NO_FINITE_MAPPING = 4, /* the mapping does not exist for these values (matched with c = 0, ...) */
+  SS_ERROR_UNSUPPORTED = 5,       /* the joint type has no such parameter or axis, or an unknown enum value */
+  SS_ERROR_NOT_FOUND = 6,         /* nothing is bound to that joint or body */
+  SS_ERROR_IO = 7,                /* a file could not be opened or read */
+  SS_ERROR_PARSE = 8,             /* a file or a text specification is malformed */
+  SS_ERROR_BLOWUP = 9,            /* a body's state became NaN or infinite */
+  SS_ERROR_SPEED_LIMIT = 10,      /* a body moved faster than the configured limit */
+  SS_ERROR_OUT_OF_MEMORY = 11,
+} ssStatus;
+
+/** The enum's name without prefix, e.g. "out of range". Never NULL. */
+const char* ssStatusName(ssStatus status);
+
+/** The message of the last failure on this thread: one line naming the value at fault. "" when none. */
+const char* ssLastError(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
