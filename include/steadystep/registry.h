@@ -1,0 +1,126 @@
+/* steadystep: the registry of what is soft in an ODE world, rewritten for each step length.
+ *
+ * Register each soft thing once with its spring (or rate, in 1/s); before each step call ssRegistry_Apply with
+ * that step's length and the registry writes ODE's per-step numbers: the world's ERP/CFM, every bound joint
+ * parameter, body damping scales and auto-disable sample counts. ssStepper (stepper.h) does this for you.
+ *
+ * ODE copies the world's ERP/CFM into ball, fixed, double-ball, double-hinge and transmission joints (and hinge-2
+ * suspension) when they are created, so a later dWorldSetERP does not reach them: bind each one. Hinge, slider,
+ * universal, PR, PU and piston joints read the world's ERP/CFM at every step for their non-limit rows.
+ *
+ * Bindings hold ODE handles. A program that destroys a joint or a body must unbind it first.
+ */
+#ifndef STEADYSTEP_REGISTRY_H
+#define STEADYSTEP_REGISTRY_H
+
+#include <ode/ode.h>
+
+#include "steadystep/spring.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct ssRegistry ssRegistry;
+
+/** Which of a joint's soft parameter sets a binding drives. */
+typedef enum ssJointParam {
+  /* dParamERP + dParamCFM: the joint's own rows. Ball, fixed, double ball, double hinge, transmission. */
+  SS_PARAM_JOINT = 0,
+  /* dParamStopERP + dParamStopCFM: a joint limit (stop) on one axis. Hinge, slider, universal, hinge-2, PR, PU,
+   * piston, angular motor, linear motor, plane-2D. A stop with dParamLoStop = dParamHiStop is a bilateral spring. */
+  SS_PARAM_STOP = 1,
+  /* dParamCFM of a limit/motor axis: the softness of the motor row away from the stops. A motor row has no
+   * position error, so only cfm = 1/(h·k + c) is written (with k = 0: a damper of c toward the motor's velocity,
+   * the same at every step length). Same joint types as SS_PARAM_STOP. */
+  SS_PARAM_MOTOR = 2,
+  /* dParamSuspensionERP + dParamSuspensionCFM: hinge-2 suspension along axis 1. */
+  SS_PARAM_SUSPENSION = 3,
+} ssJointParam;
+
+/** What the registry wrote in one Apply. */
+typedef struct ssApplyReport {
+  int rows_written;           /* joint parameter sets written, plus 1 for a bound world */
+  int rows_over_nyquist;      /* rows whose natural frequency exceeds half the step rate (1/(2h)) */
+  int rows_exact_fallback;    /* SS_MAPPING_EXACT rows that this step length could not serve: matched was used */
+} ssApplyReport;
+
+/** Creates an empty registry for world. Returns NULL when out of memory. */
+ssRegistry* ssRegistry_Create(dWorldID world);
+
+/** Destroys the registry. ODE objects are left as they are. NULL is a no-op. */
+void ssRegistry_Destroy(ssRegistry* registry);
+
+/** Binds the world's ERP and CFM (they soften the non-limit rows of hinge-like joints, and contacts that have no
+ *  soft mode). effective_mass (kg, > 0) is needed only by the matched and exact mappings; pass 0 to use 1 kg.
+ *  Errors: those of ssValidateSpring; SS_ERROR_OUT_OF_RANGE for a negative or non-finite effective_mass. */
+ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effective_mass);
+
+/** Binds one soft parameter set of a joint on one axis (1, 2 or 3, as ODE's dParamGroup1..3; SS_PARAM_JOINT and
+ *  SS_PARAM_SUSPENSION have axis 1 only). Binding the same joint, param and axis again replaces the first binding.
+ *  effective_mass (kg, or kg·m² for an angular row) is what the matched and exact mappings need; pass 0 to have it
+ *  computed at each Apply from the joint's bodies (ssJointEffectiveMass).
+ *  Errors: SS_ERROR_UNSUPPORTED when the joint's type has no such parameter on that axis (ODE itself would ignore
+ *  it silently), or for an unknown param; those of ssValidateSpring; SS_ERROR_OUT_OF_RANGE for effective_mass < 0;
+ *  SS_ERROR_OUT_OF_MEMORY. */
+ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssSpring spring,
+                              double effective_mass);
+
+/** Removes every binding of joint. Call it before dJointDestroy. Errors: SS_ERROR_NOT_FOUND. */
+ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint);
+
+/** Binds velocity damping as rates (1/s, >= 0): ODE multiplies velocity by (1 - scale) once per step, so the
+ *  registry writes scale = 1 - exp(-rate·h), which removes the same fraction of velocity per second at every step
+ *  length. body = NULL binds the world's default damping (dWorldSetLinearDamping/AngularDamping).
+ *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE, SS_ERROR_OUT_OF_MEMORY. */
+ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linear_rate_per_s,
+                                double angular_rate_per_s);
+
+/** Binds auto-disable in seconds: a body at rest for idle_time_s (> 0) is disabled, with its velocity averaged over
+ *  average_window_s (>= 0; 0 = the current step only). ODE counts steps, so the registry writes
+ *  AutoDisableSteps = ceil(idle/h), AutoDisableTime = idle and AverageSamplesCount = max(1, ceil(window/h)).
+ *  body = NULL binds the world's defaults. Enabling auto-disable and its thresholds stay the program's own choice.
+ *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE, SS_ERROR_OUT_OF_MEMORY. */
+ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double idle_time_s, double average_window_s);
+
+/** Removes the damping and auto-disable bindings of body. Call it before dBodyDestroy. Errors: SS_ERROR_NOT_FOUND. */
+ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body);
+
+/** Writes every binding for a step of step_s (s, > 0) with the mapping. previous_step_s is the length of the step
+ *  before (0 when there is none or after a teleport); only SS_MAPPING_EXACT reads it. Either everything is written
+ *  or, on an error, nothing is. report may be NULL.
+ *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (step_s, previous_step_s); SS_ERROR_NO_FINITE_MAPPING when a
+ *  binding has no softness under that mapping (c = 0 with matched or exact), naming the joint; SS_ERROR_UNSUPPORTED
+ *  for an unknown mapping. */
+ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
+                          ssApplyReport* report);
+
+/** Number of bound joint parameter sets (not counting the world). */
+int ssRegistry_JointBindingCount(const ssRegistry* registry);
+
+/** Calls visit for every distinct body attached to a bound joint or bound for damping/auto-disable. */
+void ssRegistry_VisitBodies(const ssRegistry* registry, void (*visit)(void* context, dBodyID body), void* context);
+
+/** Whether the joint's type has that parameter set on that axis in ODE 0.16. */
+int ssJointSupports(dJointID joint, ssJointParam param, int axis);
+
+/** The effective mass (kg) or inertia (kg·m²) of a joint row: 1 / (J M⁻¹ Jᵀ) from the attached bodies' current
+ *  mass and world-frame inertia, for the row that param/axis drives (slider and piston: translation along the axis;
+ *  hinge, universal, angular motor: rotation about the axis; hinge-2 suspension: translation along axis 1).
+ *  Errors: SS_ERROR_UNSUPPORTED (as ssRegistry_BindJoint), SS_ERROR_OUT_OF_RANGE when no dynamic body is attached. */
+ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, double* mass);
+
+/** Fills contact->surface.soft_erp and soft_cfm from spring for a step of step_s and sets dContactSoftERP and
+ *  dContactSoftCFM in surface.mode. The effective mass along the contact normal is computed from body1, body2
+ *  (either may be 0 for the static world) and the contact position; the matched and exact mappings need it.
+ *  Call it in the near callback that ssStepper hands the step length to.
+ *  Errors: those of ssSoftnessFor; SS_ERROR_OUT_OF_RANGE when neither body is dynamic and the mapping needs a mass.
+ *  On error contact is unchanged. */
+ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpring spring, ssMapping mapping,
+                         double step_s, double previous_step_s);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

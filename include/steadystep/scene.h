@@ -1,0 +1,128 @@
+/* steadystep: reference scenes built with ODE, and runs of a scene under a profile and a policy.
+ *
+ * A scene is data plus a builder: it makes its world, binds its soft parts in a registry, drives a stepper, and
+ * reports a few followed quantities after every physics step. This header uses no ODE types, so that any language
+ * can drive scenes (the Python package reads it with cffi).
+ *
+ * Scenes (quantities in parentheses):
+ *   oscillator  one body on a slider whose stop (lo = hi = 0) is the spring; no gravity unless params.gravity;
+ *               the article's case (x m, v m/s, erp, cfm of the stop for that step)
+ *   buggy       a four-wheeled car with hinge-2 wheels on spring suspension, driving over bumps
+ *               (chassis height m, chassis pitch rad)
+ *   drop        boxes dropped onto the ground with soft contacts from the spring (penetration m, height m)
+ *   chain       a hanging chain of bodies on ball joints with soft hinge limits under gravity (end x m, end z m)
+ *   pile        many boxes in a heap for timing (mean height m)
+ */
+#ifndef STEADYSTEP_SCENE_H
+#define STEADYSTEP_SCENE_H
+
+#include <stdint.h>
+
+#include "steadystep/spring.h"
+#include "steadystep/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SS_MAX_QUANTITIES 4
+
+/** A scene's parameters. Start from ssDefaultSceneParams(name): each scene has its own defaults. */
+typedef struct ssSceneParams {
+  ssSpring spring;     /* the scene's soft constraint: slider stop, suspension, contact or joint limit */
+  double mass;         /* kg: the oscillator's body, a buggy's chassis, each dropped box, each chain link */
+  double x0;           /* m: the oscillator's initial extension (released at rest); unused elsewhere */
+  double gravity;      /* m/s² along the scene's "down": oscillator 0 by default (along the slider), others 9.81 */
+  int body_count;      /* pile: boxes; chain: links; drop: boxes; 0 = the scene's default */
+} ssSceneParams;
+
+/** What a scene follows. */
+typedef struct ssSceneInfo {
+  const char* name;
+  const char* description;
+  int quantity_count;
+  const char* quantity_names[SS_MAX_QUANTITIES];
+  const char* quantity_units[SS_MAX_QUANTITIES];
+} ssSceneInfo;
+
+/** How scene steps are taken: the stepper's policy and limits (see stepper.h for each). */
+typedef struct ssStepping {
+  int policy;              /* an ssPolicy value */
+  int solver;              /* an ssSolver value */
+  int quick_iterations;    /* default 20 */
+  double max_step_s;       /* default 1/60 */
+  double reference_step_s; /* default 1/30 */
+  double fixed_step_s;     /* default 1/60 */
+  int max_steps_per_frame; /* default 8 */
+} ssStepping;
+
+/** The number of scenes, and each scene's description (NULL past the end). */
+int ssSceneCount(void);
+const ssSceneInfo* ssSceneInfoAt(int index);
+/** The scene called name, or NULL. */
+const ssSceneInfo* ssSceneFind(const char* name);
+
+/** The default parameters of a scene. Errors: SS_ERROR_NOT_FOUND for an unknown scene (named). */
+ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
+
+/** The stepper's defaults as an ssStepping. */
+ssStepping ssDefaultStepping(void);
+
+typedef struct ssScene ssScene;
+
+/** Builds a scene. Errors: SS_ERROR_NOT_FOUND (unknown scene), those of ssValidateSpring, SS_ERROR_OUT_OF_RANGE
+ *  (mass <= 0, body_count < 0, a stepping field out of range), SS_ERROR_UNSUPPORTED (unknown policy or solver),
+ *  SS_ERROR_OUT_OF_MEMORY. */
+ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssStepping* stepping, ssScene** out);
+
+/** Destroys the scene and its ODE world. NULL is a no-op. */
+void ssScene_Destroy(ssScene* scene);
+
+/** Advances one frame of frame_s seconds through the scene's stepper. steps (may be NULL) receives the physics
+ *  steps taken. Errors: those of ssStepper_Step. */
+ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps);
+
+/** The followed quantities now, quantity_count of them, into out. */
+void ssScene_Sample(const ssScene* scene, double* out);
+
+/** The scene's simulated time (s). */
+double ssScene_Time(const ssScene* scene);
+
+/** A run: a scene under a profile for duration_s, one record after every physics step. */
+typedef struct ssRunDef {
+  const char* scene;        /* scene name */
+  ssSceneParams params;     /* from ssDefaultSceneParams */
+  ssStepping stepping;      /* from ssDefaultStepping */
+  const char* profile;      /* profile spec (profile.h) */
+  uint64_t seed;            /* profile seed */
+  double duration_s;        /* simulated seconds, > 0 */
+} ssRunDef;
+
+typedef struct ssRun ssRun;
+
+/** Runs def to the end, or to the first blow-up (which is recorded in the run, not an error).
+ *  Errors: those of ssScene_Create and ssProfile_Create; SS_ERROR_OUT_OF_RANGE for duration_s. */
+ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out);
+
+/** Destroys the run. NULL is a no-op. */
+void ssRun_Destroy(ssRun* run);
+
+/** Records: one per physics step, time (s) after the step, the step's length (s), and each quantity. */
+int ssRun_StepCount(const ssRun* run);
+const double* ssRun_Times(const ssRun* run);
+const double* ssRun_StepLengths(const ssRun* run);
+const double* ssRun_Quantity(const ssRun* run, int index);
+
+/** Frames rendered, and the wall-clock seconds the stepping took (scene building excluded). */
+int ssRun_FrameCount(const ssRun* run);
+double ssRun_WallSeconds(const ssRun* run);
+
+/** SS_OK, or the blow-up status that ended the run early; its message. */
+ssStatus ssRun_Status(const ssRun* run);
+const char* ssRun_Message(const ssRun* run);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
