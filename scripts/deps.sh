@@ -1,0 +1,35 @@
+# Sourced by scripts/test and scripts/report: installs what the project needs on a fresh Debian machine.
+# As root it installs missing Debian packages with apt-get; otherwise it prints the exact command and stops.
+# Then it makes the Python virtual environment .venv under the repository and installs the package into it.
+set -euo pipefail
+repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+missing=()
+command -v cmake >/dev/null || missing+=(cmake)
+command -v ninja >/dev/null || missing+=(ninja-build)
+command -v g++ >/dev/null || missing+=(g++)
+command -v pkg-config >/dev/null || missing+=(pkg-config)
+pkg-config --exists ode 2>/dev/null || missing+=(libode-dev)
+[ -f /usr/include/gtest/gtest.h ] || missing+=(libgtest-dev)
+python3 -c 'import ensurepip, venv' 2>/dev/null || missing+=(python3-venv)
+if [ ${#missing[@]} -gt 0 ]; then
+  if [ "$(id -u)" = 0 ]; then
+    echo "steadystep: installing Debian packages: ${missing[*]}"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    apt-get install -y -qq "${missing[@]}" >/dev/null
+  else
+    echo "steadystep: missing Debian packages. Run this, then run me again:" >&2
+    echo "  sudo apt-get install -y ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+
+# The Python package: built by scikit-build-core from the same CMake project.
+venv="$repo/.venv"
+if [ ! -x "$venv/bin/python" ]; then
+  python3 -m venv "$venv"
+  "$venv/bin/pip" install --quiet --upgrade pip
+fi
+"$venv/bin/pip" install --quiet scikit-build-core
+"$venv/bin/pip" install --quiet --no-build-isolation "$repo[test]"
