@@ -27,7 +27,8 @@ typedef struct ssProfile ssProfile;
 
 /** Makes a profile from spec (above) and a seed.
  *  Errors: SS_ERROR_PARSE naming the spec and the part at fault (unknown kind, missing or extra field, a number
- *  that does not parse), SS_ERROR_OUT_OF_RANGE (a rate or duration <= 0, min above max, spread too large),
+ *  that does not parse), SS_ERROR_NOT_FINITE (a field that reads as nan or inf), SS_ERROR_OUT_OF_RANGE (a rate or
+ *  duration <= 0, min above max, spread too large),
  *  SS_ERROR_IO (trace file missing or unreadable, named), SS_ERROR_PARSE for a malformed trace line (with its
  *  number), SS_ERROR_OUT_OF_MEMORY. */
 ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out);
