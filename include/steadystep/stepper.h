@@ -38,10 +38,12 @@ typedef enum ssSolver {
   SS_SOLVER_STEP = 1,  /* dWorldStep, the direct (big matrix) solver */
 } ssSolver;
 
-/** Called before each physics step, after the registry has been applied: run collision detection here and create
- *  contact joints in the stepper's contact_group. step_s is the step about to be taken, previous_step_s the one
- *  before (0 if none), for ssContactSoften. */
-typedef void ssCollideFn(void* context, double step_s, double previous_step_s);
+/** Called before each physics step, after the registry has been applied: run collision detection here, create
+ *  contact joints in the stepper's contact_group and soften them with ssContactSoften(contact, b1, b2, spring,
+ *  mapping, step_s, previous_step_s). The arguments are the ones the registry was applied with: the policy's
+ *  mapping, the step length the softness is for (SS_POLICY_NAIVE: reference_step_s, whatever the frame time) and
+ *  the step before (0 if none). */
+typedef void ssCollideFn(void* context, ssMapping mapping, double step_s, double previous_step_s);
 
 /** Called after each physics step with its length; for recording. */
 typedef void ssStepDoneFn(void* context, double step_s);
