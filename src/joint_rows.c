@@ -1,0 +1,252 @@
+/* Which joint of ODE 0.16 has which soft parameters, from the sources in ode/src/joints: Set*Param silently ignores a
+ * parameter its joint does not have, so the registry checks here instead of writing into nothing. */
+#include "joint_rows.h"
+
+#include <math.h>
+
+#include "error.h"
+
+const char* ssJointTypeName(dJointID joint) {
+  switch (dJointGetType(joint)) {
+    case dJointTypeBall: return "ball";
+    case dJointTypeHinge: return "hinge";
+    case dJointTypeSlider: return "slider";
+    case dJointTypeContact: return "contact";
+    case dJointTypeUniversal: return "universal";
+    case dJointTypeHinge2: return "hinge-2";
+    case dJointTypeFixed: return "fixed";
+    case dJointTypeNull: return "null";
+    case dJointTypeAMotor: return "angular motor";
+    case dJointTypeLMotor: return "linear motor";
+    case dJointTypePlane2D: return "plane-2D";
+    case dJointTypePR: return "PR";
+    case dJointTypePU: return "PU";
+    case dJointTypePiston: return "piston";
+    case dJointTypeDBall: return "double ball";
+    case dJointTypeDHinge: return "double hinge";
+    case dJointTypeTransmission: return "transmission";
+    default: return "unknown";
+  }
+}
+
+const char* ssJointParamName(ssJointParam param) {
+  switch (param) {
+    case SS_PARAM_JOINT: return "joint";
+    case SS_PARAM_STOP: return "stop";
+    case SS_PARAM_MOTOR: return "motor";
+    case SS_PARAM_SUSPENSION: return "suspension";
+  }
+  return NULL;
+}
+
+/* The number of limit/motor axes a joint type has (0: none). */
+static int limitAxisCount(dJointID joint) {
+  switch (dJointGetType(joint)) {
+    case dJointTypeHinge:
+    case dJointTypeSlider: return 1;
+    case dJointTypeUniversal:
+    case dJointTypeHinge2:
+    case dJointTypePR:
+    case dJointTypePiston: return 2;
+    case dJointTypePU:
+    case dJointTypePlane2D: return 3;
+    case dJointTypeAMotor: return dJointGetAMotorNumAxes(joint);
+    case dJointTypeLMotor: return dJointGetLMotorNumAxes(joint);
+    default: return 0;
+  }
+}
+
+int ssJointSupports(dJointID joint, ssJointParam param, int axis) {
+  if (joint == 0) return 0;
+  switch (param) {
+    case SS_PARAM_JOINT:
+      if (axis != 1) return 0;
+      switch (dJointGetType(joint)) {
+        case dJointTypeBall:
+        case dJointTypeFixed:
+        case dJointTypeDBall:
+        case dJointTypeDHinge:
+        case dJointTypeTransmission: return 1;
+        default: return 0;
+      }
+    case SS_PARAM_STOP:
+    case SS_PARAM_MOTOR: return axis >= 1 && axis <= limitAxisCount(joint);
+    case SS_PARAM_SUSPENSION: return axis == 1 && dJointGetType(joint) == dJointTypeHinge2;
+  }
+  return 0;
+}
+
+/* ODE's parameter number for a set on an axis: groups are 0x100 apart (dParamGroup). */
+static int groupParam(int param, int axis) { return param + (axis - 1) * dParamGroup; }
+
+static void setParam(dJointID joint, int axis, int param, double value) {
+  switch (dJointGetType(joint)) {
+    case dJointTypeBall: dJointSetBallParam(joint, param, value); break;
+    case dJointTypeFixed: dJointSetFixedParam(joint, param, value); break;
+    case dJointTypeDBall: dJointSetDBallParam(joint, param, value); break;
+    case dJointTypeDHinge: dJointSetDHingeParam(joint, param, value); break;
+    case dJointTypeTransmission: dJointSetTransmissionParam(joint, param, value); break;
+    case dJointTypeHinge: dJointSetHingeParam(joint, param, value); break;
+    case dJointTypeSlider: dJointSetSliderParam(joint, param, value); break;
+    case dJointTypeUniversal: dJointSetUniversalParam(joint, groupParam(param, axis), value); break;
+    case dJointTypeHinge2: dJointSetHinge2Param(joint, groupParam(param, axis), value); break;
+    case dJointTypePR: dJointSetPRParam(joint, groupParam(param, axis), value); break;
+    case dJointTypePU: dJointSetPUParam(joint, groupParam(param, axis), value); break;
+    case dJointTypePiston: dJointSetPistonParam(joint, groupParam(param, axis), value); break;
+    case dJointTypeAMotor: dJointSetAMotorParam(joint, groupParam(param, axis), value); break;
+    case dJointTypeLMotor: dJointSetLMotorParam(joint, groupParam(param, axis), value); break;
+    case dJointTypePlane2D:
+      /* plane-2D has one function per axis instead of groups */
+      if (axis == 1) dJointSetPlane2DXParam(joint, param, value);
+      else if (axis == 2) dJointSetPlane2DYParam(joint, param, value);
+      else dJointSetPlane2DAngleParam(joint, param, value);
+      break;
+    default: break;
+  }
+}
+
+void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm) {
+  switch (param) {
+    case SS_PARAM_JOINT:
+      setParam(joint, axis, dParamERP, erp);
+      setParam(joint, axis, dParamCFM, cfm);
+      break;
+    case SS_PARAM_STOP:
+      setParam(joint, axis, dParamStopERP, erp);
+      setParam(joint, axis, dParamStopCFM, cfm);
+      break;
+    case SS_PARAM_MOTOR: setParam(joint, axis, dParamCFM, cfm); break;
+    case SS_PARAM_SUSPENSION:
+      setParam(joint, axis, dParamSuspensionERP, erp);
+      setParam(joint, axis, dParamSuspensionCFM, cfm);
+      break;
+  }
+}
+
+/* d·I⁻¹d for a body's world-frame inertia I = R I_body Rᵀ, solving I_body y = Rᵀd by Cramer's rule. */
+static double inverseInertiaAlong(dBodyID body, const dReal* d) {
+  dMass mass;
+  dBodyGetMass(body, &mass);
+  const dReal* R = dBodyGetRotation(body); /* rows of 4: R[4*i + j] */
+  double b[3];
+  for (int j = 0; j < 3; ++j) b[j] = R[j] * d[0] + R[4 + j] * d[1] + R[8 + j] * d[2];
+  const dReal* I = mass.I;
+  double a00 = I[0], a01 = I[1], a02 = I[2], a10 = I[4], a11 = I[5], a12 = I[6], a20 = I[8], a21 = I[9],
+         a22 = I[10];
+  double c0 = a11 * a22 - a12 * a21, c1 = a12 * a20 - a10 * a22, c2 = a10 * a21 - a11 * a20;
+  double det = a00 * c0 + a01 * c1 + a02 * c2;
+  if (det <= 0) return 0;
+  double y0 = (b[0] * c0 + a01 * (a12 * b[2] - b[1] * a22) + a02 * (b[1] * a21 - a11 * b[2])) / det;
+  double y1 = (a00 * (b[1] * a22 - a12 * b[2]) + b[0] * c1 + a02 * (a10 * b[2] - b[1] * a20)) / det;
+  double y2 = (a00 * (a11 * b[2] - b[1] * a21) + a01 * (b[1] * a20 - a10 * b[2]) + b[0] * c2) / det;
+  return b[0] * y0 + b[1] * y1 + b[2] * y2;
+}
+
+static int isDynamic(dBodyID body) { return body != 0 && !dBodyIsKinematic(body); }
+
+double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, const dReal* point, int angular) {
+  dBodyID bodies[2] = {body1, body2};
+  double inverse = 0;
+  for (int i = 0; i < 2; ++i) {
+    if (!isDynamic(bodies[i])) continue;
+    if (angular) {
+      inverse += inverseInertiaAlong(bodies[i], direction);
+      continue;
+    }
+    dMass mass;
+    dBodyGetMass(bodies[i], &mass);
+    inverse += 1.0 / mass.mass;
+    if (point != NULL) {
+      const dReal* p = dBodyGetPosition(bodies[i]);
+      dVector3 r = {point[0] - p[0], point[1] - p[1], point[2] - p[2], 0};
+      dVector3 rxd;
+      dCalcVectorCross3(rxd, r, direction);
+      inverse += inverseInertiaAlong(bodies[i], rxd);
+    }
+  }
+  return inverse > 0 ? 1.0 / inverse : 0;
+}
+
+/* The row's direction, whether it is angular, and (for a linear row whose point matters) its point. */
+static int rowGeometry(dJointID joint, ssJointParam param, int axis, dVector3 direction, dVector3 point,
+                       int* angular, int* has_point) {
+  *angular = 0;
+  *has_point = 0;
+  switch (dJointGetType(joint)) {
+    case dJointTypeHinge: dJointGetHingeAxis(joint, direction); *angular = 1; return 1;
+    case dJointTypeSlider: dJointGetSliderAxis(joint, direction); return 1;
+    case dJointTypeUniversal:
+      if (axis == 1) dJointGetUniversalAxis1(joint, direction);
+      else dJointGetUniversalAxis2(joint, direction);
+      *angular = 1;
+      return 1;
+    case dJointTypeHinge2:
+      if (param == SS_PARAM_SUSPENSION) {
+        /* the suspension moves the wheel's anchor along axis 1: the chassis' rotation takes part */
+        dJointGetHinge2Axis1(joint, direction);
+        dJointGetHinge2Anchor2(joint, point);
+        *has_point = 1;
+        return 1;
+      }
+      if (axis == 1) dJointGetHinge2Axis1(joint, direction);
+      else dJointGetHinge2Axis2(joint, direction);
+      *angular = 1;
+      return 1;
+    case dJointTypePR:
+      if (axis == 1) dJointGetPRAxis1(joint, direction);
+      else {
+        dJointGetPRAxis2(joint, direction);
+        *angular = 1;
+      }
+      return 1;
+    case dJointTypePU:
+      if (axis == 1) dJointGetPUAxis1(joint, direction);
+      else if (axis == 2) dJointGetPUAxis2(joint, direction);
+      else {
+        dJointGetPUAxis3(joint, direction);
+        return 1;
+      }
+      *angular = 1;
+      return 1;
+    case dJointTypePiston:
+      dJointGetPistonAxis(joint, direction);
+      *angular = axis == 2;
+      return 1;
+    case dJointTypeAMotor: dJointGetAMotorAxis(joint, axis - 1, direction); *angular = 1; return 1;
+    case dJointTypeLMotor: dJointGetLMotorAxis(joint, axis - 1, direction); return 1;
+    case dJointTypePlane2D:
+      direction[0] = axis == 1;
+      direction[1] = axis == 2;
+      direction[2] = axis == 3;
+      *angular = axis == 3;
+      return 1;
+    case dJointTypeBall:
+    case dJointTypeFixed:
+    case dJointTypeDBall:
+    case dJointTypeDHinge:
+      /* several rows at once: the pair's reduced mass, as if each row were along the line of centres */
+      direction[0] = 1;
+      direction[1] = direction[2] = 0;
+      return 1;
+    default: return 0; /* transmission couples rotations through gear geometry: the program must give a mass */
+  }
+}
+
+ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, double* mass) {
+  if (joint == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "joint = NULL: a joint is required");
+  if (!ssJointSupports(joint, param, axis))
+    return ssFail(SS_ERROR_UNSUPPORTED, "a %s joint has no %s parameters on axis %d", ssJointTypeName(joint),
+                  ssJointParamName(param) ? ssJointParamName(param) : "such", axis);
+  dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
+  int angular, has_point;
+  if (!rowGeometry(joint, param, axis, direction, point, &angular, &has_point))
+    return ssFail(SS_ERROR_UNSUPPORTED, "the effective mass of a %s joint's rows is not defined: give it",
+                  ssJointTypeName(joint));
+  double value = ssRowEffectiveMass(dJointGetBody(joint, 0), dJointGetBody(joint, 1), direction,
+                                    has_point ? point : NULL, angular);
+  if (!(value > 0) || !isfinite(value))
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "the %s joint's %s row on axis %d has no dynamic body attached",
+                  ssJointTypeName(joint), ssJointParamName(param), axis);
+  *mass = value;
+  return SS_OK;
+}

@@ -1,0 +1,23 @@
+/* Internal: what ODE 0.16's joint types offer as soft rows, how to write them and what mass they move. */
+#ifndef STEADYSTEP_JOINT_ROWS_H
+#define STEADYSTEP_JOINT_ROWS_H
+
+#include <ode/ode.h>
+
+#include "steadystep/registry.h"
+
+/* A short name of the joint's type for messages ("hinge", "slider", ...). */
+const char* ssJointTypeName(dJointID joint);
+
+/* A short name of a parameter set for messages ("stop", "motor", ...), or NULL for an unknown value. */
+const char* ssJointParamName(ssJointParam param);
+
+/* Writes the row's softness. The joint must support param on axis (ssJointSupports). MOTOR rows write only cfm. */
+void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm);
+
+/* The effective mass of a row along (linear) or about (angular) the unit direction `direction` through world point
+ * `point` (linear rows only), from body1 and body2 (0 for the static world): 1 / sum over dynamic bodies of
+ * 1/m + (r x d)·I⁻¹(r x d) (linear) or d·I⁻¹d (angular). Returns 0 when no dynamic body is attached. */
+double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, const dReal* point, int angular);
+
+#endif

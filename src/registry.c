@@ -1,0 +1,303 @@
+/* The registry: bindings of springs and rates to ODE's per-step numbers, written for each step length.
+ * Apply works in two passes, compute then write, so that an error leaves every ODE object as it was. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "joint_rows.h"
+#include "registry_internal.h"
+#include "steadystep/registry.h"
+
+typedef struct JointBinding {
+  dJointID joint;
+  ssJointParam param;
+  int axis;
+  ssSpring spring;
+  double effective_mass; /* 0: computed from the bodies at each Apply */
+  ssSoftness pending;    /* computed in Apply's first pass */
+} JointBinding;
+
+typedef struct BodyBinding {
+  dBodyID body; /* 0: the world's defaults */
+  int has_damping;
+  double linear_rate_per_s, angular_rate_per_s;
+  int has_auto_disable;
+  double idle_time_s, average_window_s;
+  int average_samples_written; /* ODE restarts its average whenever the count is set: write it only on change */
+} BodyBinding;
+
+struct ssRegistry {
+  dWorldID world;
+  int world_bound;
+  ssSpring world_spring;
+  double world_mass;
+  ssSoftness world_pending;
+  JointBinding* joints;
+  int joint_count, joint_capacity;
+  BodyBinding* bodies;
+  int body_count, body_capacity;
+};
+
+ssRegistry* ssRegistry_Create(dWorldID world) {
+  if (world == 0) {
+    ssFail(SS_ERROR_OUT_OF_RANGE, "world = NULL: a world is required");
+    return NULL;
+  }
+  ssRegistry* registry = calloc(1, sizeof *registry);
+  if (registry == NULL) {
+    ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating a registry");
+    return NULL;
+  }
+  registry->world = world;
+  return registry;
+}
+
+void ssRegistry_Destroy(ssRegistry* registry) {
+  if (registry == NULL) return;
+  free(registry->joints);
+  free(registry->bodies);
+  free(registry);
+}
+
+/* Grows an array of `size`-byte items to hold one more. */
+static int reserveOne(void** items, int count, int* capacity, size_t size) {
+  if (count < *capacity) return 1;
+  int grown = *capacity ? 2 * *capacity : 8;
+  void* larger = realloc(*items, (size_t)grown * size);
+  if (larger == NULL) return 0;
+  *items = larger;
+  *capacity = grown;
+  return 1;
+}
+
+ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effective_mass) {
+  ssStatus status = ssValidateSpring(spring);
+  if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
+  if (status != SS_OK) return status;
+  registry->world_bound = 1;
+  registry->world_spring = spring;
+  registry->world_mass = effective_mass > 0 ? effective_mass : 1.0;
+  return SS_OK;
+}
+
+ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssSpring spring,
+                              double effective_mass) {
+  if (joint == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "joint = NULL: a joint is required");
+  if (ssJointParamName(param) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "param = %d: unknown", (int)param);
+  if (!ssJointSupports(joint, param, axis))
+    return ssFail(SS_ERROR_UNSUPPORTED, "axis = %d: a %s joint has no %s parameters on it", axis,
+                  ssJointTypeName(joint), ssJointParamName(param));
+  ssStatus status = ssValidateSpring(spring);
+  if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
+  if (status != SS_OK) return status;
+
+  JointBinding binding = {joint, param, axis, spring, effective_mass, {0, 0}};
+  for (int i = 0; i < registry->joint_count; ++i) {
+    JointBinding* existing = &registry->joints[i];
+    if (existing->joint == joint && existing->param == param && existing->axis == axis) {
+      *existing = binding;
+      return SS_OK;
+    }
+  }
+  if (!reserveOne((void**)&registry->joints, registry->joint_count, &registry->joint_capacity, sizeof binding))
+    return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding a joint");
+  registry->joints[registry->joint_count++] = binding;
+  return SS_OK;
+}
+
+ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
+  int kept = 0;
+  for (int i = 0; i < registry->joint_count; ++i)
+    if (registry->joints[i].joint != joint) registry->joints[kept++] = registry->joints[i];
+  if (kept == registry->joint_count) return ssFail(SS_ERROR_NOT_FOUND, "joint %p: not bound", (void*)joint);
+  registry->joint_count = kept;
+  return SS_OK;
+}
+
+/* The binding of body (0: the world's defaults), created empty if absent; NULL when out of memory. */
+static BodyBinding* bodyBinding(ssRegistry* registry, dBodyID body) {
+  for (int i = 0; i < registry->body_count; ++i)
+    if (registry->bodies[i].body == body) return &registry->bodies[i];
+  if (!reserveOne((void**)&registry->bodies, registry->body_count, &registry->body_capacity, sizeof(BodyBinding)))
+    return NULL;
+  BodyBinding* binding = &registry->bodies[registry->body_count++];
+  memset(binding, 0, sizeof *binding);
+  binding->body = body;
+  return binding;
+}
+
+ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linear_rate_per_s,
+                                double angular_rate_per_s) {
+  ssStatus status = ssCheckNonNegative("linear_rate_per_s", "1/s", linear_rate_per_s);
+  if (status == SS_OK) status = ssCheckNonNegative("angular_rate_per_s", "1/s", angular_rate_per_s);
+  if (status != SS_OK) return status;
+  BodyBinding* binding = bodyBinding(registry, body);
+  if (binding == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding damping");
+  binding->has_damping = 1;
+  binding->linear_rate_per_s = linear_rate_per_s;
+  binding->angular_rate_per_s = angular_rate_per_s;
+  return SS_OK;
+}
+
+ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double idle_time_s, double average_window_s) {
+  ssStatus status = ssCheckPositive("idle_time_s", "s", idle_time_s);
+  if (status == SS_OK) status = ssCheckNonNegative("average_window_s", "s", average_window_s);
+  if (status != SS_OK) return status;
+  BodyBinding* binding = bodyBinding(registry, body);
+  if (binding == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding auto-disable");
+  binding->has_auto_disable = 1;
+  binding->idle_time_s = idle_time_s;
+  binding->average_window_s = average_window_s;
+  binding->average_samples_written = 0;
+  return SS_OK;
+}
+
+ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body) {
+  for (int i = 0; i < registry->body_count; ++i) {
+    if (registry->bodies[i].body != body) continue;
+    registry->bodies[i] = registry->bodies[--registry->body_count];
+    return SS_OK;
+  }
+  return ssFail(SS_ERROR_NOT_FOUND, "body %p: not bound", (void*)body);
+}
+
+/* Prefixes the current message with what failed, so that a caller of Apply learns which binding it was. */
+static ssStatus failBinding(ssStatus status, const JointBinding* binding) {
+  char cause[200];
+  strncpy(cause, ssLastError(), sizeof cause - 1);
+  cause[sizeof cause - 1] = '\0';
+  if (binding == NULL) return ssFail(status, "world ERP/CFM: %s", cause);
+  return ssFail(status, "%s joint %p, %s axis %d: %s", ssJointTypeName(binding->joint), (void*)binding->joint,
+                ssJointParamName(binding->param), binding->axis, cause);
+}
+
+/* The softness of one spring for this step; EXACT falls back to MATCHED where the pair of steps has no finite
+ * mapping (counted in the report), which keeps the exact poles and loses only the history correction. */
+static ssStatus softnessFor(ssMapping mapping, ssSpring spring, double mass, double step_s, double previous_step_s,
+                            ssApplyReport* report, ssSoftness* out) {
+  ssStatus status = ssSoftnessFor(mapping, spring, mass, step_s, previous_step_s, out);
+  if (status == SS_ERROR_NO_FINITE_MAPPING && mapping == SS_MAPPING_EXACT && spring.damping > 0) {
+    status = ssMatchedSoftness(spring, mass, step_s, out);
+    if (status == SS_OK) report->rows_exact_fallback += 1;
+  }
+  if (status == SS_OK && spring.stiffness > 0 && sqrt(spring.stiffness / mass) * step_s > M_PI)
+    report->rows_over_nyquist += 1; /* w·h > π: the natural frequency is above half the step rate */
+  return status;
+}
+
+ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
+                          ssApplyReport* report) {
+  ssStatus status = ssCheckPositive("step_s", "s", step_s);
+  if (status == SS_OK) status = ssCheckNonNegative("previous_step_s", "s", previous_step_s);
+  if (status != SS_OK) return status;
+  if (ssMappingName(mapping) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "mapping = %d: unknown", (int)mapping);
+
+  ssApplyReport counts = {0, 0, 0};
+  if (registry->world_bound) {
+    status = softnessFor(mapping, registry->world_spring, registry->world_mass, step_s, previous_step_s, &counts,
+                         &registry->world_pending);
+    if (status != SS_OK) return failBinding(status, NULL);
+  }
+  for (int i = 0; i < registry->joint_count; ++i) {
+    JointBinding* binding = &registry->joints[i];
+    double mass = binding->effective_mass;
+    if (mass == 0) {
+      status = ssJointEffectiveMass(binding->joint, binding->param, binding->axis, &mass);
+      if (status != SS_OK) return failBinding(status, binding);
+    }
+    status = softnessFor(mapping, binding->spring, mass, step_s, previous_step_s, &counts, &binding->pending);
+    if (status != SS_OK) return failBinding(status, binding);
+  }
+
+  /* Second pass: nothing below can fail. */
+  if (registry->world_bound) {
+    dWorldSetERP(registry->world, registry->world_pending.erp);
+    dWorldSetCFM(registry->world, registry->world_pending.cfm);
+    counts.rows_written += 1;
+  }
+  for (int i = 0; i < registry->joint_count; ++i) {
+    const JointBinding* binding = &registry->joints[i];
+    ssJointWriteSoftness(binding->joint, binding->param, binding->axis, binding->pending.erp, binding->pending.cfm);
+  }
+  counts.rows_written += registry->joint_count;
+  for (int i = 0; i < registry->body_count; ++i) {
+    BodyBinding* binding = &registry->bodies[i];
+    dBodyID body = binding->body;
+    if (binding->has_damping) {
+      /* ODE scales velocity by (1 - scale) once per step: this scale removes the same fraction per second */
+      double linear = -expm1(-binding->linear_rate_per_s * step_s);
+      double angular = -expm1(-binding->angular_rate_per_s * step_s);
+      if (body) {
+        dBodySetLinearDamping(body, linear);
+        dBodySetAngularDamping(body, angular);
+      } else {
+        dWorldSetLinearDamping(registry->world, linear);
+        dWorldSetAngularDamping(registry->world, angular);
+      }
+    }
+    if (binding->has_auto_disable) {
+      double steps = ceil(binding->idle_time_s / step_s);
+      int idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
+      double samples = fmax(1.0, ceil(binding->average_window_s / step_s));
+      int average_samples = samples < 1e6 ? (int)samples : 1000000;
+      if (body) {
+        dBodySetAutoDisableSteps(body, idle_steps);
+        dBodySetAutoDisableTime(body, binding->idle_time_s);
+        if (average_samples != binding->average_samples_written)
+          dBodySetAutoDisableAverageSamplesCount(body, (unsigned)average_samples);
+      } else {
+        dWorldSetAutoDisableSteps(registry->world, idle_steps);
+        dWorldSetAutoDisableTime(registry->world, binding->idle_time_s);
+        if (average_samples != binding->average_samples_written)
+          dWorldSetAutoDisableAverageSamplesCount(registry->world, (unsigned)average_samples);
+      }
+      binding->average_samples_written = average_samples;
+    }
+  }
+  if (report != NULL) *report = counts;
+  return SS_OK;
+}
+
+int ssRegistry_JointBindingCount(const ssRegistry* registry) { return registry->joint_count; }
+
+void ssRegistryVisitBodiesRepeated(const ssRegistry* registry, void (*visit)(void* context, dBodyID body),
+                                   void* context) {
+  for (int i = 0; i < registry->joint_count; ++i)
+    for (int side = 0; side < 2; ++side) {
+      dBodyID body = dJointGetBody(registry->joints[i].joint, side);
+      if (body != 0) visit(context, body);
+    }
+  for (int i = 0; i < registry->body_count; ++i)
+    if (registry->bodies[i].body != 0) visit(context, registry->bodies[i].body);
+}
+
+typedef struct BodyList {
+  dBodyID* bodies;
+  int count;
+} BodyList;
+
+static void appendBody(void* context, dBodyID body) {
+  BodyList* list = context;
+  list->bodies[list->count++] = body;
+}
+
+static int compareBodies(const void* a, const void* b) {
+  uintptr_t x = (uintptr_t) * (const dBodyID*)a, y = (uintptr_t) * (const dBodyID*)b;
+  return (x > y) - (x < y);
+}
+
+void ssRegistry_VisitBodies(const ssRegistry* registry, void (*visit)(void* context, dBodyID body), void* context) {
+  size_t most = 2 * (size_t)registry->joint_count + (size_t)registry->body_count;
+  BodyList list = {malloc((most ? most : 1) * sizeof(dBodyID)), 0};
+  if (list.bodies == NULL) { /* rather a body twice than none */
+    ssRegistryVisitBodiesRepeated(registry, visit, context);
+    return;
+  }
+  ssRegistryVisitBodiesRepeated(registry, appendBody, &list);
+  qsort(list.bodies, (size_t)list.count, sizeof(dBodyID), compareBodies);
+  for (int i = 0; i < list.count; ++i)
+    if (i == 0 || list.bodies[i] != list.bodies[i - 1]) visit(context, list.bodies[i]);
+  free(list.bodies);
+}
