@@ -10,7 +10,8 @@
  *   buggy       a four-wheeled car with hinge-2 wheels on spring suspension, driving over bumps
  *               (chassis height m, chassis pitch rad)
  *   drop        boxes dropped onto the ground with soft contacts from the spring (penetration m, height m)
- *   chain       a hanging chain of bodies on ball joints with soft hinge limits under gravity (end x m, end z m)
+ *   chain       a chain of links on hinge joints with soft limits (+-0.4 rad), pinned at one end and released
+ *               horizontal under gravity (end x m, end z m)
  *   pile        many boxes in a heap for timing (mean height m)
  */
 #ifndef STEADYSTEP_SCENE_H
@@ -68,6 +69,11 @@ ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
 /** The stepper's defaults as an ssStepping. */
 ssStepping ssDefaultStepping(void);
 
+/** The stepping of a reference run: policy spring with substeps of at most step_s (s, > 0; e.g. 1/1000), fixed_step_s
+ *  also step_s, the other fields as ssDefaultStepping. Run it under the profile "fixed:N" with N = 1/step_s (e.g.
+ *  "fixed:1000") so that every frame is one step. step_s is not checked here: ssScene_Create refuses a bad one. */
+ssStepping ssReferenceStepping(double step_s);
+
 typedef struct ssScene ssScene;
 
 /** Builds a scene. Errors: SS_ERROR_NOT_FOUND (unknown scene), those of ssValidateSpring, SS_ERROR_OUT_OF_RANGE
@@ -79,7 +85,8 @@ ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssS
 void ssScene_Destroy(ssScene* scene);
 
 /** Advances one frame of frame_s seconds through the scene's stepper. steps (may be NULL) receives the physics
- *  steps taken. Errors: those of ssStepper_Step. */
+ *  steps taken. Every body is watched, with a speed limit of 100 m/s (no scene moves anything near that fast).
+ *  Errors: those of ssStepper_Step (SS_ERROR_BLOWUP, SS_ERROR_SPEED_LIMIT when the scene explodes). */
 ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps);
 
 /** The followed quantities now, quantity_count of them, into out. */
@@ -107,7 +114,8 @@ ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out);
 /** Destroys the run. NULL is a no-op. */
 void ssRun_Destroy(ssRun* run);
 
-/** Records: one per physics step, time (s) after the step, the step's length (s), and each quantity. */
+/** Records: one per physics step, time (s) after the step, the step's length (s), and each quantity (NULL for an
+ *  index outside [0, quantity_count)). The arrays belong to the run. */
 int ssRun_StepCount(const ssRun* run);
 const double* ssRun_Times(const ssRun* run);
 const double* ssRun_StepLengths(const ssRun* run);

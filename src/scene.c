@@ -1,0 +1,236 @@
+/* The table of scenes, and a scene's life: validate, build the world, step it frame by frame, sample it.
+ *
+ * Everything a caller can get wrong is checked before ODE is touched, so a refused scene leaves no world behind
+ * and the message names the value. The stepper gets a speed limit so that a scene that explodes ends its run with
+ * SS_ERROR_SPEED_LIMIT instead of running on with nonsense. */
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "scene_internal.h"
+
+/* No reference scene moves anything faster than a few m/s; 100 m/s means it exploded. */
+#define SS_SCENE_MAX_SPEED_M_PER_S 100.0
+
+static const ssSceneDesc* const scenes[] = {
+    &ssOscillatorScene, &ssBuggyScene, &ssDropScene, &ssChainScene, &ssPileScene,
+};
+enum { SCENE_COUNT = sizeof scenes / sizeof scenes[0] };
+
+struct ssScene {
+  const ssSceneDesc* desc;
+  ssSceneWorld parts;
+  void* state;
+  double time_s;
+  ssSceneStepFn* observer;
+  void* observer_context;
+};
+
+static pthread_once_t ode_once = PTHREAD_ONCE_INIT;
+static _Thread_local int ode_thread_ready;
+
+static void init_ode(void) { dInitODE2(0); }
+
+void ssEnsureOde(void) {
+  pthread_once(&ode_once, init_ode);
+  /* An ODE built with thread-local collision data needs this on every thread that collides. */
+  if (!ode_thread_ready) ode_thread_ready = dAllocateODEDataForThread(dAllocateMaskAll);
+}
+
+int ssSceneCount(void) { return SCENE_COUNT; }
+
+const ssSceneInfo* ssSceneInfoAt(int index) {
+  if (index < 0 || index >= SCENE_COUNT) return NULL;
+  return &scenes[index]->info;
+}
+
+static const ssSceneDesc* find_desc(const char* name) {
+  if (name == NULL) return NULL;
+  for (int i = 0; i < SCENE_COUNT; ++i)
+    if (strcmp(scenes[i]->info.name, name) == 0) return scenes[i];
+  return NULL;
+}
+
+const ssSceneInfo* ssSceneFind(const char* name) {
+  const ssSceneDesc* desc = find_desc(name);
+  return desc != NULL ? &desc->info : NULL;
+}
+
+static ssStatus find_or_fail(const char* name, const ssSceneDesc** out) {
+  *out = find_desc(name);
+  if (*out != NULL) return SS_OK;
+  return ssFail(SS_ERROR_NOT_FOUND, "scene = \"%s\": unknown (oscillator, buggy, drop, chain, pile)",
+                name != NULL ? name : "(null)");
+}
+
+ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out) {
+  const ssSceneDesc* desc;
+  ssStatus status = find_or_fail(name, &desc);
+  if (status != SS_OK) return status;
+  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the parameters");
+  *out = desc->defaults;
+  return SS_OK;
+}
+
+ssStepping ssDefaultStepping(void) {
+  ssStepperDef def = ssDefaultStepperDef();
+  return (ssStepping){
+      .policy = (int)def.policy,
+      .solver = (int)def.solver,
+      .quick_iterations = def.quick_iterations,
+      .max_step_s = def.max_step_s,
+      .reference_step_s = def.reference_step_s,
+      .fixed_step_s = def.fixed_step_s,
+      .max_steps_per_frame = def.max_steps_per_frame,
+  };
+}
+
+ssStepping ssReferenceStepping(double step_s) {
+  ssStepping stepping = ssDefaultStepping();
+  stepping.policy = SS_POLICY_SPRING;
+  stepping.max_step_s = step_s;
+  stepping.fixed_step_s = step_s;
+  return stepping;
+}
+
+static ssStatus validate_params(const ssSceneDesc* desc, const ssSceneParams* params) {
+  ssStatus status = ssValidateSpring(params->spring);
+  if (status == SS_OK) status = ssCheckPositive("mass", "kg", params->mass);
+  if (status == SS_OK) status = ssCheckFinite("x0", "m", params->x0);
+  if (status == SS_OK) status = ssCheckFinite("gravity", "m/s^2", params->gravity);
+  if (status != SS_OK) return status;
+  if (params->body_count < 0)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "body_count = %d: must not be negative (0 = the scene's default)",
+                  params->body_count);
+  if (desc->max_body_count > 0 && params->body_count > desc->max_body_count)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "body_count = %d: scene \"%s\" takes at most %d", params->body_count,
+                  desc->info.name, desc->max_body_count);
+  return SS_OK;
+}
+
+static ssStatus validate_stepping(const ssStepping* stepping, const ssSpring* spring) {
+  if (ssPolicyName((ssPolicy)stepping->policy) == NULL)
+    return ssFail(SS_ERROR_UNSUPPORTED, "stepping.policy = %d: unknown (0 naive, 1 spring, 2 matched, 3 exact, 4 fixed)",
+                  stepping->policy);
+  if (stepping->solver != SS_SOLVER_QUICK && stepping->solver != SS_SOLVER_STEP)
+    return ssFail(SS_ERROR_UNSUPPORTED, "stepping.solver = %d: unknown (0 quick, 1 step)", stepping->solver);
+  if (stepping->quick_iterations <= 0)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.quick_iterations = %d: must be positive",
+                  stepping->quick_iterations);
+  if (stepping->max_steps_per_frame <= 0)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.max_steps_per_frame = %d: must be positive",
+                  stepping->max_steps_per_frame);
+  ssStatus status = ssCheckPositive("stepping.max_step_s", "s", stepping->max_step_s);
+  if (status == SS_OK) status = ssCheckPositive("stepping.reference_step_s", "s", stepping->reference_step_s);
+  if (status == SS_OK) status = ssCheckPositive("stepping.fixed_step_s", "s", stepping->fixed_step_s);
+  if (status != SS_OK) return status;
+  /* Found here rather than at the first frame, where it would stop a run that could never have worked. */
+  int exact_poles = stepping->policy == SS_POLICY_MATCHED || stepping->policy == SS_POLICY_EXACT;
+  if (exact_poles && spring->damping == 0)
+    return ssFail(SS_ERROR_NO_FINITE_MAPPING, "c = 0 N*s/m: policy %s needs a damped spring",
+                  ssPolicyName((ssPolicy)stepping->policy));
+  return SS_OK;
+}
+
+static void scene_step_done(void* context, double step_s) {
+  ssScene* scene = context;
+  scene->time_s += step_s;
+  if (scene->observer != NULL) scene->observer(scene->observer_context, scene, step_s);
+}
+
+static void free_world(ssSceneWorld* parts) {
+  ssStepper_Destroy(parts->stepper);
+  ssRegistry_Destroy(parts->registry);
+  if (parts->contacts != 0) dJointGroupDestroy(parts->contacts);
+  if (parts->space != 0) dSpaceDestroy(parts->space);
+  if (parts->world != 0) dWorldDestroy(parts->world);
+}
+
+static ssStatus make_stepper(ssScene* scene, const ssStepping* stepping) {
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = scene->parts.world;
+  def.registry = scene->parts.registry;
+  def.policy = (ssPolicy)stepping->policy;
+  def.solver = (ssSolver)stepping->solver;
+  def.quick_iterations = stepping->quick_iterations;
+  def.max_step_s = stepping->max_step_s;
+  def.reference_step_s = stepping->reference_step_s;
+  def.fixed_step_s = stepping->fixed_step_s;
+  def.max_steps_per_frame = stepping->max_steps_per_frame;
+  def.max_speed = SS_SCENE_MAX_SPEED_M_PER_S;
+  def.collide = scene->desc->collide;
+  def.collide_context = scene->state;
+  def.step_done = scene_step_done;
+  def.step_done_context = scene;
+  def.contact_group = scene->parts.contacts;
+  ssStatus status = ssStepper_Create(&def, &scene->parts.stepper);
+  if (status != SS_OK) return status;
+  if (scene->desc->watch != NULL) status = scene->desc->watch(scene->state, scene->parts.stepper);
+  return status;
+}
+
+ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssStepping* stepping, ssScene** out) {
+  const ssSceneDesc* desc;
+  ssStatus status = find_or_fail(name, &desc);
+  if (status != SS_OK) return status;
+  if (params == NULL || stepping == NULL || out == NULL)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_Create needs params, stepping and out",
+                  params == NULL ? "params" : stepping == NULL ? "stepping" : "out");
+  status = validate_params(desc, params);
+  if (status == SS_OK) status = validate_stepping(stepping, &params->spring);
+  if (status != SS_OK) return status;
+
+  ssSceneParams resolved = *params;
+  if (resolved.body_count == 0) resolved.body_count = desc->defaults.body_count;
+
+  ssScene* scene = calloc(1, sizeof *scene);
+  if (scene == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "scene \"%s\": out of memory", name);
+  scene->desc = desc;
+  ssEnsureOde();
+  scene->parts.world = dWorldCreate();
+  scene->parts.space = dHashSpaceCreate(0);
+  scene->parts.contacts = dJointGroupCreate(0);
+  scene->parts.registry = ssRegistry_Create(scene->parts.world);
+  if (scene->parts.registry == NULL) {
+    status = ssFail(SS_ERROR_OUT_OF_MEMORY, "scene \"%s\": out of memory for the registry", name);
+  } else {
+    status = desc->build(&scene->parts, &resolved, &scene->state);
+  }
+  if (status == SS_OK) status = make_stepper(scene, stepping);
+  if (status != SS_OK) {
+    if (scene->state != NULL) desc->destroy(scene->state);
+    free_world(&scene->parts);
+    free(scene);
+    return status;
+  }
+  *out = scene;
+  return SS_OK;
+}
+
+void ssScene_Destroy(ssScene* scene) {
+  if (scene == NULL) return;
+  ssStepper_Destroy(scene->parts.stepper);
+  scene->parts.stepper = NULL;
+  scene->desc->destroy(scene->state);
+  free_world(&scene->parts);
+  free(scene);
+}
+
+ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps) {
+  if (scene == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to step");
+  ssEnsureOde();
+  ssFrameReport report = {0};
+  ssStatus status = ssStepper_Step(scene->parts.stepper, frame_s, &report);
+  if (steps != NULL) *steps = report.steps;
+  return status;
+}
+
+void ssScene_Sample(const ssScene* scene, double* out) { scene->desc->sample(scene->state, out); }
+
+double ssScene_Time(const ssScene* scene) { return scene->time_s; }
+
+void ssScene_SetStepObserver(ssScene* scene, ssSceneStepFn* observer, void* context) {
+  scene->observer = observer;
+  scene->observer_context = context;
+}

@@ -1,0 +1,44 @@
+/* The near callback shared by the scenes that touch the ground: every contact is softened by one spring for the
+ * step the stepper is about to take, so contact softness follows the policy like every other soft row. */
+
+#include "scene_internal.h"
+
+typedef struct CollideCall {
+  ssContactRecipe* recipe;
+  ssMapping mapping;
+  double step_s;
+  double previous_step_s;
+} CollideCall;
+
+static void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
+  CollideCall* call = data;
+  ssContactRecipe* recipe = call->recipe;
+  dBodyID body1 = dGeomGetBody(geom1), body2 = dGeomGetBody(geom2);
+  if (body1 == 0 && body2 == 0) return;  /* static against static: the ground and its bumps */
+  /* Bodies held together by a joint (a wheel and its chassis) overlap by design. */
+  if (body1 != 0 && body2 != 0 && dAreConnectedExcluding(body1, body2, dJointTypeContact)) return;
+
+  dContact contacts[SS_MAX_PAIR_CONTACTS];
+  int count = dCollide(geom1, geom2, recipe->max_contacts, &contacts[0].geom, sizeof contacts[0]);
+  for (int i = 0; i < count; ++i) {
+    dContact* contact = &contacts[i];
+    contact->surface.mode = recipe->surface_mode;
+    contact->surface.mu = recipe->mu;
+    /* Only a validated spring and a dynamic body get here, so softening cannot fail; a contact that could not
+     * be softened is still better dropped than made rigid behind the policy's back. */
+    if (ssContactSoften(contact, body1, body2, recipe->spring, call->mapping, call->step_s, call->previous_step_s) !=
+        SS_OK)
+      continue;
+    if (contact->geom.depth > recipe->deepest_m) recipe->deepest_m = contact->geom.depth;
+    dJointID joint = dJointCreateContact(recipe->world, recipe->contacts, contact);
+    dJointAttach(joint, body1, body2);
+    ++recipe->contact_count;
+  }
+}
+
+void ssContactCollide(ssContactRecipe* recipe, ssMapping mapping, double step_s, double previous_step_s) {
+  recipe->deepest_m = 0;
+  recipe->contact_count = 0;
+  CollideCall call = {recipe, mapping, step_s, previous_step_s};
+  dSpaceCollide(recipe->space, &call, near_callback);
+}

@@ -1,0 +1,77 @@
+/* Internal: what a scene is made of, shared by scene.c (the table and the runner of frames), the scene files in
+ * src/scenes/ and run.c (which records every physics step).
+ *
+ * A scene is data plus a builder. scene.c owns the ODE world, its collision space, the contact group, the registry
+ * and the stepper; a scene's build function only fills the world with bodies, joints and geoms, binds its soft
+ * parts in the registry and returns its own state. Adding a scene is one file in src/scenes/ and one table line. */
+#ifndef STEADYSTEP_SCENE_INTERNAL_H
+#define STEADYSTEP_SCENE_INTERNAL_H
+
+#include <ode/ode.h>
+
+#include "steadystep/registry.h"
+#include "steadystep/scene.h"
+#include "steadystep/stepper.h"
+
+/* What a builder gets to fill. */
+typedef struct ssSceneWorld {
+  dWorldID world;
+  dSpaceID space;
+  dJointGroupID contacts;
+  ssRegistry* registry;
+  ssStepper* stepper; /* NULL while building; set before the first step (for ssStepper_WatchBody in watch) */
+} ssSceneWorld;
+
+typedef struct ssSceneDesc {
+  ssSceneInfo info;
+  /* The parameters ssDefaultSceneParams hands out; body_count here is the scene's real default (never 0). */
+  ssSceneParams defaults;
+  /* Largest body_count the scene accepts (memory and time stay bounded); 0 = the scene ignores body_count. */
+  int max_body_count;
+  /* Builds into world from validated params (body_count already resolved from 0 to the default). Returns the
+   * scene's state in *state. On error it frees what it made; scene.c destroys the world. */
+  ssStatus (*build)(const ssSceneWorld* world, const ssSceneParams* params, void** state);
+  /* Registers with the stepper the bodies the registry does not watch already (free bodies). May be NULL. */
+  ssStatus (*watch)(void* state, ssStepper* stepper);
+  /* The stepper's collide callback: create contacts for a step of step_s under mapping. May be NULL. */
+  ssCollideFn* collide;
+  /* The followed quantities after a step, info.quantity_count of them. */
+  void (*sample)(const void* state, double* out);
+  /* Frees the state (ODE objects go with the world). */
+  void (*destroy)(void* state);
+} ssSceneDesc;
+
+/* The scenes, each defined in its own file under src/scenes/. */
+extern const ssSceneDesc ssOscillatorScene;
+extern const ssSceneDesc ssBuggyScene;
+extern const ssSceneDesc ssDropScene;
+extern const ssSceneDesc ssChainScene;
+extern const ssSceneDesc ssPileScene;
+
+/* Called after every physics step of the scene, after its time has advanced; run.c records with it. */
+typedef void ssSceneStepFn(void* context, const ssScene* scene, double step_s);
+void ssScene_SetStepObserver(ssScene* scene, ssSceneStepFn* observer, void* context);
+
+/* Contacts against everything in a space, softened with one spring: the near callback the contact scenes share.
+ * Pairs of bodies joined by a joint do not collide. deepest_m receives the deepest contact depth of this step. */
+typedef struct ssContactRecipe {
+  dWorldID world;
+  dSpaceID space;
+  dJointGroupID contacts;
+  ssSpring spring;      /* the contact's spring-damper along the normal */
+  int max_contacts;     /* per pair of geoms, <= SS_MAX_PAIR_CONTACTS */
+  int surface_mode;     /* extra dContact* mode bits (dContactApprox1, ...); soft ERP/CFM bits are added */
+  double mu;            /* Coulomb friction coefficient (dContactApprox1: force ratio) */
+  double deepest_m;     /* out: the deepest contact of the last collide call (m) */
+  int contact_count;    /* out: contacts made by the last collide call */
+} ssContactRecipe;
+
+#define SS_MAX_PAIR_CONTACTS 8
+
+/* Runs dSpaceCollide on recipe->space and softens every contact for (mapping, step_s, previous_step_s). */
+void ssContactCollide(ssContactRecipe* recipe, ssMapping mapping, double step_s, double previous_step_s);
+
+/* Calls dInitODE2 once per process and allocates ODE's per-thread data once per thread; never dCloseODE. */
+void ssEnsureOde(void);
+
+#endif
