@@ -1,0 +1,143 @@
+/* A four-wheeled car driving forward over a few bumps: its suspension is the spring.
+ *
+ * Each wheel hangs on a hinge-2 joint: axis 1 vertical (steering, and the suspension slides along it), axis 2 the
+ * wheel's spin axis, driven by a motor. Steering is locked with lo = hi = 0 stops on axis 1. Every soft thing is
+ * bound: the suspension to the scene's spring, the ground contacts to a stiff spring, and the world's ERP/CFM
+ * (the hinge-2 rigid rows) to a stiff spring too, so that policy naive freezes all of them and policy spring maps
+ * all of them; nothing is left with a fixed ERP/CFM that would blur the comparison. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "error.h"
+#include "scene_internal.h"
+
+#define BUGGY_LENGTH_M 0.7
+#define BUGGY_WIDTH_M 0.5
+#define BUGGY_HEIGHT_M 0.2
+#define BUGGY_WHEEL_RADIUS_M 0.18
+#define BUGGY_WHEEL_MASS_KG 0.2
+#define BUGGY_AXLE_X_M 0.3         /* wheels at +-this along the car */
+#define BUGGY_TRACK_Y_M 0.32       /* wheels at +-this across the car */
+#define BUGGY_CHASSIS_Z_M 0.36     /* chassis centre at the start */
+#define BUGGY_SPEED_M_PER_S 1.5    /* the motors aim for this ground speed */
+#define BUGGY_MOTOR_TORQUE_NM 0.6  /* dParamFMax2 of each wheel motor */
+#define BUGGY_BUMP_COUNT 3
+
+/* Ground contacts: stiff next to the suspension (a few hundred Hz on a wheel), well damped. */
+static const ssSpring buggy_ground_spring = {.stiffness = 2e4, .damping = 200};
+/* The hinge-2 rigid rows, as in chain.c: stiff and critically damped per kg. */
+static const ssSpring buggy_world_spring = {.stiffness = 1e5, .damping = 630};
+
+/* Bumps across the path: x of the centre, length along x, height (m). */
+static const double bumps[BUGGY_BUMP_COUNT][3] = {{1.0, 0.3, 0.05}, {2.0, 0.2, 0.07}, {3.0, 0.4, 0.04}};
+
+typedef struct Buggy {
+  dBodyID chassis;
+  dBodyID wheels[4];
+  ssContactRecipe recipe;
+} Buggy;
+
+static dBodyID make_wheel(const ssSceneWorld* world, double x, double y, double z) {
+  dBodyID wheel = dBodyCreate(world->world);
+  dMass mass;
+  dMassSetSphereTotal(&mass, BUGGY_WHEEL_MASS_KG, BUGGY_WHEEL_RADIUS_M);
+  dBodySetMass(wheel, &mass);
+  dBodySetPosition(wheel, x, y, z);
+  dGeomID geom = dCreateSphere(world->space, BUGGY_WHEEL_RADIUS_M);
+  dGeomSetBody(geom, wheel);
+  return wheel;
+}
+
+static ssStatus attach_wheel(const ssSceneWorld* world, const ssSceneParams* params, dBodyID chassis,
+                             dBodyID wheel) {
+  const dReal* at = dBodyGetPosition(wheel);
+  dJointID joint = dJointCreateHinge2(world->world, 0);
+  dJointAttach(joint, chassis, wheel);
+  dJointSetHinge2Anchor(joint, at[0], at[1], at[2]);
+  const dReal steer_axis[3] = {0, 0, 1}, spin_axis[3] = {0, 1, 0};
+  dJointSetHinge2Axes(joint, steer_axis, spin_axis);
+  dJointSetHinge2Param(joint, dParamLoStop, 0);
+  dJointSetHinge2Param(joint, dParamHiStop, 0);
+  /* Rolling forward (+x) spins the wheel about +y, which hinge-2 reports as a negative axis-2 rate (its rate is of
+   * body 1, the chassis, relative to body 2): a positive motor velocity drives the car backwards. */
+  dJointSetHinge2Param(joint, dParamVel2, -BUGGY_SPEED_M_PER_S / BUGGY_WHEEL_RADIUS_M);
+  dJointSetHinge2Param(joint, dParamFMax2, BUGGY_MOTOR_TORQUE_NM);
+  return ssRegistry_BindJoint(world->registry, joint, SS_PARAM_SUSPENSION, 1, params->spring, 0);
+}
+
+static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, void** state) {
+  Buggy* buggy = calloc(1, sizeof *buggy);
+  if (buggy == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "buggy: out of memory");
+  dWorldSetGravity(world->world, 0, 0, -params->gravity);
+  ssStatus status = ssRegistry_BindWorld(world->registry, buggy_world_spring, params->mass);
+
+  dCreatePlane(world->space, 0, 0, 1, 0);
+  for (int i = 0; i < BUGGY_BUMP_COUNT; ++i) {
+    dGeomID bump = dCreateBox(world->space, bumps[i][1], 4.0, 2.0 * bumps[i][2]);
+    dGeomSetPosition(bump, bumps[i][0], 0, 0);  /* half buried: its top is bumps[i][2] above the ground */
+  }
+
+  buggy->chassis = dBodyCreate(world->world);
+  dMass mass;
+  dMassSetBoxTotal(&mass, params->mass, BUGGY_LENGTH_M, BUGGY_WIDTH_M, BUGGY_HEIGHT_M);
+  dBodySetMass(buggy->chassis, &mass);
+  dBodySetPosition(buggy->chassis, 0, 0, BUGGY_CHASSIS_Z_M);
+  dGeomID body_geom = dCreateBox(world->space, BUGGY_LENGTH_M, BUGGY_WIDTH_M, BUGGY_HEIGHT_M);
+  dGeomSetBody(body_geom, buggy->chassis);
+
+  /* Wheels start touching the ground; the suspension then settles under the car's weight. */
+  for (int i = 0; status == SS_OK && i < 4; ++i) {
+    double x = (i < 2 ? 1 : -1) * BUGGY_AXLE_X_M, y = (i % 2 == 0 ? 1 : -1) * BUGGY_TRACK_Y_M;
+    buggy->wheels[i] = make_wheel(world, x, y, BUGGY_WHEEL_RADIUS_M);
+    status = attach_wheel(world, params, buggy->chassis, buggy->wheels[i]);
+  }
+  if (status != SS_OK) {
+    free(buggy);
+    return status;
+  }
+  buggy->recipe = (ssContactRecipe){.world = world->world,
+                                    .space = world->space,
+                                    .contacts = world->contacts,
+                                    .spring = buggy_ground_spring,
+                                    .max_contacts = 4,
+                                    .surface_mode = dContactApprox1,
+                                    .mu = 1.0};
+  *state = buggy;
+  return SS_OK;
+}
+
+static ssStatus watch(void* state, ssStepper* stepper) {
+  Buggy* buggy = state;
+  return ssStepper_WatchBody(stepper, buggy->chassis);
+}
+
+static void collide(void* context, ssMapping mapping, double step_s, double previous_step_s) {
+  Buggy* buggy = context;
+  ssContactCollide(&buggy->recipe, mapping, step_s, previous_step_s);
+}
+
+static void sample(const void* state, double* out) {
+  const Buggy* buggy = state;
+  const dReal* rotation = dBodyGetRotation(buggy->chassis);
+  out[0] = dBodyGetPosition(buggy->chassis)[2];
+  /* The chassis' forward axis in world coordinates is (R[0], R[4], R[8]): its climb is the pitch, nose up > 0. */
+  out[1] = atan2(rotation[8], hypot(rotation[0], rotation[4]));
+}
+
+static void destroy(void* state) { free(state); }
+
+const ssSceneDesc ssBuggyScene = {
+    .info = {.name = "buggy",
+             .description = "a four-wheeled car on hinge-2 spring suspension driving over bumps",
+             .quantity_count = 2,
+             .quantity_names = {"chassis height", "chassis pitch"},
+             .quantity_units = {"m", "rad"}},
+    /* Per wheel: about 4 Hz on a quarter of the 1 kg chassis, lightly damped so the bumps set it rocking. */
+    .defaults = {.spring = {.stiffness = 150, .damping = 1.5}, .mass = 1, .x0 = 0, .gravity = 9.81, .body_count = 0},
+    .max_body_count = 0,
+    .build = build,
+    .watch = watch,
+    .collide = collide,
+    .sample = sample,
+    .destroy = destroy,
+};
