@@ -182,7 +182,7 @@ static ssStatus softnessFor(ssMapping mapping, ssSpring spring, double mass, dou
     status = ssMatchedSoftness(spring, mass, step_s, out);
     if (status == SS_OK) report->rows_exact_fallback += 1;
   }
-  if (status == SS_OK && spring.stiffness > 0 && sqrt(spring.stiffness / mass) * step_s > M_PI)
+  if (status == SS_OK && spring.stiffness > 0 && isfinite(mass) && sqrt(spring.stiffness / mass) * step_s > M_PI)
     report->rows_over_nyquist += 1; /* w·h > π: the natural frequency is above half the step rate */
   return status;
 }
@@ -205,7 +205,9 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     double mass = binding->effective_mass;
     if (mass == 0) {
       status = ssJointEffectiveMass(binding->joint, binding->param, binding->axis, &mass);
-      if (status != SS_OK) return failBinding(status, binding);
+      /* the spring mapping needs no mass: without one, only the Nyquist count is skipped */
+      if (status != SS_OK && mapping != SS_MAPPING_SPRING) return failBinding(status, binding);
+      if (status != SS_OK) mass = NAN;
     }
     status = softnessFor(mapping, binding->spring, mass, step_s, previous_step_s, &counts, &binding->pending);
     if (status != SS_OK) return failBinding(status, binding);

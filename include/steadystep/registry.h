@@ -71,7 +71,8 @@ ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint);
 
 /** Binds velocity damping as rates (1/s, >= 0): ODE multiplies velocity by (1 - scale) once per step, so the
  *  registry writes scale = 1 - exp(-rate·h), which removes the same fraction of velocity per second at every step
- *  length. body = NULL binds the world's default damping (dWorldSetLinearDamping/AngularDamping).
+ *  length. body = NULL binds the world's default damping (dWorldSetLinearDamping/AngularDamping), which ODE copies
+ *  into a body when the body is created: bind existing bodies one by one.
  *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE, SS_ERROR_OUT_OF_MEMORY. */
 ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linear_rate_per_s,
                                 double angular_rate_per_s);
@@ -79,7 +80,9 @@ ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linea
 /** Binds auto-disable in seconds: a body at rest for idle_time_s (> 0) is disabled, with its velocity averaged over
  *  average_window_s (>= 0; 0 = the current step only). ODE counts steps, so the registry writes
  *  AutoDisableSteps = ceil(idle/h), AutoDisableTime = idle and AverageSamplesCount = max(1, ceil(window/h)).
- *  body = NULL binds the world's defaults. Enabling auto-disable and its thresholds stay the program's own choice.
+ *  body = NULL binds the world's defaults (copied into bodies when they are created). The sample count is written
+ *  only when it changes, because ODE restarts a body's velocity average whenever it is set. Enabling auto-disable
+ *  and its thresholds stay the program's own choice.
  *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE, SS_ERROR_OUT_OF_MEMORY. */
 ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double idle_time_s, double average_window_s);
 

@@ -1,0 +1,357 @@
+// The registry against real ODE joints: every joint type and parameter set is written for the step length and read
+// back, bad bindings are refused at bind time, and an error in Apply writes nothing.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "ode_fixture.h"
+#include "steadystep/steadystep.h"
+
+namespace {
+
+const ssSpring kSpring = {400.0, 12.0};
+
+// ODE's getter for a joint's parameter number on an axis, written independently of the library's setter.
+double GetParam(dJointID joint, int param, int axis) {
+  int grouped = param + (axis - 1) * dParamGroup;
+  switch (dJointGetType(joint)) {
+    case dJointTypeBall: return dJointGetBallParam(joint, param);
+    case dJointTypeFixed: return dJointGetFixedParam(joint, param);
+    case dJointTypeDBall: return dJointGetDBallParam(joint, param);
+    case dJointTypeDHinge: return dJointGetDHingeParam(joint, param);
+    case dJointTypeTransmission: return dJointGetTransmissionParam(joint, param);
+    case dJointTypeHinge: return dJointGetHingeParam(joint, param);
+    case dJointTypeSlider: return dJointGetSliderParam(joint, param);
+    case dJointTypeUniversal: return dJointGetUniversalParam(joint, grouped);
+    case dJointTypeHinge2: return dJointGetHinge2Param(joint, grouped);
+    case dJointTypePR: return dJointGetPRParam(joint, grouped);
+    case dJointTypePU: return dJointGetPUParam(joint, grouped);
+    case dJointTypePiston: return dJointGetPistonParam(joint, grouped);
+    case dJointTypeAMotor: return dJointGetAMotorParam(joint, grouped);
+    case dJointTypeLMotor: return dJointGetLMotorParam(joint, grouped);
+    default: ADD_FAILURE() << "no getter for joint type " << dJointGetType(joint); return NAN;
+  }
+}
+
+struct Row {
+  ssJointParam param;
+  int axis;
+};
+
+struct JointCase {
+  const char* name;
+  dJointID joint;
+  std::vector<Row> rows;
+};
+
+class RegistryTest : public OdeTest {
+ protected:
+  void SetUp() override {
+    OdeTest::SetUp();
+    a = MakeBody(2.0, 0, 0, 1);
+    b = MakeBody(3.0, 0.5, 0.2, 1.3);
+  }
+
+  // Every joint type with every parameter set it has, attached to two bodies.
+  std::vector<JointCase> AllJoints() {
+    std::vector<JointCase> cases;
+    auto add = [&](const char* name, dJointID joint, std::vector<Row> rows) {
+      dJointAttach(joint, a, b);
+      cases.push_back({name, joint, rows});
+    };
+    const Row j1{SS_PARAM_JOINT, 1};
+    add("ball", dJointCreateBall(world, 0), {j1});
+    add("fixed", dJointCreateFixed(world, 0), {j1});
+    add("dball", dJointCreateDBall(world, 0), {j1});
+    add("dhinge", dJointCreateDHinge(world, 0), {j1});
+    dJointID transmission = dJointCreateTransmission(world, 0);
+    add("transmission", transmission, {j1});
+    dJointSetTransmissionMode(transmission, dTransmissionParallelAxes);
+    auto limits = [](int axes) {
+      std::vector<Row> rows;
+      for (int axis = 1; axis <= axes; ++axis) {
+        rows.push_back({SS_PARAM_STOP, axis});
+        rows.push_back({SS_PARAM_MOTOR, axis});
+      }
+      return rows;
+    };
+    add("hinge", dJointCreateHinge(world, 0), limits(1));
+    add("slider", dJointCreateSlider(world, 0), limits(1));
+    add("universal", dJointCreateUniversal(world, 0), limits(2));
+    std::vector<Row> hinge2 = limits(2);
+    hinge2.push_back({SS_PARAM_SUSPENSION, 1});
+    dJointID h2 = dJointCreateHinge2(world, 0);
+    add("hinge2", h2, hinge2);
+    dJointSetHinge2Axes(h2, (const dReal[]){0, 0, 1}, (const dReal[]){0, 1, 0});
+    add("pr", dJointCreatePR(world, 0), limits(2));
+    add("pu", dJointCreatePU(world, 0), limits(3));
+    add("piston", dJointCreatePiston(world, 0), limits(2));
+    dJointID amotor = dJointCreateAMotor(world, 0);
+    add("amotor", amotor, limits(3));
+    dJointSetAMotorNumAxes(amotor, 3);
+    dJointSetAMotorAxis(amotor, 0, 1, 1, 0, 0);
+    dJointSetAMotorAxis(amotor, 1, 1, 0, 1, 0);
+    dJointSetAMotorAxis(amotor, 2, 1, 0, 0, 1);
+    dJointID lmotor = dJointCreateLMotor(world, 0);
+    add("lmotor", lmotor, limits(3));
+    dJointSetLMotorNumAxes(lmotor, 3);
+    dJointSetLMotorAxis(lmotor, 0, 1, 1, 0, 0);
+    dJointSetLMotorAxis(lmotor, 1, 1, 0, 1, 0);
+    dJointSetLMotorAxis(lmotor, 2, 1, 0, 0, 1);
+    return cases;
+  }
+
+  dBodyID a = nullptr, b = nullptr;
+};
+
+int ErpParam(ssJointParam param) {
+  return param == SS_PARAM_JOINT ? dParamERP : param == SS_PARAM_STOP ? dParamStopERP : dParamSuspensionERP;
+}
+int CfmParam(ssJointParam param) {
+  return param == SS_PARAM_JOINT || param == SS_PARAM_MOTOR ? dParamCFM
+         : param == SS_PARAM_STOP                          ? dParamStopCFM
+                                                           : dParamSuspensionCFM;
+}
+
+TEST_F(RegistryTest, EveryJointTypeAndParameterIsWrittenForEachStepLength) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  std::vector<JointCase> cases = AllJoints();
+  int bound = 0;
+  for (const JointCase& c : cases)
+    for (const Row& row : c.rows) {
+      ASSERT_EQ(ssRegistry_BindJoint(registry, c.joint, row.param, row.axis, kSpring, 0), SS_OK)
+          << c.name << " " << ssLastError();
+      ++bound;
+    }
+  EXPECT_EQ(ssRegistry_JointBindingCount(registry), bound);
+  for (double step_s : {1.0 / 30.0, 1.0 / 144.0}) {
+    ssApplyReport report;
+    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, step_s, 0, &report), SS_OK) << ssLastError();
+    EXPECT_EQ(report.rows_written, bound);
+    ssSoftness expected;
+    ASSERT_EQ(ssSoftnessFromSpring(kSpring, step_s, &expected), SS_OK);
+    for (const JointCase& c : cases)
+      for (const Row& row : c.rows) {
+        SCOPED_TRACE(std::string(c.name) + " param " + std::to_string(row.param) + " axis " +
+                     std::to_string(row.axis) + " h " + std::to_string(step_s));
+        EXPECT_DOUBLE_EQ(GetParam(c.joint, CfmParam(row.param), row.axis), expected.cfm);
+        if (row.param != SS_PARAM_MOTOR) {
+          EXPECT_DOUBLE_EQ(GetParam(c.joint, ErpParam(row.param), row.axis), expected.erp);
+        }
+      }
+  }
+  ssRegistry_Destroy(registry);
+}
+
+TEST_F(RegistryTest, MatchedMappingUsesEachRowsEffectiveMass) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  dJointID slider = dJointCreateSlider(world, 0);
+  dJointAttach(slider, a, 0);
+  ASSERT_EQ(ssRegistry_BindJoint(registry, slider, SS_PARAM_STOP, 1, kSpring, 0), SS_OK);
+  const double step_s = 1.0 / 60.0;
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_MATCHED, step_s, 0, nullptr), SS_OK);
+  ssSoftness expected;
+  ASSERT_EQ(ssMatchedSoftness(kSpring, 2.0, step_s, &expected), SS_OK);  // body a is 2 kg
+  EXPECT_NEAR(dJointGetSliderParam(slider, dParamStopERP), expected.erp, 1e-12);
+  EXPECT_NEAR(dJointGetSliderParam(slider, dParamStopCFM), expected.cfm, 1e-12);
+  ssRegistry_Destroy(registry);
+}
+
+TEST_F(RegistryTest, EffectiveMassOfLinearAndAngularRows) {
+  dJointID slider = dJointCreateSlider(world, 0);
+  dJointAttach(slider, a, b);
+  double mass = 0;
+  ASSERT_EQ(ssJointEffectiveMass(slider, SS_PARAM_STOP, 1, &mass), SS_OK);
+  EXPECT_NEAR(mass, 1.0 / (1.0 / 2.0 + 1.0 / 3.0), 1e-12);
+
+  // A box of 2 kg and side 0.1 m has inertia m·s²/6 about any axis through its centre; rotate it to be sure the
+  // world-frame inertia is used.
+  dMatrix3 rotation;
+  dRFromAxisAndAngle(rotation, 1, 2, 3, 0.7);
+  dBodySetRotation(a, rotation);
+  dJointID hinge = dJointCreateHinge(world, 0);
+  dJointAttach(hinge, a, 0);
+  dJointSetHingeAxis(hinge, 0.3, -0.2, 0.9);
+  ASSERT_EQ(ssJointEffectiveMass(hinge, SS_PARAM_STOP, 1, &mass), SS_OK);
+  EXPECT_NEAR(mass, 2.0 * 0.01 / 6.0, 1e-12);
+
+  dJointID unattached = dJointCreateHinge(world, 0);
+  EXPECT_EQ(ssJointEffectiveMass(unattached, SS_PARAM_STOP, 1, &mass), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("no dynamic body"), std::string::npos) << ssLastError();
+}
+
+TEST_F(RegistryTest, UnsupportedBindingsAreRefusedAtBindTime) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  dJointID hinge = dJointCreateHinge(world, 0);
+  dJointID ball = dJointCreateBall(world, 0);
+  dJointID amotor = dJointCreateAMotor(world, 0);
+  dJointSetAMotorNumAxes(amotor, 1);
+  struct Bad {
+    dJointID joint;
+    int param, axis;
+    const char* named;
+  } bad[] = {
+      {hinge, SS_PARAM_JOINT, 1, "hinge"},      {hinge, SS_PARAM_STOP, 2, "axis = 2"},
+      {hinge, SS_PARAM_SUSPENSION, 1, "hinge"}, {ball, SS_PARAM_STOP, 1, "ball"},
+      {amotor, SS_PARAM_STOP, 2, "axis = 2"},   {hinge, 7, 1, "param = 7"},
+      {hinge, SS_PARAM_STOP, 0, "axis = 0"},
+  };
+  for (const Bad& b : bad) {
+    EXPECT_EQ(ssRegistry_BindJoint(registry, b.joint, (ssJointParam)b.param, b.axis, kSpring, 0),
+              SS_ERROR_UNSUPPORTED);
+    EXPECT_NE(std::string(ssLastError()).find(b.named), std::string::npos) << ssLastError();
+  }
+  EXPECT_EQ(ssRegistry_BindJoint(registry, nullptr, SS_PARAM_STOP, 1, kSpring, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, ssSpring{-1, 1}, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, ssSpring{0, 0}, 0), SS_ERROR_NO_SPRING);
+  EXPECT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, ssSpring{NAN, 1}, 0), SS_ERROR_NOT_FINITE);
+  EXPECT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, kSpring, -2), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("effective_mass = -2"), std::string::npos) << ssLastError();
+  EXPECT_EQ(ssRegistry_JointBindingCount(registry), 0);
+  ssRegistry_Destroy(registry);
+}
+
+TEST_F(RegistryTest, BindingAgainReplacesAndUnbindRemoves) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  dJointID hinge = dJointCreateHinge(world, 0);
+  dJointAttach(hinge, a, 0);
+  ASSERT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, kSpring, 0), SS_OK);
+  ASSERT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, ssSpring{100, 1}, 0), SS_OK);
+  ASSERT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_MOTOR, 1, ssSpring{0, 5}, 0), SS_OK);
+  EXPECT_EQ(ssRegistry_JointBindingCount(registry), 2);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 0.01, 0, nullptr), SS_OK);
+  EXPECT_DOUBLE_EQ(dJointGetHingeParam(hinge, dParamStopCFM), 1.0 / (0.01 * 100 + 1));
+  EXPECT_DOUBLE_EQ(dJointGetHingeParam(hinge, dParamCFM), 1.0 / 5.0);  // a pure damper: same at every h
+
+  ASSERT_EQ(ssRegistry_UnbindJoint(registry, hinge), SS_OK);
+  EXPECT_EQ(ssRegistry_JointBindingCount(registry), 0);
+  EXPECT_EQ(ssRegistry_UnbindJoint(registry, hinge), SS_ERROR_NOT_FOUND);
+  dJointDestroy(hinge);
+  EXPECT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 0.01, 0, nullptr), SS_OK);
+  ssRegistry_Destroy(registry);
+}
+
+TEST_F(RegistryTest, ApplyErrorWritesNothing) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  dJointID first = dJointCreateSlider(world, 0);
+  dJointAttach(first, a, 0);
+  dJointID undamped = dJointCreateSlider(world, 0);
+  dJointAttach(undamped, b, 0);
+  ASSERT_EQ(ssRegistry_BindWorld(registry, kSpring, 0), SS_OK);
+  ASSERT_EQ(ssRegistry_BindJoint(registry, first, SS_PARAM_STOP, 1, kSpring, 0), SS_OK);
+  ASSERT_EQ(ssRegistry_BindJoint(registry, undamped, SS_PARAM_STOP, 1, ssSpring{50, 0}, 0), SS_OK);
+  ASSERT_EQ(ssRegistry_BindDamping(registry, a, 1.0, 1.0), SS_OK);
+  const double erp = dWorldGetERP(world), cfm = dWorldGetCFM(world);
+  const double stop_erp = dJointGetSliderParam(first, dParamStopERP);
+  const double damping = dBodyGetLinearDamping(a);
+
+  // c = 0 has no matched softness: refused, naming the joint, and nothing written (the first binding included)
+  EXPECT_EQ(ssRegistry_Apply(registry, SS_MAPPING_MATCHED, 0.01, 0, nullptr), SS_ERROR_NO_FINITE_MAPPING);
+  EXPECT_NE(std::string(ssLastError()).find("slider joint"), std::string::npos) << ssLastError();
+  for (double step_s : {0.0, -0.01, double(NAN), double(INFINITY)}) {
+    EXPECT_NE(ssRegistry_Apply(registry, SS_MAPPING_SPRING, step_s, 0, nullptr), SS_OK);
+    EXPECT_NE(std::string(ssLastError()).find("step_s"), std::string::npos) << ssLastError();
+  }
+  EXPECT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 0.01, -1, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_Apply(registry, (ssMapping)9, 0.01, 0, nullptr), SS_ERROR_UNSUPPORTED);
+  EXPECT_EQ(dWorldGetERP(world), erp);
+  EXPECT_EQ(dWorldGetCFM(world), cfm);
+  EXPECT_EQ(dJointGetSliderParam(first, dParamStopERP), stop_erp);
+  EXPECT_EQ(dBodyGetLinearDamping(a), damping);
+
+  // The spring mapping serves c = 0.
+  EXPECT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 0.01, 0, nullptr), SS_OK);
+  ssRegistry_Destroy(registry);
+}
+
+TEST_F(RegistryTest, DampingRatesRemoveTheSameFractionPerSecond) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  ASSERT_EQ(ssRegistry_BindDamping(registry, a, 0.5, 2.0), SS_OK);
+  ASSERT_EQ(ssRegistry_BindDamping(registry, nullptr, 0.25, 0.0), SS_OK);
+  dWorldSetGravity(world, 0, 0, 0);
+  for (double step_s : {1.0 / 15.0, 1.0 / 144.0}) {
+    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, step_s, 0, nullptr), SS_OK);
+    EXPECT_NEAR(dBodyGetLinearDamping(a), 1 - std::exp(-0.5 * step_s), 1e-15);
+    EXPECT_NEAR(dBodyGetAngularDamping(a), 1 - std::exp(-2.0 * step_s), 1e-15);
+    EXPECT_NEAR(dWorldGetLinearDamping(world), 1 - std::exp(-0.25 * step_s), 1e-15);
+    // One simulated second at this step length leaves exp(-0.5) of the speed, whatever the step.
+    dBodySetLinearVel(a, 10, 0, 0);
+    dBodySetLinearDampingThreshold(a, 0);
+    int steps = (int)std::lround(1.0 / step_s);
+    for (int i = 0; i < steps; ++i) dWorldStep(world, step_s);
+    EXPECT_NEAR(dBodyGetLinearVel(a)[0], 10 * std::exp(-0.5), 1e-9);
+  }
+  EXPECT_EQ(ssRegistry_BindDamping(registry, a, -1, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_BindDamping(registry, a, 0, NAN), SS_ERROR_NOT_FINITE);
+  ssRegistry_Destroy(registry);
+}
+
+TEST_F(RegistryTest, AutoDisableIsGivenInSeconds) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  ASSERT_EQ(ssRegistry_BindAutoDisable(registry, a, 0.5, 0.1), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 1.0 / 60.0, 0, nullptr), SS_OK);
+  EXPECT_EQ(dBodyGetAutoDisableSteps(a), 30);
+  EXPECT_DOUBLE_EQ(dBodyGetAutoDisableTime(a), 0.5);
+  EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(a), 6u);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 1.0 / 15.0, 0, nullptr), SS_OK);
+  EXPECT_EQ(dBodyGetAutoDisableSteps(a), 8);
+  EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(a), 2u);
+  EXPECT_EQ(ssRegistry_BindAutoDisable(registry, a, 0, 0.1), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("idle_time_s = 0"), std::string::npos) << ssLastError();
+  ASSERT_EQ(ssRegistry_UnbindBody(registry, a), SS_OK);
+  EXPECT_EQ(ssRegistry_UnbindBody(registry, a), SS_ERROR_NOT_FOUND);
+  ssRegistry_Destroy(registry);
+}
+
+TEST_F(RegistryTest, VisitsEachBoundBodyOnce) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  for (int i = 0; i < 3; ++i) {
+    dJointID hinge = dJointCreateHinge(world, 0);
+    dJointAttach(hinge, a, i == 2 ? nullptr : b);
+    ASSERT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, kSpring, 0), SS_OK);
+  }
+  dBodyID c = MakeBody(1.0);
+  ASSERT_EQ(ssRegistry_BindDamping(registry, c, 1, 1), SS_OK);
+  ASSERT_EQ(ssRegistry_BindDamping(registry, a, 1, 1), SS_OK);
+  std::vector<dBodyID> seen;
+  ssRegistry_VisitBodies(
+      registry, [](void* context, dBodyID body) { static_cast<std::vector<dBodyID>*>(context)->push_back(body); },
+      &seen);
+  std::sort(seen.begin(), seen.end());
+  std::vector<dBodyID> expected = {a, b, c};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(seen, expected);
+  ssRegistry_Destroy(registry);
+}
+
+TEST_F(RegistryTest, ContactSoftenFillsTheSurface) {
+  dContact contact;
+  std::memset(&contact, 0, sizeof contact);
+  contact.geom.normal[2] = 1;
+  dBodySetPosition(a, 0, 0, 0.05);
+  contact.geom.pos[2] = 0;
+  ASSERT_EQ(ssContactSoften(&contact, a, nullptr, kSpring, SS_MAPPING_SPRING, 0.02, 0), SS_OK);
+  ssSoftness expected;
+  ssSoftnessFromSpring(kSpring, 0.02, &expected);
+  EXPECT_TRUE(contact.surface.mode & dContactSoftERP);
+  EXPECT_TRUE(contact.surface.mode & dContactSoftCFM);
+  EXPECT_DOUBLE_EQ(contact.surface.soft_erp, expected.erp);
+  EXPECT_DOUBLE_EQ(contact.surface.soft_cfm, expected.cfm);
+
+  // Straight below the centre the normal row moves the body's mass alone.
+  ASSERT_EQ(ssContactSoften(&contact, a, nullptr, kSpring, SS_MAPPING_MATCHED, 0.02, 0), SS_OK);
+  ssMatchedSoftness(kSpring, 2.0, 0.02, &expected);
+  EXPECT_NEAR(contact.surface.soft_cfm, expected.cfm, 1e-12);
+
+  dContact before = contact;
+  EXPECT_EQ(ssContactSoften(&contact, nullptr, nullptr, kSpring, SS_MAPPING_MATCHED, 0.02, 0),
+            SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssContactSoften(&contact, a, nullptr, ssSpring{1, -1}, SS_MAPPING_SPRING, 0.02, 0),
+            SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssContactSoften(&contact, a, nullptr, kSpring, SS_MAPPING_SPRING, 0, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(std::memcmp(&before, &contact, sizeof contact), 0);
+}
+
+}  // namespace
