@@ -23,6 +23,7 @@ struct ssScene {
   ssSceneWorld parts;
   void* state;
   double time_s;
+  unsigned long ode_random_seed; /* this scene's state of ODE's one global generator */
   ssSceneStepFn* observer;
   void* observer_context;
 };
@@ -220,8 +221,12 @@ void ssScene_Destroy(ssScene* scene) {
 ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps) {
   if (scene == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to step");
   ssEnsureOde();
+  /* dWorldQuickStep shuffles its constraints with ODE's process-wide generator. Giving each scene its own state of
+   * it makes a run the same whatever ran before it in the process (or between its frames, on the same thread). */
+  dRandSetSeed(scene->ode_random_seed);
   ssFrameReport report = {0};
   ssStatus status = ssStepper_Step(scene->parts.stepper, frame_s, &report);
+  scene->ode_random_seed = dRandGetSeed();
   if (steps != NULL) *steps = report.steps;
   return status;
 }
