@@ -1,0 +1,292 @@
+// The method held to independent truth in real ODE: the implicit-Euler recurrence (spring), the article's
+// consistency claim (spring vs naive), the exact poles (matched) and the exact motion (exact).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+
+#include "oscillator_rig.h"
+
+namespace {
+
+class Oscillator : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { dInitODE2(0); }
+};
+
+// The article's setting: one physics step per frame (max_step_s no shorter than the longest frame).
+void OneStepPerFrame(OscillatorRig& rig, ssPolicy policy, ssSolver solver) {
+  rig.def.policy = policy;
+  rig.def.solver = solver;
+  rig.def.max_step_s = 1.0 / 15.0;
+}
+
+TEST_F(Oscillator, SpringFollowsImplicitEulerAtFixedAndVariableSteps) {
+  struct Case {
+    const char* profile;
+    ssSolver solver;
+    double tolerance_m;
+  } cases[] = {
+      {"fixed:30", SS_SOLVER_STEP, 1e-9},      {"uniform:15:45", SS_SOLVER_STEP, 1e-9},
+      {"fixed:30", SS_SOLVER_QUICK, 1e-8},     {"uniform:15:45", SS_SOLVER_QUICK, 1e-8},
+      {"jitter:60:2", SS_SOLVER_STEP, 1e-9},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::string(c.profile) + (c.solver == SS_SOLVER_STEP ? " step" : " quick"));
+    OscillatorRig rig;
+    OneStepPerFrame(rig, SS_POLICY_SPRING, c.solver);
+    ASSERT_EQ(rig.Build(), SS_OK) << ssLastError();
+    ASSERT_EQ(rig.Run(c.profile, 5.0, 7), SS_OK) << ssLastError();
+    ASSERT_GT(rig.x.size(), 70u);
+    EXPECT_LT(MaxDifference(rig.x, ImplicitEuler(rig, rig.h)), c.tolerance_m);
+  }
+}
+
+TEST_F(Oscillator, SubstepsFollowImplicitEulerAtEachSubstep) {
+  OscillatorRig rig;
+  rig.def.solver = SS_SOLVER_STEP;  // max_step_s stays 1/60: 15-45 fps frames become 1 to 4 substeps
+  ASSERT_EQ(rig.Build(), SS_OK);
+  ASSERT_EQ(rig.Run("uniform:15:45", 3.0, 3), SS_OK);
+  for (double h : rig.h) EXPECT_LE(h, 1.0 / 60.0 + 1e-15);
+  EXPECT_LT(MaxDifference(rig.x, ImplicitEuler(rig, rig.h)), 1e-9);
+}
+
+// An angular stop on a hinge: the same recurrence in angle, with the body's inertia about the axis.
+TEST_F(Oscillator, HingeAngularStopFollowsImplicitEuler) {
+  const double inertia = 0.02, k = 3.0, c = 0.05, theta0 = 0.3;
+  for (ssSolver solver : {SS_SOLVER_STEP, SS_SOLVER_QUICK}) {
+    dWorldID world = dWorldCreate();
+    dBodyID body = dBodyCreate(world);
+    dMass m;
+    dMassSetZero(&m);
+    dMassSetParameters(&m, 1.0, 0, 0, 0, inertia, inertia, inertia, 0, 0, 0);
+    dBodySetMass(body, &m);
+    dBodySetFiniteRotationMode(body, 1);  // ODE's default rotation update is first order in the angle
+    dBodySetFiniteRotationAxis(body, 0, 0, 1);
+    dJointID hinge = dJointCreateHinge(world, 0);
+    dJointAttach(hinge, body, 0);
+    dJointSetHingeAxis(hinge, 0, 0, 1);
+    dJointSetHingeParam(hinge, dParamLoStop, 0);
+    dJointSetHingeParam(hinge, dParamHiStop, 0);
+    dQuaternion q;
+    dQFromAxisAndAngle(q, 0, 0, 1, theta0);
+    dBodySetQuaternion(body, q);
+    ASSERT_NEAR(dJointGetHingeAngle(hinge), theta0, 1e-12);
+
+    ssRegistry* registry = ssRegistry_Create(world);
+    ASSERT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, ssSpring{k, c}, 0), SS_OK);
+    ssStepperDef def = ssDefaultStepperDef();
+    def.world = world;
+    def.registry = registry;
+    def.solver = solver;
+    def.max_step_s = 1.0 / 15.0;
+    ssStepper* stepper;
+    ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
+    std::mt19937_64 random(11);
+    std::uniform_real_distribution<double> frame(1.0 / 45.0, 1.0 / 15.0);
+    double x = theta0, v = 0, worst = 0;
+    for (int i = 0; i < 150; ++i) {
+      double h = frame(random);
+      ASSERT_EQ(ssStepper_Step(stepper, h, nullptr), SS_OK);
+      v = (inertia * v - h * k * x) / (inertia + h * c + h * h * k);
+      x += h * v;
+      worst = std::fmax(worst, std::fabs(dJointGetHingeAngle(hinge) - x));
+    }
+    EXPECT_LT(worst, solver == SS_SOLVER_STEP ? 1e-9 : 1e-8) << "solver " << solver;
+    ssStepper_Destroy(stepper);
+    ssRegistry_Destroy(registry);
+    dWorldDestroy(world);
+  }
+}
+
+// Hinge-2 suspension: a wheel on a chassis that does not move (kinematic), sprung along axis 1.
+TEST_F(Oscillator, Hinge2SuspensionFollowsImplicitEuler) {
+  const double wheel_kg = 2.0, k = 800.0, c = 20.0, z0 = 0.05;
+  for (ssSolver solver : {SS_SOLVER_STEP, SS_SOLVER_QUICK}) {
+    dWorldID world = dWorldCreate();
+    dWorldSetGravity(world, 0, 0, 0);
+    dBodyID chassis = dBodyCreate(world);
+    dBodySetKinematic(chassis);
+    dBodyID wheel = dBodyCreate(world);
+    dMass m;
+    dMassSetSphereTotal(&m, wheel_kg, 0.3);
+    dBodySetMass(wheel, &m);
+    dBodySetPosition(wheel, 1, 0, 0);
+    dJointID hinge2 = dJointCreateHinge2(world, 0);
+    dJointAttach(hinge2, chassis, wheel);
+    dJointSetHinge2Anchor(hinge2, 1, 0, 0);
+    const dReal axis1[] = {0, 0, 1}, axis2[] = {0, 1, 0};
+    dJointSetHinge2Axes(hinge2, axis1, axis2);
+    dBodySetPosition(wheel, 1, 0, z0);
+
+    ssRegistry* registry = ssRegistry_Create(world);
+    ASSERT_EQ(ssRegistry_BindJoint(registry, hinge2, SS_PARAM_SUSPENSION, 1, ssSpring{k, c}, 0), SS_OK);
+    double effective = 0;
+    ASSERT_EQ(ssJointEffectiveMass(hinge2, SS_PARAM_SUSPENSION, 1, &effective), SS_OK);
+    EXPECT_NEAR(effective, wheel_kg, 1e-12);
+    ssStepperDef def = ssDefaultStepperDef();
+    def.world = world;
+    def.registry = registry;
+    def.solver = solver;
+    def.max_step_s = 1.0 / 15.0;
+    ssStepper* stepper;
+    ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
+    std::mt19937_64 random(5);
+    std::uniform_real_distribution<double> frame(1.0 / 45.0, 1.0 / 15.0);
+    double x = z0, v = 0, worst = 0;
+    for (int i = 0; i < 150; ++i) {
+      double h = frame(random);
+      ASSERT_EQ(ssStepper_Step(stepper, h, nullptr), SS_OK);
+      v = (wheel_kg * v - h * k * x) / (wheel_kg + h * c + h * h * k);
+      x += h * v;
+      worst = std::fmax(worst, std::fabs(dBodyGetPosition(wheel)[2] - x));
+    }
+    EXPECT_LT(worst, solver == SS_SOLVER_STEP ? 1e-9 : 1e-8) << "solver " << solver;
+    ssStepper_Destroy(stepper);
+    ssRegistry_Destroy(registry);
+    dWorldDestroy(world);
+  }
+}
+
+// RMS over the variable run's samples of (variable - fixed run linearly interpolated), over x0.
+double RmsAgainst(const OscillatorRig& variable, const OscillatorRig& fixed) {
+  double sum = 0;
+  size_t j = 0;
+  for (size_t i = 0; i < variable.t.size(); ++i) {
+    double t = variable.t[i];
+    while (j + 1 < fixed.t.size() && fixed.t[j + 1] < t) ++j;
+    double t0 = j == 0 && t < fixed.t[0] ? 0 : fixed.t[j], x0 = j == 0 && t < fixed.t[0] ? fixed.x0 : fixed.x[j];
+    size_t k = j == 0 && t < fixed.t[0] ? 0 : std::min(j + 1, fixed.t.size() - 1);
+    double along = fixed.t[k] > t0 ? (t - t0) / (fixed.t[k] - t0) : 0;
+    double interpolated = x0 + along * (fixed.x[k] - x0);
+    sum += (variable.x[i] - interpolated) * (variable.x[i] - interpolated);
+  }
+  return std::sqrt(sum / variable.t.size()) / variable.x0;
+}
+
+// The article's claim: with the spring mapping a run at 15-45 fps stays with the run at 30 fps; with ERP/CFM
+// frozen at their 30 fps values it does not.
+TEST_F(Oscillator, SpringIsConsistentAcrossFrameRatesAndNaiveIsNot) {
+  double spring_sum = 0, naive_sum = 0;
+  const int seeds = 8;
+  for (int seed = 0; seed < seeds; ++seed) {
+    double rms[2];
+    for (int which = 0; which < 2; ++which) {
+      ssPolicy policy = which == 0 ? SS_POLICY_SPRING : SS_POLICY_NAIVE;
+      OscillatorRig fixed, variable;
+      OneStepPerFrame(fixed, policy, SS_SOLVER_QUICK);
+      OneStepPerFrame(variable, policy, SS_SOLVER_QUICK);
+      ASSERT_EQ(fixed.Build(), SS_OK);
+      ASSERT_EQ(variable.Build(), SS_OK);
+      ASSERT_EQ(fixed.Run("fixed:30", 5.0), SS_OK);
+      ASSERT_EQ(variable.Run("uniform:15:45", 5.0, seed), SS_OK);
+      rms[which] = RmsAgainst(variable, fixed);
+    }
+    EXPECT_LE(rms[0], 0.05) << "seed " << seed;
+    spring_sum += rms[0];
+    naive_sum += rms[1];
+  }
+  double spring = spring_sum / seeds, naive = naive_sum / seeds;
+  std::printf("RMS(15-45 fps vs 30 fps)/x0 over %d seeds: spring %.4f, naive %.4f (ratio %.1f)\n", seeds, spring,
+              naive, naive / spring);
+  EXPECT_LE(spring, 0.05);
+  EXPECT_GE(naive, 2 * spring);
+}
+
+// Fits x_(n+1) = a1 x_n + a2 x_(n-1), which a damped sinusoid sampled at a constant step obeys exactly:
+// a1 = 2 e^(-σh) cos(ωh), a2 = -e^(-2σh). Returns σ (1/s) and ω (rad/s).
+void FitDecayAndFrequency(const std::vector<double>& x, double h, double* sigma, double* omega) {
+  double s11 = 0, s12 = 0, s22 = 0, b1 = 0, b2 = 0;
+  for (size_t n = 1; n + 1 < x.size(); ++n) {
+    s11 += x[n] * x[n];
+    s12 += x[n] * x[n - 1];
+    s22 += x[n - 1] * x[n - 1];
+    b1 += x[n + 1] * x[n];
+    b2 += x[n + 1] * x[n - 1];
+  }
+  double det = s11 * s22 - s12 * s12;
+  double a1 = (b1 * s22 - b2 * s12) / det, a2 = (s11 * b2 - s12 * b1) / det;
+  *sigma = -std::log(-a2) / (2 * h);
+  *omega = std::acos(a1 / (2 * std::sqrt(-a2))) / h;
+}
+
+TEST_F(Oscillator, MatchedHasTheExactDecayAndFrequencyAtEveryFixedStep) {
+  for (int fps : {15, 30, 60, 144}) {
+    for (ssSolver solver : {SS_SOLVER_STEP, SS_SOLVER_QUICK}) {
+      OscillatorRig rig;
+      rig.def.policy = SS_POLICY_MATCHED;
+      rig.def.solver = solver;
+      rig.def.max_step_s = 1.0 / fps;
+      ASSERT_EQ(rig.Build(), SS_OK);
+      ASSERT_EQ(rig.Run(("fixed:" + std::to_string(fps)).c_str(), 5.0), SS_OK);
+      std::vector<double> xs = {rig.x0};
+      xs.insert(xs.end(), rig.x.begin(), rig.x.end());
+      double sigma, omega;
+      FitDecayAndFrequency(xs, 1.0 / fps, &sigma, &omega);
+      const double true_sigma = 0.5, true_omega = std::sqrt(40.0 - 0.25);
+      EXPECT_NEAR(sigma / true_sigma, 1.0, 1e-3) << fps << " fps, solver " << solver;
+      EXPECT_NEAR(omega / true_omega, 1.0, 1e-3) << fps << " fps, solver " << solver;
+    }
+  }
+}
+
+double RmsAgainstExact(const OscillatorRig& rig) {
+  double sum = 0;
+  for (size_t i = 0; i < rig.t.size(); ++i) sum += std::pow(rig.x[i] - ExactPosition(rig, rig.t[i]), 2);
+  return std::sqrt(sum / rig.t.size()) / rig.x0;
+}
+
+TEST_F(Oscillator, ExactReproducesTheExactMotionUnderVariableFrames) {
+  for (ssSolver solver : {SS_SOLVER_STEP, SS_SOLVER_QUICK}) {
+    for (double max_step_s : {1.0 / 15.0, 1.0 / 60.0}) {
+      OscillatorRig rig;
+      rig.def.policy = SS_POLICY_EXACT;
+      rig.def.solver = solver;
+      rig.def.max_step_s = max_step_s;
+      ASSERT_EQ(rig.Build(), SS_OK);
+      ASSERT_EQ(rig.Run("uniform:15:45", 5.0, 1), SS_OK) << ssLastError();
+      double rms = RmsAgainstExact(rig);
+      std::printf("exact, %s, max_step 1/%.0f s: RMS vs exact / x0 = %.3g\n",
+                  solver == SS_SOLVER_STEP ? "dWorldStep" : "dWorldQuickStep(20)", 1 / max_step_s, rms);
+      // QuickStep's iterations leave a residual (measured 5e-11): bounded loosely, the claim is dWorldStep's
+      EXPECT_LE(rms, solver == SS_SOLVER_STEP ? 1e-6 : 1e-9);
+    }
+  }
+}
+
+// Gravity along the slider: the spring mapping keeps the static deflection m g / k (its erp/(h cfm) is k); matched
+// and exact have erp/(h cfm) != k, so their rest position is off. Measured and bounded here; see the docs.
+TEST_F(Oscillator, GravityAlongTheSliderByMapping) {
+  for (ssPolicy policy : {SS_POLICY_SPRING, SS_POLICY_MATCHED, SS_POLICY_EXACT}) {
+    OscillatorRig rig;
+    rig.gravity = 9.81;
+    rig.def.policy = policy;
+    rig.def.solver = SS_SOLVER_STEP;
+    ASSERT_EQ(rig.Build(), SS_OK);
+    ASSERT_EQ(rig.Run("uniform:15:45", 20.0, 2), SS_OK);
+    double rest = -rig.mass * rig.gravity / rig.spring.stiffness;
+    double rest_error = std::fabs(rig.x.back() - rest) / std::fabs(rest);
+    std::printf("gravity, %s: rest position error %.3g of m g / k, RMS vs exact / x0 %.3g\n", ssPolicyName(policy),
+                rest_error, RmsAgainstExact(rig));
+    if (policy == SS_POLICY_SPRING) {
+      EXPECT_LT(rest_error, 1e-6);
+    }
+  }
+}
+
+TEST_F(Oscillator, UndampedSpringIsRefusedByMatchedAndTheWorldIsLeftAsItWas) {
+  OscillatorRig rig;
+  rig.spring = {40.0, 0.0};
+  rig.def.policy = SS_POLICY_MATCHED;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  const double before = dJointGetSliderPosition(rig.slider);
+  ssFrameReport report;
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 1.0 / 30.0, &report), SS_ERROR_NO_FINITE_MAPPING);
+  EXPECT_NE(std::string(ssLastError()).find("c = 0"), std::string::npos) << ssLastError();
+  EXPECT_EQ(report.steps, 0);
+  EXPECT_EQ(dJointGetSliderPosition(rig.slider), before);
+}
+
+}  // namespace
