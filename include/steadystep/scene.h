@@ -86,6 +86,8 @@ void ssScene_Destroy(ssScene* scene);
 
 /** Advances one frame of frame_s seconds through the scene's stepper. steps (may be NULL) receives the physics
  *  steps taken. Every body is watched, with a speed limit of 100 m/s (no scene moves anything near that fast).
+ *  Each scene keeps its own state of ODE's process-wide random generator (dWorldQuickStep shuffles its rows with
+ *  it), so a run does not depend on what else ran in the process; step scenes from one thread at a time.
  *  Errors: those of ssStepper_Step (SS_ERROR_BLOWUP, SS_ERROR_SPEED_LIMIT when the scene explodes). */
 ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps);
 
