@@ -1,0 +1,356 @@
+"""The comparison: scenes x frame-time profiles x policies on real ODE, measured against a reference run, written
+as an HTML report (report.html, figures embedded and also beside it), metrics.json and metrics.csv."""
+
+from __future__ import annotations
+
+import base64
+import csv
+import html
+import io
+import json
+import math
+import platform
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from steadystep import article, figures, metrics, runs
+from steadystep._native import SteadystepError
+from steadystep.files import atomic_write_text
+from steadystep.profiles import DEFAULT_PROFILES
+
+DEFAULT_POLICIES = ("naive", "spring", "fixed")
+OSCILLATOR_POLICIES = ("naive", "spring", "matched", "exact", "fixed")
+SIDE_BY_SIDE_PROFILES = ("fixed:30", "uniform:15:45")
+# Quantities that are settings, not motion: they are plotted by `run`, never measured against a reference.
+NOT_MOTION = frozenset({"erp", "cfm"})
+# The pile is there for timing; the report keeps it small so that the whole report takes a few minutes.
+REPORT_PARAMS = {"pile": {"body_count": 150}}
+
+
+@dataclass
+class Row:
+    """One run's line in the table."""
+
+    scene: str
+    profile: str
+    policy: str
+    deviations: dict[str, float]     # per motion quantity: RMS deviation from the reference / its amplitude
+    steps_per_frame: float
+    steps_per_second: float
+    wall_us_per_step: float
+    status: str
+    rms_vs_exact: float | None = None
+
+
+@dataclass
+class Report:
+    scenes: list[str]
+    profiles: list[str]
+    policies: dict[str, list[str]]
+    duration_s: float
+    seed: int
+    rows: list[Row] = field(default_factory=list)
+    spreads: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)  # scene -> policy -> quantity
+    side_by_side: list[dict] = field(default_factory=list)
+    params: dict[str, dict] = field(default_factory=dict)
+    figures: dict[str, list[Path]] = field(default_factory=dict)
+    elapsed_s: float = 0.0
+
+
+def motion_quantities(scene: str) -> list[str]:
+    return [q for q in runs.scene_info(scene).quantities if q not in NOT_MOTION]
+
+
+def policies_for(scene: str, policies) -> list[str]:
+    """The policies a scene runs: the given ones, or the defaults (all five for the oscillator)."""
+    if policies:
+        return list(policies)
+    return list(OSCILLATOR_POLICIES if scene == "oscillator" else DEFAULT_POLICIES)
+
+
+def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: float = 5.0, seed: int = 1,
+            params: dict | None = None, progress: bool | None = None, figure_dir: Path | None = None) -> Report:
+    """Runs every scene under every profile and policy, plus each scene's reference, and measures them.
+
+    params: per scene changes to its parameters (default REPORT_PARAMS). progress: a tqdm bar (None: only on a
+    terminal). figure_dir: where to draw the figures (None: none drawn)."""
+    started = time.perf_counter()
+    scenes = list(scenes) if scenes else [info.name for info in runs.scenes()]
+    for scene in scenes:
+        runs.scene_info(scene)  # unknown names fail before anything runs
+    for policy in policies or ():
+        runs.policy_value(policy)
+    params = REPORT_PARAMS if params is None else params
+    report = Report(scenes, list(profiles), {s: policies_for(s, policies) for s in scenes}, duration_s, seed)
+    total = sum(1 + len(profiles) * len(report.policies[s]) for s in scenes)
+    oscillator = "oscillator" in scenes
+    if oscillator:
+        total += len(SIDE_BY_SIDE_PROFILES) * len(OSCILLATOR_POLICIES)
+    bar = tqdm(total=total, desc="steadystep compare", unit="run", disable=None if progress is None else not progress)
+    try:
+        for scene in scenes:
+            _compare_scene(report, scene, params.get(scene), bar, figure_dir)
+        if oscillator:
+            _side_by_side(report, params.get("oscillator"), bar)
+    finally:
+        bar.close()
+    report.elapsed_s = time.perf_counter() - started
+    return report
+
+
+def _compare_scene(report: Report, scene: str, scene_params: dict | None, bar, figure_dir: Path | None) -> None:
+    bar.set_postfix_str(f"{scene} reference")
+    reference = runs.reference_run(scene, report.duration_s, params=scene_params)
+    bar.update()
+    report.params[scene] = reference.params
+    quantities = motion_quantities(scene)
+    results = {}
+    for profile in report.profiles:
+        for policy in report.policies[scene]:
+            bar.set_postfix_str(f"{scene} {profile} {policy}")
+            result = runs.run(scene, profile, policy, report.duration_s, report.seed, params=scene_params)
+            bar.update()
+            results[(profile, policy)] = result
+            deviations = {q: _deviation(result, reference, q) for q in quantities}
+            report.rows.append(Row(
+                scene, profile, policy, deviations,
+                metrics.steps_per_frame(result.step_count, result.frame_count),
+                metrics.steps_per_second(result.step_count, result.simulated_s),
+                1e6 * result.wall_s / result.step_count if result.step_count else math.nan,
+                result.status, _rms_vs_exact(result) if scene == "oscillator" else None))
+    report.spreads[scene] = {
+        policy: {q: metrics.spread(row.deviations[q] for row in report.rows
+                                   if row.scene == scene and row.policy == policy) for q in quantities}
+        for policy in report.policies[scene]}
+    if figure_dir is not None:
+        exact_curve = _exact_curve(reference.params, report.duration_s) if scene == "oscillator" else None
+        paths = []
+        for q in quantities[:2]:
+            paths += figures.scene_figure(scene, q, reference.units[q], reference, results, figure_dir,
+                                          exact_curve if q == "x" else None)
+        deviations = {(row.profile, row.policy): row.deviations[quantities[0]]
+                      for row in report.rows if row.scene == scene}
+        paths += figures.deviation_figure(scene, quantities[0], deviations, figure_dir)
+        report.figures[scene] = paths
+
+
+def _deviation(result: runs.RunResult, reference: runs.RunResult, quantity: str) -> float:
+    if result.blew_up or result.step_count == 0:
+        return math.inf
+    return metrics.rms_deviation(result.times, result.quantities[quantity], reference.times,
+                                 reference.quantities[quantity])
+
+
+def _oscillator(params: dict) -> article.Oscillator:
+    return article.Oscillator(params["mass"], params["spring"]["stiffness"], params["spring"]["damping"])
+
+
+def _exact_curve(params: dict, duration_s: float):
+    t = np.linspace(0.0, duration_s, 1501)
+    return t, article.exact(_oscillator(params), params["x0"], 0.0, t)[0]
+
+
+def _rms_vs_exact(result: runs.RunResult) -> float:
+    """The oscillator's RMS error against the exact solution over the run, relative to x0 (no gravity only)."""
+    if result.blew_up or result.params["gravity"] != 0.0:
+        return math.inf if result.blew_up else math.nan
+    exact_x, _ = article.exact(_oscillator(result.params), result.params["x0"], 0.0, result.times)
+    return metrics.rms_vs_exact(result.quantities["x"], exact_x, result.params["x0"])
+
+
+def _side_by_side(report: Report, params: dict | None, bar) -> None:
+    """Issue 4's table: the oscillator at 30 fps and 15-45 fps under every policy, against the exact solution."""
+    for profile in SIDE_BY_SIDE_PROFILES:
+        for policy in OSCILLATOR_POLICIES:
+            bar.set_postfix_str(f"oscillator {profile} {policy} vs exact")
+            result = runs.run("oscillator", profile, policy, report.duration_s, report.seed, params=params)
+            bar.update()
+            osc = _oscillator(result.params)
+            entry = {"profile": profile, "policy": policy, "rms_vs_exact": _rms_vs_exact(result),
+                     "decay_rate_per_s": math.nan, "angular_frequency_rad_s": math.nan,
+                     "true_decay_rate_per_s": osc.decay_rate, "true_angular_frequency_rad_s": osc.angular_frequency,
+                     "status": result.status}
+            try:
+                entry["decay_rate_per_s"], entry["angular_frequency_rad_s"] = metrics.fit_oscillation(
+                    result.times, result.quantities["x"])
+            except SteadystepError:
+                pass  # nothing oscillates (over-damped or blown up): the table shows "-"
+            report.side_by_side.append(entry)
+
+
+# ---- writing ------------------------------------------------------------------------------------------------
+
+def write(report: Report, out_dir: Path, command: str, article_paths: list[Path] | None = None) -> Path:
+    """Writes report.html (figures embedded), index.html (a link to it), metrics.json and metrics.csv."""
+    out_dir = Path(out_dir)
+    atomic_write_text(out_dir / "metrics.json", json.dumps(_as_json(report, command), indent=1, default=_json_default))
+    atomic_write_text(out_dir / "metrics.csv", _as_csv(report))
+    path = atomic_write_text(out_dir / "report.html", _as_html(report, command, article_paths or []))
+    atomic_write_text(out_dir / "index.html", '<!doctype html><meta charset="utf-8"><title>steadystep report</title>'
+                      '<meta http-equiv="refresh" content="0; url=report.html"><a href="report.html">report</a>\n')
+    return path
+
+
+def _json_default(value):
+    if isinstance(value, Path):
+        return value.name
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(type(value))
+
+
+def _finite_or_none(value):
+    return value if value is None or math.isfinite(value) else None
+
+
+def _as_json(report: Report, command: str) -> dict:
+    return {
+        "command": command, "duration_s": report.duration_s, "seed": report.seed, "profiles": report.profiles,
+        "policies": report.policies, "params": report.params, "elapsed_s": report.elapsed_s,
+        "rows": [{"scene": r.scene, "profile": r.profile, "policy": r.policy, "status": r.status,
+                  "deviation": {q: _finite_or_none(v) for q, v in r.deviations.items()},
+                  "steps_per_frame": r.steps_per_frame, "steps_per_second": r.steps_per_second,
+                  "wall_us_per_step": r.wall_us_per_step, "rms_vs_exact": _finite_or_none(r.rms_vs_exact)}
+                 for r in report.rows],
+        "spread": {s: {p: {q: _finite_or_none(v) for q, v in qs.items()} for p, qs in ps.items()}
+                   for s, ps in report.spreads.items()},
+        "oscillator_side_by_side": [{k: _finite_or_none(v) if isinstance(v, float) else v for k, v in e.items()}
+                                    for e in report.side_by_side],
+    }
+
+
+def _as_csv(report: Report) -> str:
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(["scene", "profile", "policy", "quantity", "deviation", "steps_per_frame", "steps_per_second",
+                     "wall_us_per_step", "status"])
+    for r in report.rows:
+        for q, v in r.deviations.items():
+            writer.writerow([r.scene, r.profile, r.policy, q, f"{v:.6g}", f"{r.steps_per_frame:.6g}",
+                             f"{r.steps_per_second:.6g}", f"{r.wall_us_per_step:.6g}", r.status])
+    return buffer.getvalue()
+
+
+def _number(value, digits: int = 3) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    if isinstance(value, float) and math.isinf(value):
+        return "blew up"
+    return f"{value:.{digits}g}"
+
+
+def _table(header: list[str], rows: list[list[str]]) -> str:
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td>{cell}</td>" for cell in row) + "</tr>" for row in rows)
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def _policy_cell(policy: str) -> str:
+    color = figures.policy_color(policy)
+    return f'<span class="dot" style="background:{color}"></span>{html.escape(policy)}'
+
+
+def _embed(path: Path) -> str:
+    data = base64.b64encode(Path(path).read_bytes()).decode()
+    return f'<img src="data:image/png;base64,{data}" alt="{html.escape(Path(path).name)}">'
+
+
+def _as_html(report: Report, command: str, article_paths: list[Path]) -> str:
+    parts = ["<h1>steadystep: constraint softness under variable frame times</h1>",
+             "<p>Every run is real ODE 0.16 (libode from Debian) stepped by libsteadystep. Deviation: RMS of the "
+             "followed quantity minus the reference run (the same scene at a fixed 1/1000 s step, the article's "
+             "mapping), divided by the reference's amplitude (max &minus; min). Spread: RMS over the profiles of "
+             "that deviation, per policy: the smaller, the less the motion depends on the frame rate.</p>",
+             _summary(report)]
+    pngs = [p for p in article_paths if p.suffix == ".png"]
+    if pngs:
+        parts += ["<h2>The article's figure</h2>",
+                  "<p>Top: the article's equations 4 and 5. Bottom: real ODE with the article's mapping, one step per "
+                  "frame (policy spring, max_step_s = 1/15 s).</p>", _embed(pngs[0])]
+    if report.side_by_side:
+        parts += ["<h2>Oscillator against the exact solution</h2>", _side_by_side_table(report)]
+    for scene in report.scenes:
+        parts += _scene_section(report, scene)
+    parts += ["<h2>Parameters</h2>", _parameters(report),
+              "<h2>Regenerate</h2>", f"<pre>{html.escape(command)}</pre>",
+              f"<p class=small>Made in {report.elapsed_s:.1f} s on {html.escape(platform.node())} "
+              f"({html.escape(platform.machine())}), {time.strftime('%Y-%m-%d %H:%M:%S %Z')}.</p>"]
+    return _PAGE.format(body="\n".join(parts))
+
+
+def _summary(report: Report) -> str:
+    rows = []
+    for scene in report.scenes:
+        quantity = motion_quantities(scene)[0]
+        spreads = report.spreads[scene]
+        cells = [html.escape(scene), html.escape(quantity)]
+        for policy in ("naive", "spring", "fixed"):
+            cells.append(_number(spreads[policy][quantity]) if policy in spreads else "-")
+        naive, spring = spreads.get("naive", {}).get(quantity), spreads.get("spring", {}).get(quantity)
+        cells.append(_number(spring / naive) if naive and spring is not None and math.isfinite(naive) else "-")
+        rows.append(cells)
+    return "<h2>Summary: spread across profiles</h2>" + _table(
+        ["scene", "quantity", "naive", "spring", "fixed", "spring / naive"], rows)
+
+
+def _side_by_side_table(report: Report) -> str:
+    rows = []
+    for e in report.side_by_side:
+        decay, omega = e["decay_rate_per_s"], e["angular_frequency_rad_s"]
+        rows.append([html.escape(e["profile"]), _policy_cell(e["policy"]), _number(e["rms_vs_exact"]),
+                     _number(decay, 4), _number(e["true_decay_rate_per_s"], 4),
+                     _number(omega, 5), _number(e["true_angular_frequency_rad_s"], 5), html.escape(e["status"])])
+    return _table(["profile", "policy", "RMS vs exact / x0", "fitted decay (1/s)", "true decay (1/s)",
+                   "fitted ω (rad/s)", "true ω (rad/s)", "status"], rows)
+
+
+def _scene_section(report: Report, scene: str) -> list[str]:
+    quantities = motion_quantities(scene)
+    info = runs.scene_info(scene)
+    parts = [f"<h2 id='{html.escape(scene)}'>{html.escape(scene)}</h2>", f"<p>{html.escape(info.description)}</p>"]
+    spread_rows = [[_policy_cell(p)] + [_number(report.spreads[scene][p][q]) for q in quantities]
+                   for p in report.policies[scene]]
+    parts += ["<h3>Spread across profiles</h3>", _table(["policy"] + [f"spread of {q}" for q in quantities],
+                                                       spread_rows)]
+    header = (["profile", "policy"] + [f"deviation of {q}" for q in quantities]
+              + (["RMS vs exact / x0"] if scene == "oscillator" else [])
+              + ["steps / frame", "steps / s", "wall µs / step", "status"])
+    rows = []
+    for r in (r for r in report.rows if r.scene == scene):
+        rows.append([html.escape(r.profile), _policy_cell(r.policy)] + [_number(r.deviations[q]) for q in quantities]
+                    + ([_number(r.rms_vs_exact)] if scene == "oscillator" else [])
+                    + [_number(r.steps_per_frame), _number(r.steps_per_second, 4), _number(r.wall_us_per_step),
+                       html.escape(r.status)])
+    parts += ["<h3>Every run</h3>", _table(header, rows)]
+    parts += [_embed(p) for p in report.figures.get(scene, []) if p.suffix == ".png"]
+    return parts
+
+
+def _parameters(report: Report) -> str:
+    rows = [[html.escape(s), f"<code>{html.escape(json.dumps(p))}</code>"] for s, p in report.params.items()]
+    general = (f"<p>duration {report.duration_s:g} s simulated per run, profile seed {report.seed}, profiles "
+               f"{html.escape(', '.join(report.profiles))}; stepping defaults "
+               f"<code>{html.escape(json.dumps(runs.default_stepping()))}</code> (policy set per run); reference "
+               f"<code>{html.escape(json.dumps(runs.reference_stepping()))}</code> under "
+               f"{runs.REFERENCE_PROFILE}.</p>")
+    return general + _table(["scene", "parameters"], rows)
+
+
+_PAGE = """<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><title>steadystep report</title>
+<style>
+body {{ font-family: system-ui, sans-serif; max-width: 1400px; margin: 2em auto; padding: 0 1em; color: #222; }}
+table {{ border-collapse: collapse; margin: 0.5em 0 1.5em; font-size: 0.9em; }}
+th, td {{ border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: right; }}
+th {{ background: #f3f3f3; }} td:first-child, td:nth-child(2) {{ text-align: left; }}
+img {{ max-width: 100%; display: block; margin: 0.5em 0 1.5em; }}
+.dot {{ display: inline-block; width: 0.7em; height: 0.7em; border-radius: 50%; margin-right: 0.4em; }}
+pre {{ background: #f6f6f6; padding: 0.6em; }} .small {{ color: #777; font-size: 0.85em; }}
+</style></head><body>
+{body}
+</body></html>
+"""
