@@ -59,7 +59,9 @@ typedef struct ssStepperDef {
   double reference_step_s;      /* NAIVE: the step its softness was tuned at (s), > 0; default 1/30 */
   double fixed_step_s;          /* FIXED: the constant step (s), > 0; default 1/60 */
   int max_steps_per_frame;      /* FIXED: cap against the spiral of death (later time is dropped), > 0; default 8 */
-  double max_speed;             /* a watched body faster than this (m/s) is a blow-up; 0 = no limit; default 0 */
+  /* a watched body faster than this (m/s) is a blow-up; 0 = no limit; default 0. Set it: ODE 0.16 aborts the
+   * program (dxNormalize4) when a step produces a non-finite rotation, so a runaway must be caught before NaN. */
+  double max_speed;
   ssCollideFn* collide;         /* may be NULL */
   void* collide_context;
   ssStepDoneFn* step_done;      /* may be NULL */

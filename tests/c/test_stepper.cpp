@@ -1,0 +1,243 @@
+// The stepper: how frames become steps under each policy, what the callbacks are handed, refusals that leave the
+// world as it was, blow-up and speed checks, and the Nyquist report.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "ode_fixture.h"
+#include "oscillator_rig.h"
+
+namespace {
+
+class StepperTest : public OdeTest {};
+
+TEST_F(StepperTest, FramesAreSplitIntoEqualSubstepsNoLongerThanTheMaximum) {
+  OscillatorRig rig;
+  ASSERT_EQ(rig.Build(), SS_OK);  // max_step_s = 1/60
+  struct Case {
+    double frame_s;
+    int steps;
+  } cases[] = {{1.0 / 60.0, 1}, {2.0 / 60.0, 2}, {0.05, 3}, {1.0 / 144.0, 1}, {0.1 + 0.2, 18}};
+  for (const Case& c : cases) {
+    ssFrameReport report;
+    ASSERT_EQ(ssStepper_Step(rig.stepper, c.frame_s, &report), SS_OK);
+    EXPECT_EQ(report.steps, c.steps) << c.frame_s;
+    EXPECT_NEAR(report.step_s, c.frame_s / c.steps, 1e-15);
+    EXPECT_NEAR(report.simulated_s, c.frame_s, 1e-15);
+    EXPECT_EQ(report.apply.rows_written, 1);  // the spring mapping is written once a frame
+  }
+}
+
+TEST_F(StepperTest, NaiveTakesOneStepWithSoftnessFrozenAtTheReference) {
+  OscillatorRig rig;
+  rig.def.policy = SS_POLICY_NAIVE;
+  rig.def.reference_step_s = 1.0 / 30.0;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  ssSoftness reference;
+  ASSERT_EQ(ssSoftnessFromSpring(rig.spring, 1.0 / 30.0, &reference), SS_OK);
+  for (double frame_s : {1.0 / 15.0, 1.0 / 45.0}) {
+    ssFrameReport report;
+    ASSERT_EQ(ssStepper_Step(rig.stepper, frame_s, &report), SS_OK);
+    EXPECT_EQ(report.steps, 1);
+    EXPECT_DOUBLE_EQ(report.step_s, frame_s);
+    EXPECT_DOUBLE_EQ(dJointGetSliderParam(rig.slider, dParamStopERP), reference.erp);
+    EXPECT_DOUBLE_EQ(dJointGetSliderParam(rig.slider, dParamStopCFM), reference.cfm);
+  }
+}
+
+TEST_F(StepperTest, FixedStepsFromAnAccumulatorWithInterpolationAndACap) {
+  OscillatorRig rig;
+  rig.def.policy = SS_POLICY_FIXED;
+  rig.def.fixed_step_s = 0.01;
+  rig.def.max_steps_per_frame = 4;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  ssFrameReport report;
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 0.025, &report), SS_OK);
+  EXPECT_EQ(report.steps, 2);
+  EXPECT_NEAR(report.interpolation, 0.5, 1e-9);
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 0.006, &report), SS_OK);  // 0.005 + 0.006 in the accumulator
+  EXPECT_EQ(report.steps, 1);
+  EXPECT_NEAR(report.interpolation, 0.1, 1e-9);
+  EXPECT_EQ(report.dropped_s, 0);
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 0.004, &report), SS_OK);
+  EXPECT_EQ(report.steps, 0);
+  EXPECT_NEAR(report.interpolation, 0.5, 1e-9);
+  // A one-second hitch: four steps, the rest dropped rather than spiralling.
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0, &report), SS_OK);
+  EXPECT_EQ(report.steps, 4);
+  EXPECT_NEAR(report.dropped_s, 0.96, 1e-9);
+  EXPECT_GE(report.interpolation, 0.0);
+  EXPECT_LT(report.interpolation, 1.0);
+  for (double h : rig.h) EXPECT_DOUBLE_EQ(h, 0.01);
+}
+
+TEST_F(StepperTest, BadFramesAreRefusedAndTheWorldIsLeftAsItWas) {
+  OscillatorRig rig;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  const double x = dJointGetSliderPosition(rig.slider);
+  for (double frame_s : {double(NAN), double(INFINITY), -0.01, -double(INFINITY)}) {
+    ssFrameReport report;
+    ssStatus status = ssStepper_Step(rig.stepper, frame_s, &report);
+    EXPECT_NE(status, SS_OK) << frame_s;
+    EXPECT_NE(std::string(ssLastError()).find("frame_s"), std::string::npos) << ssLastError();
+    EXPECT_EQ(report.steps, 0);
+  }
+  ssFrameReport report;
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 0.0, &report), SS_OK);
+  EXPECT_EQ(report.steps, 0);
+  EXPECT_EQ(dJointGetSliderPosition(rig.slider), x);
+  EXPECT_TRUE(rig.x.empty());
+}
+
+TEST_F(StepperTest, CreateRefusesBadDefinitionsNamingTheField) {
+  dWorldID other = dWorldCreate();
+  struct Case {
+    void (*change)(ssStepperDef*);
+    ssStatus status;
+    const char* named;
+  } cases[] = {
+      {[](ssStepperDef* d) { d->world = nullptr; }, SS_ERROR_OUT_OF_RANGE, "world"},
+      {[](ssStepperDef* d) { d->max_step_s = 0; }, SS_ERROR_OUT_OF_RANGE, "max_step_s = 0"},
+      {[](ssStepperDef* d) { d->max_step_s = NAN; }, SS_ERROR_NOT_FINITE, "max_step_s"},
+      {[](ssStepperDef* d) { d->reference_step_s = -1; }, SS_ERROR_OUT_OF_RANGE, "reference_step_s = -1"},
+      {[](ssStepperDef* d) { d->fixed_step_s = INFINITY; }, SS_ERROR_NOT_FINITE, "fixed_step_s"},
+      {[](ssStepperDef* d) { d->quick_iterations = 0; }, SS_ERROR_OUT_OF_RANGE, "quick_iterations = 0"},
+      {[](ssStepperDef* d) { d->max_steps_per_frame = -3; }, SS_ERROR_OUT_OF_RANGE, "max_steps_per_frame = -3"},
+      {[](ssStepperDef* d) { d->max_speed = -1; }, SS_ERROR_OUT_OF_RANGE, "max_speed = -1"},
+      {[](ssStepperDef* d) { d->policy = (ssPolicy)42; }, SS_ERROR_UNSUPPORTED, "policy = 42"},
+      {[](ssStepperDef* d) { d->solver = (ssSolver)7; }, SS_ERROR_UNSUPPORTED, "solver = 7"},
+  };
+  for (const Case& c : cases) {
+    ssStepperDef def = ssDefaultStepperDef();
+    def.world = other;
+    c.change(&def);
+    ssStepper* stepper = nullptr;
+    EXPECT_EQ(ssStepper_Create(&def, &stepper), c.status) << c.named;
+    EXPECT_EQ(stepper, nullptr);
+    EXPECT_NE(std::string(ssLastError()).find(c.named), std::string::npos) << ssLastError();
+  }
+  dWorldDestroy(other);
+}
+
+TEST_F(StepperTest, PolicyNamesRoundTrip) {
+  for (int p = SS_POLICY_NAIVE; p <= SS_POLICY_FIXED; ++p) {
+    ssPolicy parsed;
+    ASSERT_EQ(ssPolicyParse(ssPolicyName((ssPolicy)p), &parsed), SS_OK);
+    EXPECT_EQ(parsed, p);
+  }
+  ssPolicy parsed;
+  EXPECT_EQ(ssPolicyParse("smooth", &parsed), SS_ERROR_PARSE);
+  EXPECT_NE(std::string(ssLastError()).find("smooth"), std::string::npos);
+  EXPECT_EQ(ssPolicyName((ssPolicy)9), nullptr);
+}
+
+struct CallbackLog {
+  std::vector<double> collide_steps, collide_previous, done_steps;
+  std::vector<int> mappings;
+};
+
+TEST_F(StepperTest, CallbacksAreHandedTheStepAndTheMapping) {
+  OscillatorRig rig;
+  CallbackLog log;
+  rig.def.policy = SS_POLICY_EXACT;
+  rig.def.collide = [](void* context, ssMapping mapping, double step_s, double previous_step_s) {
+    auto* l = static_cast<CallbackLog*>(context);
+    l->mappings.push_back(mapping);
+    l->collide_steps.push_back(step_s);
+    l->collide_previous.push_back(previous_step_s);
+  };
+  rig.def.collide_context = &log;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 0.05, nullptr), SS_OK);  // three substeps of 1/60
+  ASSERT_EQ(log.collide_steps.size(), 3u);
+  EXPECT_EQ(log.collide_previous[0], 0.0);
+  EXPECT_DOUBLE_EQ(log.collide_previous[1], 0.05 / 3);
+  EXPECT_EQ(log.mappings[0], SS_MAPPING_EXACT);
+  EXPECT_EQ(rig.h.size(), 3u);
+  ssStepper_ResetHistory(rig.stepper);
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 0.01, nullptr), SS_OK);
+  EXPECT_EQ(log.collide_previous.back(), 0.0);
+  ASSERT_EQ(ssStepper_SetPolicy(rig.stepper, SS_POLICY_NAIVE), SS_OK);
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 0.01, nullptr), SS_OK);
+  EXPECT_EQ(log.mappings.back(), SS_MAPPING_SPRING);
+  EXPECT_DOUBLE_EQ(log.collide_steps.back(), rig.def.reference_step_s);
+  EXPECT_EQ(ssStepper_SetPolicy(rig.stepper, (ssPolicy)-1), SS_ERROR_UNSUPPORTED);
+}
+
+TEST_F(StepperTest, ContactGroupIsEmptiedAfterEveryStep) {
+  OscillatorRig rig;
+  dJointGroupID contacts = dJointGroupCreate(0);
+  rig.def.contact_group = contacts;
+  rig.def.collide = [](void* context, ssMapping, double, double) {
+    auto* r = static_cast<OscillatorRig*>(context);
+    dContact contact = {};
+    contact.geom.normal[2] = 1;
+    contact.geom.pos[2] = -0.05;
+    dJointID joint = dJointCreateContact(r->world, r->def.contact_group, &contact);
+    dJointAttach(joint, r->body, 0);
+    EXPECT_EQ(dBodyGetNumJoints(r->body), 2);  // the slider and this step's contact, never an old one
+  };
+  rig.def.collide_context = &rig;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 0.05, nullptr), SS_OK);
+  EXPECT_EQ(dBodyGetNumJoints(rig.body), 1);
+  dJointGroupDestroy(contacts);
+}
+
+TEST_F(StepperTest, BlowUpsAndRunawaySpeedsAreReportedNotPassedOver) {
+  OscillatorRig rig;
+  rig.def.max_speed = 100;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  dBodyID loose = MakeBody(1.0);
+  ssStepper_WatchBody(rig.stepper, loose);
+  dBodySetLinearVel(loose, 150, 0, 0);
+  ssFrameReport report;
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_SPEED_LIMIT);
+  EXPECT_EQ(report.failed_body, loose);
+  EXPECT_EQ(report.steps, 1);  // the frame stops at the step that failed
+  EXPECT_NE(std::string(ssLastError()).find("max_speed = 100"), std::string::npos) << ssLastError();
+
+  // A body of a bound joint is watched without being asked.
+  dBodySetLinearVel(loose, 0, 0, 0);
+  dBodySetLinearVel(rig.body, 500, 0, 0);
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_SPEED_LIMIT);
+  EXPECT_EQ(report.failed_body, rig.body);
+
+  // ODE aborts on a non-finite rotation, so the blow-up is in a free body's linear motion.
+  dBodySetLinearVel(rig.body, 0, 0, 0);
+  dBodySetLinearVel(loose, NAN, 0, 0);
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_BLOWUP);
+  EXPECT_EQ(report.failed_body, loose);
+  EXPECT_NE(std::string(ssLastError()).find("not finite"), std::string::npos) << ssLastError();
+  EXPECT_EQ(ssStepper_UnwatchBody(rig.stepper, loose), SS_OK);
+  EXPECT_EQ(ssStepper_UnwatchBody(rig.stepper, loose), SS_ERROR_NOT_FOUND);
+}
+
+TEST_F(StepperTest, FrequenciesAboveHalfTheStepRateAreReported) {
+  OscillatorRig rig;
+  rig.spring = {40000.0, 1.0};  // 1 kg: w = 200 rad/s, so w h > π above h = 15.7 ms
+  rig.def.max_step_s = 1.0 / 30.0;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  ssFrameReport report;
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 30.0, &report), SS_OK);
+  EXPECT_EQ(report.apply.rows_over_nyquist, 1);
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 100.0, &report), SS_OK);
+  EXPECT_EQ(report.apply.rows_over_nyquist, 0);
+}
+
+TEST_F(StepperTest, ExactFallsBackToMatchedWhereAStepPairHasNoFiniteMapping) {
+  OscillatorRig rig;
+  rig.spring = {40.0, 0.05};  // lightly damped
+  rig.def.policy = SS_POLICY_EXACT;
+  rig.def.max_step_s = 1.0;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  int fallbacks = 0;
+  for (double frame_s : {0.4, 0.004, 0.4, 0.004}) {
+    ssFrameReport report;
+    ASSERT_EQ(ssStepper_Step(rig.stepper, frame_s, &report), SS_OK) << ssLastError();
+    fallbacks += report.apply.rows_exact_fallback;
+  }
+  EXPECT_GT(fallbacks, 0);
+}
+
+}  // namespace
