@@ -23,7 +23,7 @@
 #define BUGGY_MOTOR_TORQUE_NM 0.6  /* dParamFMax2 of each wheel motor */
 #define BUGGY_BUMP_COUNT 3
 
-/* Ground contacts: stiff next to the suspension (a few hundred Hz on a wheel), well damped. */
+/* Ground contacts: stiff next to the suspension (about 50 Hz on a 0.2 kg wheel), well damped. */
 static const ssSpring buggy_ground_spring = {.stiffness = 2e4, .damping = 200};
 /* The hinge-2 rigid rows, as in chain.c: stiff and critically damped per kg. */
 static const ssSpring buggy_world_spring = {.stiffness = 1e5, .damping = 630};

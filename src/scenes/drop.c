@@ -96,7 +96,7 @@ const ssSceneDesc ssDropScene = {
              .quantity_count = 2,
              .quantity_names = {"penetration", "height"},
              .quantity_units = {"m", "m"}},
-    /* Per contact point (a flat box rests on four): about 8 Hz for a 1 kg box, under-damped so it rebounds. */
+    /* Per contact point; a flat box rests on four, 1e4 N/m on 1 kg: 16 Hz, damping ratio 0.4, so it rebounds. */
     .defaults = {.spring = {.stiffness = 2500, .damping = 20}, .mass = 1, .x0 = 0, .gravity = 9.81, .body_count = 4},
     .max_body_count = 1000,
     .build = build,
