@@ -144,6 +144,7 @@ def _compare(args, argv) -> int:
     from steadystep import report
     from steadystep.figures import article_figure
 
+    report.validate(args.scenes, args.profiles, args.policies)  # before the directory is made
     args.out.mkdir(parents=True, exist_ok=True)
     result = report.compare(args.scenes, args.profiles, args.policies, args.duration, args.seed,
                             figure_dir=args.out)

@@ -20,7 +20,7 @@ from tqdm import tqdm
 from steadystep import article, figures, metrics, runs
 from steadystep._native import SteadystepError
 from steadystep.files import atomic_write_text
-from steadystep.profiles import DEFAULT_PROFILES
+from steadystep.profiles import DEFAULT_PROFILES, Profile
 
 DEFAULT_POLICIES = ("naive", "spring", "fixed")
 OSCILLATOR_POLICIES = ("naive", "spring", "matched", "exact", "fixed")
@@ -72,6 +72,18 @@ def policies_for(scene: str, policies) -> list[str]:
     return list(OSCILLATOR_POLICIES if scene == "oscillator" else DEFAULT_POLICIES)
 
 
+def validate(scenes, profiles, policies) -> list[str]:
+    """Checks every name and spec before anything runs or is written; returns the scenes (default: all)."""
+    scenes = list(scenes) if scenes else [info.name for info in runs.scenes()]
+    for scene in scenes:
+        runs.scene_info(scene)
+    for profile in profiles:
+        Profile(profile)
+    for policy in policies or ():
+        runs.policy_value(policy)
+    return scenes
+
+
 def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: float = 5.0, seed: int = 1,
             params: dict | None = None, progress: bool | None = None, figure_dir: Path | None = None) -> Report:
     """Runs every scene under every profile and policy, plus each scene's reference, and measures them.
@@ -79,11 +91,7 @@ def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: f
     params: per scene changes to its parameters (default REPORT_PARAMS). progress: a tqdm bar (None: only on a
     terminal). figure_dir: where to draw the figures (None: none drawn)."""
     started = time.perf_counter()
-    scenes = list(scenes) if scenes else [info.name for info in runs.scenes()]
-    for scene in scenes:
-        runs.scene_info(scene)  # unknown names fail before anything runs
-    for policy in policies or ():
-        runs.policy_value(policy)
+    scenes = validate(scenes, profiles, policies)
     params = REPORT_PARAMS if params is None else params
     report = Report(scenes, list(profiles), {s: policies_for(s, policies) for s in scenes}, duration_s, seed)
     total = sum(1 + len(profiles) * len(report.policies[s]) for s in scenes)

@@ -228,5 +228,5 @@ class Scene:
     def close(self) -> None:
         """Destroys the scene and its ODE world now rather than at garbage collection."""
         if self._scene is not None:
-            lib.ssScene_Destroy(ffi.gc(self._scene, None))
+            ffi.release(self._scene)  # runs ssScene_Destroy now, once
             self._scene = None

@@ -1,0 +1,127 @@
+"""The steadystep command end to end, as a user runs it: every command on short runs, and every bad-argument path
+ending with exit code 2, one line on stderr and no file written."""
+
+import csv
+import io
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from steadystep.convert import softness_from_spring, spring_from_frequency, spring_from_softness
+
+SCRIPT = Path(sys.executable).parent / "steadystep"
+COMMAND = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "steadystep.cli"]
+
+
+def steadystep(*args, cwd=None):
+    return subprocess.run([*COMMAND, *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=120)
+
+
+def no_temporaries(directory: Path) -> bool:
+    return not any(p.name.startswith(".") and p.name.endswith(p.suffix) and ".tmp" in p.name
+                   for p in directory.iterdir())
+
+
+def test_every_command_has_help():
+    for command in ([], ["figure"], ["compare"], ["run"], ["convert"]):
+        result = steadystep(*command, "--help")
+        assert result.returncode == 0 and "usage: steadystep" in result.stdout
+
+
+def test_figure_writes_png_and_svg(tmp_path):
+    result = steadystep("figure", "--out", tmp_path / "figs", "--duration", "2")
+    assert result.returncode == 0, result.stderr
+    png, svg = tmp_path / "figs" / "article_figure.png", tmp_path / "figs" / "article_figure.svg"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "<svg" in svg.read_text()[:1000]
+    assert no_temporaries(tmp_path / "figs")
+
+
+def test_compare_writes_the_report(tmp_path):
+    result = steadystep("compare", "--out", tmp_path, "--scenes", "oscillator", "chain", "--profiles", "fixed:30",
+                        "uniform:15:45", "--duration", "1", "--seed", "3")
+    assert result.returncode == 0, result.stderr
+    page = (tmp_path / "report.html").read_text()
+    assert "Oscillator against the exact solution" in page and "steadystep compare --out" in page
+    metrics = json.loads((tmp_path / "metrics.json").read_text())
+    assert {(r["scene"], r["profile"], r["policy"]) for r in metrics["rows"]} >= {
+        ("oscillator", "uniform:15:45", "exact"), ("chain", "fixed:30", "naive"), ("chain", "uniform:15:45", "fixed")}
+    assert metrics["seed"] == 3
+    assert (tmp_path / "metrics.csv").read_text().startswith("scene,profile,policy,quantity,deviation")
+    assert (tmp_path / "deviation_chain.png").exists() and (tmp_path / "index.html").exists()
+    assert no_temporaries(tmp_path)
+
+
+def test_run_csv_on_stdout_and_to_a_file(tmp_path):
+    result = steadystep("run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--duration", "0.5")
+    assert result.returncode == 0, result.stderr
+    rows = list(csv.reader(io.StringIO(result.stdout)))
+    assert rows[0] == ["t", "x", "v", "erp", "cfm"]
+    assert len(rows) == 1 + 30  # 15 frames of 1/30 s, two 1/60 s steps each
+    assert float(rows[1][0]) == pytest.approx(1 / 60)
+    out = tmp_path / "run.csv"
+    result = steadystep("run", "chain", "--profile", "uniform:15:45", "--policy", "naive", "--duration", "0.5",
+                        "--csv", out)
+    assert result.returncode == 0, result.stderr
+    assert out.read_text().splitlines()[0] == "t,end x,end z"
+    assert no_temporaries(tmp_path)
+
+
+def test_run_json():
+    result = steadystep("run", "oscillator", "--profile", "uniform:15:45", "--policy", "exact", "--duration", "0.5",
+                        "--json", "--max-step", "0.1")
+    assert result.returncode == 0, result.stderr
+    data = json.loads(result.stdout)
+    assert data["status"] == "ok" and data["frames"] == data["steps"]
+    assert list(data["columns"]) == ["t", "x", "v", "erp", "cfm"] and data["units"]["x"] == "m"
+
+
+def test_convert_all_three_ways_equal_the_package():
+    result = steadystep("convert", "--k", "40", "--c", "1", "--dt", "0.02", "--json")
+    assert json.loads(result.stdout) == softness_from_spring((40, 1), 0.02)._asdict()
+    result = steadystep("convert", "--erp", "0.2", "--cfm", "1e-5", "--dt", "0.01", "--json")
+    assert json.loads(result.stdout) == spring_from_softness((0.2, 1e-5), 0.01)._asdict()
+    result = steadystep("convert", "--frequency", "2", "--damping-ratio", "0.3", "--mass", "1.5")
+    k, c = spring_from_frequency(2, 0.3, 1.5)
+    assert result.stdout.splitlines() == [f"stiffness = {k:.17g} N/m", f"damping = {c:.17g} N·s/m"]
+
+
+@pytest.mark.parametrize("args", [
+    ["frobnicate"],
+    [],
+    ["run", "oscillator", "--policy", "spring"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "sideways"],
+    ["run", "nosuch", "--profile", "fixed:30", "--policy", "spring"],
+    ["run", "oscillator", "--profile", "fixed:-30", "--policy", "spring"],
+    ["run", "oscillator", "--profile", "warp:9", "--policy", "spring"],
+    ["run", "oscillator", "--profile", "trace:/no/such/file", "--policy", "spring"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--duration", "-1"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--duration", "inf"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--seed", "-4"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--max-step", "0"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--json", "--csv", "x.csv"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--csv", "no/such/dir/x.csv"],
+    ["convert", "--k", "40"],
+    ["convert", "--k", "40", "--c", "1", "--erp", "0.2", "--dt", "0.1"],
+    ["convert", "--k", "-40", "--c", "1", "--dt", "0.1"],
+    ["convert", "--k", "forty", "--c", "1", "--dt", "0.1"],
+    ["convert", "--erp", "1.5", "--cfm", "0.1", "--dt", "0.1"],
+    ["convert", "--frequency", "2", "--damping-ratio", "0.3", "--mass", "0"],
+    ["compare", "--scenes", "nosuch", "--duration", "1"],
+    ["compare", "--policies", "sideways", "--duration", "1"],
+    ["compare", "--profiles", "fixed:0", "--scenes", "oscillator", "--duration", "1"],
+    ["figure", "--duration", "0"],
+    ["figure", "--out", "a_file"],
+])
+def test_bad_arguments_exit_2_with_one_line(tmp_path, args):
+    (tmp_path / "a_file").write_text("not a directory")
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    result = steadystep(*args, cwd=tmp_path)
+    assert result.returncode == 2, (args, result.stdout, result.stderr)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, (args, result.stderr)
+    assert "Traceback" not in result.stderr and lines[0].startswith("steadystep")
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before  # nothing written, not even half
