@@ -109,7 +109,8 @@ def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_d
     rows = (len(profiles) + columns - 1) // columns
     figure, axes = plt.subplots(rows, columns, figsize=(4.6 * columns, 3.1 * rows + 0.8), squeeze=False,
                                 sharex=True, sharey=True, constrained_layout=True)
-    low, high = _limits(reference.quantities[quantity])
+    low, high = _limits(reference.quantities[quantity],
+                        [r.quantities[quantity] for r in results.values() if r.step_count])
     for index, profile in enumerate(profiles):
         ax = axes[index // columns][index % columns]
         if exact_curve is not None:
@@ -121,7 +122,10 @@ def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_d
             if result is None or result.step_count == 0:
                 continue
             label = policy + (" (blew up)" if result.blew_up else "")
-            ax.plot(result.times, result.quantities[quantity], color=policy_color(policy), lw=1.1, label=label)
+            # The article's method drawn on top: it is what the figure is about.
+            on_top = policy == "spring"
+            ax.plot(result.times, result.quantities[quantity], color=policy_color(policy), lw=1.5 if on_top else 1.1,
+                    zorder=3 if on_top else 2, label=label)
         ax.set_title(profile, loc="left", fontsize=10)
         ax.set_ylim(low, high)
         if index % columns == 0:
@@ -141,11 +145,16 @@ def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_d
     return save(figure, out_dir, f"scene_{scene}_{quantity}".replace(" ", "_"))
 
 
-def _limits(values: np.ndarray) -> tuple[float, float]:
-    """The y range: the reference's range with a margin, so a run that blows up does not flatten every curve."""
-    finite = values[np.isfinite(values)]
+def _limits(reference: np.ndarray, others: list[np.ndarray]) -> tuple[float, float]:
+    """The y range: every curve's, but at most the reference's range widened by its span on each side, so that a
+    run gone wild does not flatten every other curve."""
+    finite = reference[np.isfinite(reference)]
     low, high = (float(finite.min()), float(finite.max())) if len(finite) else (-1.0, 1.0)
-    margin = 0.35 * (high - low) if high > low else max(abs(high), 1e-3)
+    span = high - low if high > low else max(abs(high), 1e-3)
+    values = np.concatenate([finite] + [v[np.isfinite(v)] for v in others])
+    low = max(float(values.min()), low - span)
+    high = min(float(values.max()), high + span)
+    margin = 0.08 * (high - low)
     return low - margin, high + margin
 
 
