@@ -46,7 +46,7 @@ def test_malformed_trace_names_the_line(tmp_path):
     with pytest.raises(SteadystepError) as error:
         Profile(f"trace:{trace}")
     assert error.value.status == "parse error"
-    assert "3" in error.value.message
+    assert "line 3" in error.value.message and "fast" in error.value.message
 
 
 @pytest.mark.parametrize("spec, status", [
