@@ -17,6 +17,10 @@ typedef struct JointBinding {
   ssSpring spring;
   double effective_mass; /* 0: computed from the bodies at each Apply */
   ssSoftness pending;    /* computed in Apply's first pass */
+  ssSoftness written;    /* last written: the registry owns the row, so an unchanged value is not written again */
+  /* The spring mapping needs the mass only for the Nyquist report: it is refreshed every few Applies there. */
+  double report_mass;
+  int report_mass_age;
 } JointBinding;
 
 typedef struct BodyBinding {
@@ -38,6 +42,7 @@ struct ssRegistry {
   int joint_count, joint_capacity;
   BodyBinding* bodies;
   int body_count, body_capacity;
+  unsigned generation; /* changes whenever the set of bound joints or bodies does */
 };
 
 ssRegistry* ssRegistry_Create(dWorldID world) {
@@ -93,7 +98,7 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
   if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
   if (status != SS_OK) return status;
 
-  JointBinding binding = {joint, param, axis, spring, effective_mass, {0, 0}};
+  JointBinding binding = {joint, param, axis, spring, effective_mass, {0, 0}, {NAN, NAN}, NAN, 0};
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* existing = &registry->joints[i];
     if (existing->joint == joint && existing->param == param && existing->axis == axis) {
@@ -104,6 +109,7 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
   if (!reserveOne((void**)&registry->joints, registry->joint_count, &registry->joint_capacity, sizeof binding))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding a joint");
   registry->joints[registry->joint_count++] = binding;
+  registry->generation += 1;
   return SS_OK;
 }
 
@@ -113,6 +119,7 @@ ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
     if (registry->joints[i].joint != joint) registry->joints[kept++] = registry->joints[i];
   if (kept == registry->joint_count) return ssFail(SS_ERROR_NOT_FOUND, "joint %p: not bound", (void*)joint);
   registry->joint_count = kept;
+  registry->generation += 1;
   return SS_OK;
 }
 
@@ -123,6 +130,7 @@ static BodyBinding* bodyBinding(ssRegistry* registry, dBodyID body) {
   if (!reserveOne((void**)&registry->bodies, registry->body_count, &registry->body_capacity, sizeof(BodyBinding)))
     return NULL;
   BodyBinding* binding = &registry->bodies[registry->body_count++];
+  registry->generation += 1;
   memset(binding, 0, sizeof *binding);
   binding->body = body;
   return binding;
@@ -158,6 +166,7 @@ ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body) {
   for (int i = 0; i < registry->body_count; ++i) {
     if (registry->bodies[i].body != body) continue;
     registry->bodies[i] = registry->bodies[--registry->body_count];
+    registry->generation += 1;
     return SS_OK;
   }
   return ssFail(SS_ERROR_NOT_FOUND, "body %p: not bound", (void*)body);
@@ -173,6 +182,14 @@ static ssStatus failBinding(ssStatus status, const JointBinding* binding) {
                 ssJointParamName(binding->param), binding->axis, cause);
 }
 
+/* How many Applies of the spring mapping reuse a computed effective mass for the Nyquist report. */
+enum { kReportMassRefresh = 16 };
+
+/* w·h > π, i.e. k·h² > π²·m: the natural frequency is above half the step rate. */
+static int overNyquist(ssSpring spring, double mass, double step_s) {
+  return spring.stiffness * step_s * step_s > M_PI * M_PI * mass;
+}
+
 /* The softness of one spring for this step; EXACT falls back to MATCHED where the pair of steps has no finite
  * mapping (counted in the report), which keeps the exact poles and loses only the history correction. */
 static ssStatus softnessFor(ssMapping mapping, ssSpring spring, double mass, double step_s, double previous_step_s,
@@ -182,9 +199,27 @@ static ssStatus softnessFor(ssMapping mapping, ssSpring spring, double mass, dou
     status = ssMatchedSoftness(spring, mass, step_s, out);
     if (status == SS_OK) report->rows_exact_fallback += 1;
   }
-  if (status == SS_OK && spring.stiffness > 0 && isfinite(mass) && sqrt(spring.stiffness / mass) * step_s > M_PI)
-    report->rows_over_nyquist += 1; /* w·h > π: the natural frequency is above half the step rate */
   return status;
+}
+
+/* The binding's mass for this Apply: given, or computed (every time where the mapping depends on it). NAN when the
+ * spring mapping cannot have one, which only skips the Nyquist report. */
+static ssStatus bindingMass(JointBinding* binding, ssMapping mapping, double* mass) {
+  if (binding->effective_mass > 0) {
+    *mass = binding->effective_mass;
+    return SS_OK;
+  }
+  if (mapping == SS_MAPPING_SPRING && binding->report_mass_age > 0) {
+    binding->report_mass_age -= 1;
+    *mass = binding->report_mass;
+    return SS_OK;
+  }
+  ssStatus status = ssJointEffectiveMass(binding->joint, binding->param, binding->axis, mass);
+  if (status != SS_OK && mapping != SS_MAPPING_SPRING) return status;
+  if (status != SS_OK) *mass = NAN;
+  binding->report_mass = *mass;
+  binding->report_mass_age = kReportMassRefresh;
+  return SS_OK;
 }
 
 ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
@@ -199,18 +234,34 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     status = softnessFor(mapping, registry->world_spring, registry->world_mass, step_s, previous_step_s, &counts,
                          &registry->world_pending);
     if (status != SS_OK) return failBinding(status, NULL);
+    counts.rows_over_nyquist += overNyquist(registry->world_spring, registry->world_mass, step_s);
   }
+  /* Programs bind many rows to a few springs: under the spring mapping each one's softness is computed once. */
+  enum { kCacheSize = 4 };
+  ssSpring cached_spring[kCacheSize];
+  ssSoftness cached_softness[kCacheSize];
+  int cached = 0;
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
-    double mass = binding->effective_mass;
-    if (mass == 0) {
-      status = ssJointEffectiveMass(binding->joint, binding->param, binding->axis, &mass);
-      /* the spring mapping needs no mass: without one, only the Nyquist count is skipped */
-      if (status != SS_OK && mapping != SS_MAPPING_SPRING) return failBinding(status, binding);
-      if (status != SS_OK) mass = NAN;
-    }
-    status = softnessFor(mapping, binding->spring, mass, step_s, previous_step_s, &counts, &binding->pending);
+    double mass;
+    status = bindingMass(binding, mapping, &mass);
     if (status != SS_OK) return failBinding(status, binding);
+    int hit = -1;
+    for (int j = 0; j < cached && hit < 0; ++j)
+      if (cached_spring[j].stiffness == binding->spring.stiffness && cached_spring[j].damping == binding->spring.damping)
+        hit = j;
+    if (hit >= 0) {
+      binding->pending = cached_softness[hit];
+    } else {
+      status = softnessFor(mapping, binding->spring, mass, step_s, previous_step_s, &counts, &binding->pending);
+      if (status != SS_OK) return failBinding(status, binding);
+      if (mapping == SS_MAPPING_SPRING) {
+        int slot = cached < kCacheSize ? cached++ : i % kCacheSize;
+        cached_spring[slot] = binding->spring;
+        cached_softness[slot] = binding->pending;
+      }
+    }
+    counts.rows_over_nyquist += overNyquist(binding->spring, mass, step_s); /* false for a NAN mass */
   }
 
   /* Second pass: nothing below can fail. */
@@ -220,8 +271,10 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     counts.rows_written += 1;
   }
   for (int i = 0; i < registry->joint_count; ++i) {
-    const JointBinding* binding = &registry->joints[i];
+    JointBinding* binding = &registry->joints[i];
+    if (binding->pending.erp == binding->written.erp && binding->pending.cfm == binding->written.cfm) continue;
     ssJointWriteSoftness(binding->joint, binding->param, binding->axis, binding->pending.erp, binding->pending.cfm);
+    binding->written = binding->pending;
   }
   counts.rows_written += registry->joint_count;
   for (int i = 0; i < registry->body_count; ++i) {
@@ -264,8 +317,13 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
 
 int ssRegistry_JointBindingCount(const ssRegistry* registry) { return registry->joint_count; }
 
-void ssRegistryVisitBodiesRepeated(const ssRegistry* registry, void (*visit)(void* context, dBodyID body),
-                                   void* context) {
+int ssRegistryBodyBindingCount(const ssRegistry* registry) { return registry->body_count; }
+
+unsigned ssRegistryGeneration(const ssRegistry* registry) { return registry->generation; }
+
+/* Every bound body, with repeats, without allocating. */
+static void visitBodiesRepeated(const ssRegistry* registry, void (*visit)(void* context, dBodyID body),
+                                void* context) {
   for (int i = 0; i < registry->joint_count; ++i)
     for (int side = 0; side < 2; ++side) {
       dBodyID body = dJointGetBody(registry->joints[i].joint, side);
@@ -294,10 +352,10 @@ void ssRegistry_VisitBodies(const ssRegistry* registry, void (*visit)(void* cont
   size_t most = 2 * (size_t)registry->joint_count + (size_t)registry->body_count;
   BodyList list = {malloc((most ? most : 1) * sizeof(dBodyID)), 0};
   if (list.bodies == NULL) { /* rather a body twice than none */
-    ssRegistryVisitBodiesRepeated(registry, visit, context);
+    visitBodiesRepeated(registry, visit, context);
     return;
   }
-  ssRegistryVisitBodiesRepeated(registry, appendBody, &list);
+  visitBodiesRepeated(registry, appendBody, &list);
   qsort(list.bodies, (size_t)list.count, sizeof(dBodyID), compareBodies);
   for (int i = 0; i < list.count; ++i)
     if (i == 0 || list.bodies[i] != list.bodies[i - 1]) visit(context, list.bodies[i]);

@@ -4,8 +4,10 @@
 
 #include "steadystep/registry.h"
 
-/* Like ssRegistry_VisitBodies, without removing repeats and without allocating: for checks that may repeat. */
-void ssRegistryVisitBodiesRepeated(const ssRegistry* registry, void (*visit)(void* context, dBodyID body),
-                                   void* context);
+/* A number that changes whenever a joint or body is bound or unbound: the stepper rebuilds its list on a change. */
+unsigned ssRegistryGeneration(const ssRegistry* registry);
+
+/* The number of bodies bound for damping or auto-disable (the world's defaults included). */
+int ssRegistryBodyBindingCount(const ssRegistry* registry);
 
 #endif

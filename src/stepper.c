@@ -17,6 +17,11 @@ struct ssStepper {
   double accumulator_s;   /* FIXED: time not yet stepped */
   dBodyID* watched;
   int watched_count, watched_capacity;
+  /* the registry's bodies, each once, rebuilt when its generation changes */
+  dBodyID* bound;
+  int bound_count, bound_capacity;
+  unsigned bound_generation;
+  int bound_valid;
   /* the check of one step, filled by checkBody */
   dBodyID failed_body;
   ssStatus failed_status;
@@ -86,6 +91,7 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
 void ssStepper_Destroy(ssStepper* stepper) {
   if (stepper == NULL) return;
   free(stepper->watched);
+  free(stepper->bound);
   free(stepper);
 }
 
@@ -123,33 +129,46 @@ ssStatus ssStepper_SetPolicy(ssStepper* stepper, ssPolicy policy) {
   return SS_OK;
 }
 
-static int allFinite(const dReal* values, int count) {
-  for (int i = 0; i < count; ++i)
-    if (!isfinite(values[i])) return 0;
-  return 1;
+/* Checks one body after a step; the first failure of the step is kept. Rotation is not read: a non-finite angular
+ * velocity makes ODE 0.16 abort inside the step (dxNormalize4), so a rotation that comes back is finite. */
+static void checkBody(ssStepper* stepper, dBodyID body) {
+  const dReal* position = dBodyGetPosition(body);
+  const dReal* velocity = dBodyGetLinearVel(body);
+  /* a NaN or an infinity anywhere makes the sum non-finite: one test for six numbers */
+  double sum = position[0] + position[1] + position[2] + velocity[0] + velocity[1] + velocity[2];
+  double speed_squared = velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2];
+  double max_speed = stepper->def.max_speed;
+  if (isfinite(sum) && (max_speed == 0 || speed_squared <= max_speed * max_speed)) return;
+  stepper->failed_body = body;
+  if (!isfinite(sum) || !isfinite(speed_squared))
+    stepper->failed_status = ssFail(SS_ERROR_BLOWUP, "body %p: position or velocity is not finite", (void*)body);
+  else
+    stepper->failed_status = ssFail(SS_ERROR_SPEED_LIMIT, "body %p: speed %g m/s is above max_speed = %g m/s",
+                                    (void*)body, sqrt(speed_squared), max_speed);
 }
 
-static void checkBody(void* context, dBodyID body) {
+static void appendBound(void* context, dBodyID body) {
   ssStepper* stepper = context;
-  if (stepper->failed_body != 0) return;
-  const dReal* velocity = dBodyGetLinearVel(body);
-  if (!allFinite(dBodyGetPosition(body), 3) || !allFinite(dBodyGetQuaternion(body), 4) || !allFinite(velocity, 3) ||
-      !allFinite(dBodyGetAngularVel(body), 3)) {
-    stepper->failed_body = body;
-    stepper->failed_status = ssFail(SS_ERROR_BLOWUP, "body %p: position, orientation or velocity is not finite",
-                                    (void*)body);
-    return;
+  if (stepper->bound_count < stepper->bound_capacity) stepper->bound[stepper->bound_count++] = body;
+}
+
+/* The registry's bodies, each once; rebuilt only when the registry's bindings changed. */
+static ssStatus refreshBound(ssStepper* stepper) {
+  const ssRegistry* registry = stepper->def.registry;
+  unsigned generation = ssRegistryGeneration(registry);
+  if (stepper->bound_valid && stepper->bound_generation == generation) return SS_OK;
+  int most = 2 * ssRegistry_JointBindingCount(registry) + ssRegistryBodyBindingCount(registry);
+  if (most > stepper->bound_capacity) {
+    dBodyID* larger = realloc(stepper->bound, (size_t)most * sizeof *larger);
+    if (larger == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the bound bodies");
+    stepper->bound = larger;
+    stepper->bound_capacity = most;
   }
-  double max_speed = stepper->def.max_speed;
-  if (max_speed > 0) {
-    double speed = sqrt(velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2]);
-    if (speed > max_speed) {
-      stepper->failed_body = body;
-      stepper->failed_status =
-          ssFail(SS_ERROR_SPEED_LIMIT, "body %p: speed %g m/s is above max_speed = %g m/s", (void*)body, speed,
-                 max_speed);
-    }
-  }
+  stepper->bound_count = 0;
+  ssRegistry_VisitBodies(registry, appendBound, stepper);
+  stepper->bound_generation = generation;
+  stepper->bound_valid = 1;
+  return SS_OK;
 }
 
 /* One physics step of step_s, the registry having been applied for it. */
@@ -171,8 +190,8 @@ static ssStatus takeStep(ssStepper* stepper, ssMapping mapping, double softness_
 
   stepper->failed_body = 0;
   stepper->failed_status = SS_OK;
-  for (int i = 0; i < stepper->watched_count; ++i) checkBody(stepper, stepper->watched[i]);
-  if (def->registry) ssRegistryVisitBodiesRepeated(def->registry, checkBody, stepper);
+  for (int i = 0; i < stepper->watched_count && !stepper->failed_body; ++i) checkBody(stepper, stepper->watched[i]);
+  for (int i = 0; i < stepper->bound_count && !stepper->failed_body; ++i) checkBody(stepper, stepper->bound[i]);
   if (stepper->failed_body != 0) {
     report->failed_body = stepper->failed_body;
     stepper->previous_step_s = 0;
@@ -268,6 +287,7 @@ ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* repor
   memset(report, 0, sizeof *report);
   ssStatus status = ssCheckNonNegative("frame_s", "s", frame_s);
   if (status != SS_OK || frame_s == 0) return status;
+  if (stepper->def.registry != NULL && (status = refreshBound(stepper)) != SS_OK) return status;
   switch (stepper->def.policy) {
     case SS_POLICY_NAIVE: return stepNaive(stepper, frame_s, report);
     case SS_POLICY_FIXED: return stepFixed(stepper, frame_s, report);

@@ -8,7 +8,9 @@
  * suspension) when they are created, so a later dWorldSetERP does not reach them: bind each one. Hinge, slider,
  * universal, PR, PU and piston joints read the world's ERP/CFM at every step for their non-limit rows.
  *
- * Bindings hold ODE handles. A program that destroys a joint or a body must unbind it first.
+ * Bindings hold ODE handles. A program that destroys a joint or a body must unbind it first. A bound parameter
+ * belongs to the registry, which writes it only when its value changes: a program that sets one itself binds it
+ * again to have it rewritten at the next Apply.
  */
 #ifndef STEADYSTEP_REGISTRY_H
 #define STEADYSTEP_REGISTRY_H
@@ -40,7 +42,7 @@ typedef enum ssJointParam {
 
 /** What the registry wrote in one Apply. */
 typedef struct ssApplyReport {
-  int rows_written;           /* joint parameter sets written, plus 1 for a bound world */
+  int rows_written;           /* joint parameter sets brought up to date, plus 1 for a bound world */
   int rows_over_nyquist;      /* rows whose natural frequency exceeds half the step rate (1/(2h)) */
   int rows_exact_fallback;    /* SS_MAPPING_EXACT rows that this step length could not serve: matched was used */
 } ssApplyReport;

@@ -96,7 +96,7 @@ void ssStepper_Destroy(ssStepper* stepper);
 /** Advances the world by one frame of frame_s seconds (>= 0; 0 does nothing). report may be NULL.
  *  Errors, with the world left as it was: SS_ERROR_NOT_FINITE or SS_ERROR_OUT_OF_RANGE for frame_s; errors of
  *  ssRegistry_Apply (checked before the first step touches the world).
- *  Errors after stepping: SS_ERROR_BLOWUP (a watched body's position, orientation or velocity is not finite) and
+ *  Errors after stepping: SS_ERROR_BLOWUP (a watched body's position or linear velocity is not finite) and
  *  SS_ERROR_SPEED_LIMIT (faster than max_speed): the frame stops at that step and report->failed_body names it. */
 ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* report);
 
