@@ -250,3 +250,22 @@ ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, doub
   *mass = value;
   return SS_OK;
 }
+
+int ssJointRowHasDirection(dJointID joint, ssJointParam param, int axis) {
+  return param != SS_PARAM_JOINT && ssJointSupports(joint, param, axis);
+}
+
+void ssJointAddRowForce(dJointID joint, ssJointParam param, int axis, double force_or_torque) {
+  dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
+  int angular, has_point;
+  if (!rowGeometry(joint, param, axis, direction, point, &angular, &has_point)) return;
+  for (int side = 0; side < 2; ++side) {
+    dBodyID body = dJointGetBody(joint, side);
+    if (!isDynamic(body)) continue;
+    double f = side == 0 ? force_or_torque : -force_or_torque;
+    if (angular) dBodyAddTorque(body, f * direction[0], f * direction[1], f * direction[2]);
+    else if (has_point)
+      dBodyAddForceAtPos(body, f * direction[0], f * direction[1], f * direction[2], point[0], point[1], point[2]);
+    else dBodyAddForce(body, f * direction[0], f * direction[1], f * direction[2]);
+  }
+}

@@ -20,4 +20,12 @@ void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double e
  * 1/m + (r x d)·I⁻¹(r x d) (linear) or d·I⁻¹d (angular). Returns 0 when no dynamic body is attached. */
 double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, const dReal* point, int angular);
 
+/* Whether a row has one direction that a load along it can be declared for (every limit, motor and suspension row;
+ * not the several rows of SS_PARAM_JOINT). */
+int ssJointRowHasDirection(dJointID joint, ssJointParam param, int axis);
+
+/* Adds force_or_torque (N or N·m) along the row to its first body and the opposite to its second, for the coming
+ * step: at the row's point for a linear row that has one (hinge-2 suspension), at the centres otherwise. */
+void ssJointAddRowForce(dJointID joint, ssJointParam param, int axis, double force_or_torque);
+
 #endif

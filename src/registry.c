@@ -18,6 +18,7 @@ typedef struct JointBinding {
   double effective_mass; /* 0: computed from the bodies at each Apply */
   ssSoftness pending;    /* computed in Apply's first pass */
   ssSoftness written;    /* last written: the registry owns the row, so an unchanged value is not written again */
+  double load; /* the steady force or torque the row carries (ssRegistry_SetJointLoad); 0 = none declared */
   /* The spring mapping needs the mass only for the Nyquist report: it is refreshed every few Applies there. */
   double report_mass;
   int report_mass_age;
@@ -98,7 +99,7 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
   if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
   if (status != SS_OK) return status;
 
-  JointBinding binding = {joint, param, axis, spring, effective_mass, {0, 0}, {NAN, NAN}, NAN, 0};
+  JointBinding binding = {joint, param, axis, spring, effective_mass, {0, 0}, {NAN, NAN}, 0, NAN, 0};
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* existing = &registry->joints[i];
     if (existing->joint == joint && existing->param == param && existing->axis == axis) {
@@ -111,6 +112,21 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
   registry->joints[registry->joint_count++] = binding;
   registry->generation += 1;
   return SS_OK;
+}
+
+ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, double load) {
+  ssStatus status = ssCheckFinite("load", "N or N·m", load);
+  if (status != SS_OK) return status;
+  for (int i = 0; i < registry->joint_count; ++i) {
+    JointBinding* binding = &registry->joints[i];
+    if (binding->joint != joint || binding->param != param || binding->axis != axis) continue;
+    if (!ssJointRowHasDirection(joint, param, axis))
+      return ssFail(SS_ERROR_UNSUPPORTED, "a %s joint's %s rows have no single direction to carry a load",
+                    ssJointTypeName(joint), ssJointParamName(param));
+    binding->load = load;
+    return SS_OK;
+  }
+  return ssFail(SS_ERROR_NOT_FOUND, "joint %p, param %d, axis %d: not bound", (void*)joint, (int)param, axis);
 }
 
 ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
@@ -275,6 +291,16 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     if (binding->pending.erp == binding->written.erp && binding->pending.cfm == binding->written.cfm) continue;
     ssJointWriteSoftness(binding->joint, binding->param, binding->axis, binding->pending.erp, binding->pending.cfm);
     binding->written = binding->pending;
+  }
+  if (mapping != SS_MAPPING_SPRING) {
+    for (int i = 0; i < registry->joint_count; ++i) {
+      const JointBinding* binding = &registry->joints[i];
+      if (binding->load == 0 || binding->spring.stiffness == 0) continue;
+      /* the step's static stiffness is k' = erp/(h·cfm): this force puts the rest position back at load/k */
+      double static_stiffness = binding->pending.erp / (step_s * binding->pending.cfm);
+      ssJointAddRowForce(binding->joint, binding->param, binding->axis,
+                         binding->load * (static_stiffness / binding->spring.stiffness - 1));
+    }
   }
   counts.rows_written += registry->joint_count;
   for (int i = 0; i < registry->body_count; ++i) {

@@ -68,6 +68,19 @@ ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effe
 ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssSpring spring,
                               double effective_mass);
 
+/** Declares the steady load a bound row carries: a force (N) along a linear row or a torque (N·m) about an angular
+ *  one, as it acts on the joint's first body in the axis' positive direction (a 1 kg body hanging on an upward
+ *  slider: -9.81 N; a quarter of a chassis' weight on a hinge-2 suspension whose axis 1 points up: -m·g/4).
+ *  Why: the matched and exact mappings choose erp and cfm for the right poles, which makes the row's static stiffness
+ *  k' = erp/(h·cfm) differ from k, so under a load the rest position would be load/k' instead of load/k. With the
+ *  load declared, every Apply under those mappings adds load·(k'/k - 1) along the row (the opposite to the second
+ *  body) for the coming step, which puts the rest position back at load/k; for a lone spring under a constant load
+ *  the exact mapping's samples are then exact again. The spring mapping needs nothing (its k' is k). Call Apply
+ *  once per step (the stepper does), since the force is added each time. Binding the row again clears the load.
+ *  Errors: SS_ERROR_NOT_FINITE; SS_ERROR_NOT_FOUND when that row is not bound; SS_ERROR_UNSUPPORTED for
+ *  SS_PARAM_JOINT rows, which have no single direction. */
+ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, double load);
+
 /** Removes every binding of joint. Call it before dJointDestroy. Errors: SS_ERROR_NOT_FOUND. */
 ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint);
 

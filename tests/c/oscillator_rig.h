@@ -12,6 +12,7 @@
 
 struct OscillatorRig {
   double mass = 1.0, x0 = 0.5, gravity = 0.0;
+  bool declare_load = false;  // tell the registry the weight the stop carries (ssRegistry_SetJointLoad)
   ssSpring spring = {40.0, 1.0};
   ssStepperDef def = ssDefaultStepperDef();
 
@@ -38,6 +39,8 @@ struct OscillatorRig {
     dBodySetPosition(body, x0, 0, 0);  // after attaching, so the slider reads x0
     registry = ssRegistry_Create(world);
     ssStatus status = ssRegistry_BindJoint(registry, slider, SS_PARAM_STOP, 1, spring, mass);
+    if (status == SS_OK && declare_load)
+      status = ssRegistry_SetJointLoad(registry, slider, SS_PARAM_STOP, 1, -mass * gravity);
     if (status != SS_OK) return status;
     def.world = world;
     def.registry = registry;
