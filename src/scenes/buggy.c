@@ -62,7 +62,12 @@ static ssStatus attach_wheel(const ssSceneWorld* world, const ssSceneParams* par
    * body 1, the chassis, relative to body 2): a positive motor velocity drives the car backwards. */
   dJointSetHinge2Param(joint, dParamVel2, -BUGGY_SPEED_M_PER_S / BUGGY_WHEEL_RADIUS_M);
   dJointSetHinge2Param(joint, dParamFMax2, BUGGY_MOTOR_TORQUE_NM);
-  return ssRegistry_BindJoint(world->registry, joint, SS_PARAM_SUSPENSION, 1, params->spring, 0);
+  ssStatus status = ssRegistry_BindJoint(world->registry, joint, SS_PARAM_SUSPENSION, 1, params->spring, 0);
+  /* Each suspension carries a quarter of the chassis' weight, down along axis 1 on the chassis (body 1): declared,
+   * so that the matched and exact mappings keep the sag of k instead of that of their own static stiffness. */
+  if (status == SS_OK)
+    status = ssRegistry_SetJointLoad(world->registry, joint, SS_PARAM_SUSPENSION, 1, -params->mass * params->gravity / 4);
+  return status;
 }
 
 static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, void** state) {
