@@ -238,6 +238,13 @@ static ssStatus bindingMass(JointBinding* binding, ssMapping mapping, double* ma
   return SS_OK;
 }
 
+/* Whether two bindings drive rows along the same axis of the same joint (a stop and a motor). */
+static int sharesRow(const JointBinding* a, const JointBinding* b) {
+  int a_limit = a->param == SS_PARAM_STOP || a->param == SS_PARAM_MOTOR;
+  int b_limit = b->param == SS_PARAM_STOP || b->param == SS_PARAM_MOTOR;
+  return a->joint == b->joint && a->axis == b->axis && a_limit && b_limit;
+}
+
 ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
                           ssApplyReport* report) {
   ssStatus status = ssCheckPositive("step_s", "s", step_s);
@@ -257,11 +264,18 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   ssSpring cached_spring[kCacheSize];
   ssSoftness cached_softness[kCacheSize];
   int cached = 0;
+  double last_mass = NAN;
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
     double mass;
-    status = bindingMass(binding, mapping, &mass);
-    if (status != SS_OK) return failBinding(status, binding);
+    const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
+    if (before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass) {
+      mass = last_mass; /* a stop and a motor on one axis move the same mass: computed once */
+    } else {
+      status = bindingMass(binding, mapping, &mass);
+      if (status != SS_OK) return failBinding(status, binding);
+    }
+    last_mass = mass;
     int hit = -1;
     for (int j = 0; j < cached && hit < 0; ++j)
       if (cached_spring[j].stiffness == binding->spring.stiffness && cached_spring[j].damping == binding->spring.damping)
