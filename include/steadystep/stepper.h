@@ -45,7 +45,7 @@ typedef enum ssSolver {
  *  the step before (0 if none). */
 typedef void ssCollideFn(void* context, ssMapping mapping, double step_s, double previous_step_s);
 
-/** Called after each physics step with its length; for recording. */
+/** Called after each physics step that passed the blow-up checks, with its length; for recording. */
 typedef void ssStepDoneFn(void* context, double step_s);
 
 /** How a stepper is made. Start from ssDefaultStepperDef(): new fields keep working defaults. */
