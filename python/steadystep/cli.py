@@ -1,4 +1,4 @@
-"""The `steadystep` command: figure, compare, run, convert. A thin layer over the package.
+"""The `steadystep` command: figure, compare, run, probe, convert. A thin layer over the package.
 
 Bad arguments and every SteadystepError end with one line on stderr and exit code 2, never a traceback. Output
 files are written whole (temporary name, then rename).
@@ -110,6 +110,21 @@ def build_parser() -> argparse.ArgumentParser:
     output.add_argument("--csv", type=Path, metavar="FILE", help="write CSV to FILE (default: CSV on stdout)")
     output.add_argument("--json", action="store_true", help="JSON on stdout: columns and a summary")
 
+    probe = commands.add_parser("probe", help="the largest step a scene survives under each policy",
+                                description="Bisects for the longest physics step (every frame one step of h) at "
+                                "which SCENE stays stable: no blow-up, and its motion within the reference run's "
+                                "range widened by that range on both sides.")
+    probe.add_argument("scene", metavar="SCENE", help="oscillator, buggy, drop, chain or pile")
+    probe.add_argument("--policies", nargs="+", metavar="POLICY", default=["naive", "spring", "matched", "exact"],
+                       help="default: naive spring matched exact")
+    probe.add_argument("--duration", type=_positive_float, default=3.0, metavar="S",
+                       help="seconds per trial (default 3)")
+    probe.add_argument("--low", type=_positive_float, default=0.001, metavar="S",
+                       help="shortest step tried (default 0.001 s)")
+    probe.add_argument("--high", type=_positive_float, default=0.25, metavar="S",
+                       help="longest step tried (default 0.25 s)")
+    probe.add_argument("--json", action="store_true", help="JSON on stdout")
+
     convert = commands.add_parser("convert", help="springs <-> ERP/CFM <-> frequency and damping ratio",
                                   description="One of: --k K --c C --dt H (spring to ERP/CFM), --erp E --cfm F "
                                   "--dt H (tuned ERP/CFM to a spring), --frequency HZ --damping-ratio Z --mass M "
@@ -183,6 +198,26 @@ def _run(args, argv) -> int:
     return 0
 
 
+def _probe(args, argv) -> int:
+    from steadystep import probe, runs
+
+    runs.scene_info(args.scene)
+    for policy in args.policies:
+        runs.policy_value(policy)
+    results = [probe.largest_stable_step(args.scene, policy, args.duration, args.low, args.high)
+               for policy in args.policies]
+    if args.json:
+        print(json.dumps([{"scene": r.scene, "policy": r.policy, "stable_s": r.stable_s,
+                           "unstable_s": r.unstable_s if math.isfinite(r.unstable_s) else None, "reason": r.reason}
+                          for r in results]))
+    else:
+        for r in results:
+            unstable = f"unstable at {1000 * r.unstable_s:.4g} ms: {r.reason}" if math.isfinite(r.unstable_s) \
+                else "stable up to the longest step tried"
+            print(f"{r.scene} {r.policy}: stable up to {1000 * r.stable_s:.4g} ms; {unstable}")
+    return 0
+
+
 def _convert(args, argv) -> int:
     from steadystep import convert
 
@@ -224,7 +259,8 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
         args = build_parser().parse_args(argv)
-        handler = {"figure": _figure, "compare": _compare, "run": _run, "convert": _convert}[args.command]
+        handler = {"figure": _figure, "compare": _compare, "run": _run, "probe": _probe,
+                   "convert": _convert}[args.command]
         return handler(args, argv)
     except _UsageError as error:
         print(error, file=sys.stderr)

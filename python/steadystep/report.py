@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from steadystep import article, figures, metrics, runs
+from steadystep import article, figures, metrics, probe, runs
 from steadystep._native import SteadystepError
 from steadystep.files import atomic_write_text
 from steadystep.profiles import DEFAULT_PROFILES, Profile
@@ -26,9 +26,10 @@ DEFAULT_POLICIES = ("naive", "spring", "fixed")
 OSCILLATOR_POLICIES = ("naive", "spring", "matched", "exact", "fixed")
 SIDE_BY_SIDE_PROFILES = ("fixed:30", "uniform:15:45")
 # Quantities that are settings, not motion: they are plotted by `run`, never measured against a reference.
-NOT_MOTION = frozenset({"erp", "cfm"})
 # The pile is there for timing; the report keeps it small so that the whole report takes a few minutes.
 REPORT_PARAMS = {"pile": {"body_count": 150}}
+# The pile is for timing: each probe trial at 1 ms steps would cost seconds of it.
+NOT_PROBED = frozenset({"pile"})
 
 
 @dataclass
@@ -56,13 +57,10 @@ class Report:
     rows: list[Row] = field(default_factory=list)
     spreads: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)  # scene -> policy -> quantity
     side_by_side: list[dict] = field(default_factory=list)
+    probes: dict[str, list[probe.ProbeResult]] = field(default_factory=dict)  # scene -> one per policy
     params: dict[str, dict] = field(default_factory=dict)
     figures: dict[str, list[Path]] = field(default_factory=dict)
     elapsed_s: float = 0.0
-
-
-def motion_quantities(scene: str) -> list[str]:
-    return [q for q in runs.scene_info(scene).quantities if q not in NOT_MOTION]
 
 
 def policies_for(scene: str, policies) -> list[str]:
@@ -94,7 +92,8 @@ def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: f
     scenes = validate(scenes, profiles, policies)
     params = REPORT_PARAMS if params is None else params
     report = Report(scenes, list(profiles), {s: policies_for(s, policies) for s in scenes}, duration_s, seed)
-    total = sum(1 + len(profiles) * len(report.policies[s]) for s in scenes)
+    total = sum(1 + len(profiles) * len(report.policies[s]) + (0 if s in NOT_PROBED else len(report.policies[s]))
+                for s in scenes)
     oscillator = "oscillator" in scenes
     if oscillator:
         total += len(SIDE_BY_SIDE_PROFILES) * len(OSCILLATOR_POLICIES)
@@ -115,7 +114,7 @@ def _compare_scene(report: Report, scene: str, scene_params: dict | None, bar, f
     reference = runs.reference_run(scene, report.duration_s, params=scene_params)
     bar.update()
     report.params[scene] = reference.params
-    quantities = motion_quantities(scene)
+    quantities = runs.motion_quantities(scene)
     results = {}
     for profile in report.profiles:
         for policy in report.policies[scene]:
@@ -134,6 +133,12 @@ def _compare_scene(report: Report, scene: str, scene_params: dict | None, bar, f
         policy: {q: metrics.spread(row.deviations[q] for row in report.rows
                                    if row.scene == scene and row.policy == policy) for q in quantities}
         for policy in report.policies[scene]}
+    if scene not in NOT_PROBED:
+        report.probes[scene] = []
+        for policy in report.policies[scene]:
+            bar.set_postfix_str(f"{scene} largest stable step, {policy}")
+            report.probes[scene].append(probe.largest_stable_step(scene, policy, params=scene_params))
+            bar.update()
     if figure_dir is not None:
         exact_curve = _exact_curve(reference.params, report.duration_s) if scene == "oscillator" else None
         paths = []
@@ -228,6 +233,9 @@ def _as_json(report: Report, command: str) -> dict:
                    for s, ps in report.spreads.items()},
         "oscillator_side_by_side": [{k: _finite_or_none(v) if isinstance(v, float) else v for k, v in e.items()}
                                     for e in report.side_by_side],
+        "largest_stable_step": {s: [{"policy": r.policy, "stable_s": r.stable_s,
+                                     "unstable_s": _finite_or_none(r.unstable_s), "reason": r.reason}
+                                    for r in results] for s, results in report.probes.items()},
     }
 
 
@@ -293,7 +301,7 @@ def _as_html(report: Report, command: str, article_paths: list[Path]) -> str:
 def _summary(report: Report) -> str:
     rows = []
     for scene in report.scenes:
-        quantity = motion_quantities(scene)[0]
+        quantity = runs.motion_quantities(scene)[0]
         spreads = report.spreads[scene]
         cells = [html.escape(scene), html.escape(quantity)]
         for policy in ("naive", "spring", "fixed"):
@@ -317,7 +325,7 @@ def _side_by_side_table(report: Report) -> str:
 
 
 def _scene_section(report: Report, scene: str) -> list[str]:
-    quantities = motion_quantities(scene)
+    quantities = runs.motion_quantities(scene)
     info = runs.scene_info(scene)
     parts = [f"<h2 id='{html.escape(scene)}'>{html.escape(scene)}</h2>", f"<p>{html.escape(info.description)}</p>"]
     spread_rows = [[_policy_cell(p)] + [_number(report.spreads[scene][p][q]) for q in quantities]
@@ -334,6 +342,15 @@ def _scene_section(report: Report, scene: str) -> list[str]:
                     + [_number(r.steps_per_frame), _number(r.steps_per_second, 4), _number(r.wall_us_per_step),
                        html.escape(r.status)])
     parts += ["<h3>Every run</h3>", _table(header, rows)]
+    if scene in report.probes:
+        probe_rows = [[_policy_cell(r.policy), _number(1000 * r.stable_s, 4),
+                       _number(1000 * r.unstable_s, 4) if math.isfinite(r.unstable_s) else "none up to 250",
+                       html.escape(r.reason or "-")] for r in report.probes[scene]]
+        parts += ["<h3>Largest stable step</h3>",
+                  "<p>Every frame one step of h (max_step_s = fixed_step_s = h), 3 s; stable: no blow-up and every "
+                  "motion quantity within the reference's range widened by that range on both sides. Bisection in "
+                  "log h between 1 and 250 ms.</p>",
+                  _table(["policy", "stable up to (ms)", "unstable at (ms)", "first failure there"], probe_rows)]
     parts += [_embed(p) for p in report.figures.get(scene, []) if p.suffix == ".png"]
     return parts
 

@@ -73,6 +73,15 @@ def _as_dict(cdata) -> dict:
     return out
 
 
+# Followed quantities that are settings the stepper wrote, not motion: not measured against the reference.
+NOT_MOTION = frozenset({"erp", "cfm"})
+
+
+def motion_quantities(scene: str) -> list[str]:
+    """The scene's quantities that describe its motion (the oscillator's erp and cfm do not)."""
+    return [q for q in scene_info(scene).quantities if q not in NOT_MOTION]
+
+
 def default_params(scene: str) -> dict:
     """The scene's default parameters (ssSceneParams as a dict: spring {stiffness, damping}, mass, x0, ...)."""
     out = ffi.new("ssSceneParams*")

@@ -26,7 +26,7 @@ def no_temporaries(directory: Path) -> bool:
 
 
 def test_every_command_has_help():
-    for command in ([], ["figure"], ["compare"], ["run"], ["convert"]):
+    for command in ([], ["figure"], ["compare"], ["run"], ["probe"], ["convert"]):
         result = steadystep(*command, "--help")
         assert result.returncode == 0 and "usage: steadystep" in result.stdout
 
@@ -79,6 +79,15 @@ def test_run_json():
     assert list(data["columns"]) == ["t", "x", "v", "erp", "cfm"] and data["units"]["x"] == "m"
 
 
+def test_probe_prints_each_policy():
+    result = steadystep("probe", "chain", "--policies", "naive", "spring", "--duration", "1", "--json")
+    assert result.returncode == 0, result.stderr
+    found = json.loads(result.stdout)
+    assert [r["policy"] for r in found] == ["naive", "spring"]
+    for r in found:
+        assert 0.001 < r["stable_s"] < r["unstable_s"] <= 0.25 and r["reason"]
+
+
 def test_convert_all_three_ways_equal_the_package():
     result = steadystep("convert", "--k", "40", "--c", "1", "--dt", "0.02", "--json")
     assert json.loads(result.stdout) == softness_from_spring((40, 1), 0.02)._asdict()
@@ -113,6 +122,10 @@ def test_convert_all_three_ways_equal_the_package():
     ["compare", "--scenes", "nosuch", "--duration", "1"],
     ["compare", "--policies", "sideways", "--duration", "1"],
     ["compare", "--profiles", "fixed:0", "--scenes", "oscillator", "--duration", "1"],
+    ["probe", "nosuch"],
+    ["probe", "chain", "--policies", "sideways"],
+    ["probe", "chain", "--low", "0.5", "--high", "0.25"],
+    ["probe", "chain", "--duration", "0"],
     ["figure", "--duration", "0"],
     ["figure", "--out", "a_file"],
 ])

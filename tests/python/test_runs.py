@@ -80,7 +80,7 @@ def test_spring_halves_the_spread_of_naive_in_every_soft_scene():
     result = report.compare(soft_scenes, ["fixed:30", "uniform:15:45", "hitch:60:30:0.1", "vsync:60:30"],
                             ["naive", "spring"], duration_s=2.0, seed=1, progress=False)
     for scene in soft_scenes:
-        for quantity in report.motion_quantities(scene):
+        for quantity in runs.motion_quantities(scene):
             naive = result.spreads[scene]["naive"][quantity]
             spring = result.spreads[scene]["spring"][quantity]
             assert math.isfinite(spring), (scene, quantity)

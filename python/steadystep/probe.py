@@ -1,0 +1,87 @@
+"""The largest stable step: how long a physics step a scene survives under a policy.
+
+The article asks for "a largest time step the simulation can handle"; this finds it on real ODE. A trial runs the
+scene with every frame one step of length h (max_step_s = fixed_step_s = h). It is stable when the run ends without
+a blow-up (NaN or a speed above the scene's limit) and every followed quantity stays within the reference run's
+range widened by that range on both sides. The step is found by bisection in log(h), which assumes that a scene
+stable at some h is stable at every shorter one; a scene that is not (a resonance) gets the border nearest to the
+start of the search.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from steadystep import runs
+from steadystep._native import SteadystepError
+
+DEFAULT_LOW_S = 1.0 / 1000.0
+DEFAULT_HIGH_S = 0.25
+
+
+@dataclass
+class ProbeResult:
+    scene: str
+    policy: str
+    stable_s: float      # the longest step found stable (s); 0 when even low_s is not
+    unstable_s: float    # the shortest step found unstable (s); inf when high_s is stable
+    trials: int
+    reason: str          # why unstable_s failed ("blow-up: ...", "x left its range", ""), for the report
+
+
+def _trial(scene: str, policy: str, step_s: float, duration_s: float, bounds: dict, params) -> str:
+    """'' when the scene is stable at step_s, else why not."""
+    try:
+        result = runs.run(scene, f"fixed:{1.0 / step_s!r}", policy, duration_s, params=params,
+                          stepping={"max_step_s": step_s, "fixed_step_s": step_s})
+    except SteadystepError as error:
+        if error.status != "no finite mapping":  # a mapping with nothing to offer at this step is a failure of it
+            raise
+        return f"{error.status}: {error.message}"
+    if result.blew_up:
+        return f"{result.status}: {result.message}"
+    for name, (low, high) in bounds.items():
+        values = result.quantities[name]
+        if not np.all(np.isfinite(values)) or values.min() < low or values.max() > high:
+            return f"{name} left [{low:.3g}, {high:.3g}]"
+    return ""
+
+
+def largest_stable_step(scene: str, policy: str, duration_s: float = 3.0, low_s: float = DEFAULT_LOW_S,
+                        high_s: float = DEFAULT_HIGH_S, tolerance: float = 0.02, params: dict | None = None
+                        ) -> ProbeResult:
+    """Bisects for the longest step in [low_s, high_s] at which scene stays stable under policy, to a relative
+    tolerance. Raises SteadystepError for bad input (the scene, policy and parameters are checked by the library)."""
+    for name, value in (("duration_s", duration_s), ("low_s", low_s), ("high_s", high_s), ("tolerance", tolerance)):
+        if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+            raise SteadystepError("out of range", f"{name} = {value}: must be a positive finite number")
+    if low_s >= high_s:
+        raise SteadystepError("out of range", f"low_s = {low_s} s: must be shorter than high_s = {high_s} s")
+    reference = runs.reference_run(scene, duration_s, params)
+    bounds = {}
+    for name in runs.motion_quantities(scene):
+        values = reference.quantities[name]
+        width = max(float(values.max() - values.min()), 1e-3)
+        bounds[name] = (float(values.min()) - width, float(values.max()) + width)
+
+    trials = 1
+    reason = _trial(scene, policy, high_s, duration_s, bounds, params)
+    if not reason:
+        return ProbeResult(scene, policy, high_s, math.inf, trials, "")
+    trials += 1
+    low_reason = _trial(scene, policy, low_s, duration_s, bounds, params)
+    if low_reason:
+        return ProbeResult(scene, policy, 0.0, low_s, trials, low_reason)
+    stable, unstable = low_s, high_s
+    while unstable / stable > 1.0 + tolerance:
+        middle = math.sqrt(stable * unstable)
+        trials += 1
+        why = _trial(scene, policy, middle, duration_s, bounds, params)
+        if why:
+            unstable, reason = middle, why
+        else:
+            stable = middle
+    return ProbeResult(scene, policy, stable, unstable, trials, reason)
