@@ -71,6 +71,24 @@ typedef struct ssContactRecipe {
 /* Runs dSpaceCollide on recipe->space and softens every contact for (mapping, step_s, previous_step_s). */
 void ssContactCollide(ssContactRecipe* recipe, ssMapping mapping, double step_s, double previous_step_s);
 
+/* Boxes of one size on a ground plane whose contacts are soft with the scene's spring (drop, pile). */
+typedef struct ssBoxes {
+  int count;
+  dBodyID* bodies;
+  ssContactRecipe recipe;
+} ssBoxes;
+
+/* Allocates room for params->body_count boxes, sets gravity along -z and makes the ground. scene names the scene
+ * in the out-of-memory message. */
+ssStatus ssBoxes_Create(const ssSceneWorld* world, const ssSceneParams* params, const char* scene, ssBoxes** out);
+/* Adds one box of side_m (m) and mass_kg (kg) centred at (x, y, z). */
+void ssBoxes_Add(ssBoxes* boxes, const ssSceneWorld* world, double mass_kg, double side_m, double x, double y,
+                 double z);
+/* The ssSceneDesc callbacks of a scene whose state is an ssBoxes. */
+ssStatus ssBoxes_Watch(void* state, ssStepper* stepper);
+void ssBoxes_Collide(void* context, ssMapping mapping, double step_s, double previous_step_s);
+void ssBoxes_Destroy(void* state);
+
 /* Calls dInitODE2 once per process and allocates ODE's per-thread data once per thread; never dCloseODE. */
 void ssEnsureOde(void);
 

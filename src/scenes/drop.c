@@ -4,9 +4,7 @@
  * the step boundaries fall (speed times step length), whatever the softness; from low, the penetration a run
  * shows is the contact spring's own sag and rebound, which is what the policies differ in. */
 #include <math.h>
-#include <stdlib.h>
 
-#include "error.h"
 #include "scene_internal.h"
 
 #define DROP_SIDE_M 0.2         /* box edge */
@@ -14,64 +12,16 @@
 #define DROP_LOWEST_GAP_M 0.02  /* the first box's bottom above the ground */
 #define DROP_GAP_STEP_M 0.03    /* each next box starts this much higher: they land one after another */
 
-typedef struct Drop {
-  int count;
-  dBodyID* boxes;
-  ssContactRecipe recipe;
-} Drop;
-
-static void destroy(void* state) {
-  Drop* drop = state;
-  free(drop->boxes);
-  free(drop);
-}
-
 static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, void** state) {
-  Drop* drop = calloc(1, sizeof *drop);
-  dBodyID* boxes = calloc((size_t)params->body_count, sizeof *boxes);
-  if (drop == NULL || boxes == NULL) {
-    free(drop);
-    free(boxes);
-    return ssFail(SS_ERROR_OUT_OF_MEMORY, "drop: out of memory for %d boxes", params->body_count);
-  }
-  drop->count = params->body_count;
-  drop->boxes = boxes;
-  dWorldSetGravity(world->world, 0, 0, -params->gravity);
-  dCreatePlane(world->space, 0, 0, 1, 0);
-  for (int i = 0; i < drop->count; ++i) {
-    dBodyID box = dBodyCreate(world->world);
-    dMass mass;
-    dMassSetBoxTotal(&mass, params->mass, DROP_SIDE_M, DROP_SIDE_M, DROP_SIDE_M);
-    dBodySetMass(box, &mass);
+  ssBoxes* boxes;
+  ssStatus status = ssBoxes_Create(world, params, "drop", &boxes);
+  if (status != SS_OK) return status;
+  for (int i = 0; i < params->body_count; ++i) {
     double bottom_m = DROP_LOWEST_GAP_M + DROP_GAP_STEP_M * i;
-    dBodySetPosition(box, DROP_SPACING_M * i, 0, bottom_m + 0.5 * DROP_SIDE_M);
-    dGeomID geom = dCreateBox(world->space, DROP_SIDE_M, DROP_SIDE_M, DROP_SIDE_M);
-    dGeomSetBody(geom, box);
-    boxes[i] = box;
+    ssBoxes_Add(boxes, world, params->mass, DROP_SIDE_M, DROP_SPACING_M * i, 0, bottom_m + 0.5 * DROP_SIDE_M);
   }
-  drop->recipe = (ssContactRecipe){.world = world->world,
-                                   .space = world->space,
-                                   .contacts = world->contacts,
-                                   .spring = params->spring,
-                                   .max_contacts = 4,
-                                   .surface_mode = dContactApprox1,
-                                   .mu = 0.5};
-  *state = drop;
+  *state = boxes;
   return SS_OK;
-}
-
-static ssStatus watch(void* state, ssStepper* stepper) {
-  Drop* drop = state;
-  for (int i = 0; i < drop->count; ++i) {
-    ssStatus status = ssStepper_WatchBody(stepper, drop->boxes[i]);
-    if (status != SS_OK) return status;
-  }
-  return SS_OK;
-}
-
-static void collide(void* context, ssMapping mapping, double step_s, double previous_step_s) {
-  Drop* drop = context;
-  ssContactCollide(&drop->recipe, mapping, step_s, previous_step_s);
 }
 
 /* The lowest corner of a box of side DROP_SIDE_M: its centre less the half extents projected on world z. */
@@ -83,11 +33,11 @@ static double lowest_corner_z(dBodyID box) {
 }
 
 static void sample(const void* state, double* out) {
-  const Drop* drop = state;
+  const ssBoxes* boxes = state;
   double penetration_m = 0;
-  for (int i = 0; i < drop->count; ++i) penetration_m = fmax(penetration_m, -lowest_corner_z(drop->boxes[i]));
+  for (int i = 0; i < boxes->count; ++i) penetration_m = fmax(penetration_m, -lowest_corner_z(boxes->bodies[i]));
   out[0] = penetration_m;
-  out[1] = dBodyGetPosition(drop->boxes[0])[2];
+  out[1] = dBodyGetPosition(boxes->bodies[0])[2];
 }
 
 const ssSceneDesc ssDropScene = {
@@ -100,8 +50,8 @@ const ssSceneDesc ssDropScene = {
     .defaults = {.spring = {.stiffness = 2500, .damping = 20}, .mass = 1, .x0 = 0, .gravity = 9.81, .body_count = 4},
     .max_body_count = 1000,
     .build = build,
-    .watch = watch,
-    .collide = collide,
+    .watch = ssBoxes_Watch,
+    .collide = ssBoxes_Collide,
     .sample = sample,
-    .destroy = destroy,
+    .destroy = ssBoxes_Destroy,
 };

@@ -1,0 +1,60 @@
+/* Boxes of one size on a ground plane with soft contacts: what the drop and pile scenes share. They differ only in
+ * where the boxes start and what they sample. */
+#include <stdlib.h>
+
+#include "error.h"
+#include "scene_internal.h"
+
+ssStatus ssBoxes_Create(const ssSceneWorld* world, const ssSceneParams* params, const char* scene, ssBoxes** out) {
+  ssBoxes* boxes = calloc(1, sizeof *boxes);
+  dBodyID* bodies = calloc((size_t)params->body_count, sizeof *bodies);
+  if (boxes == NULL || bodies == NULL) {
+    free(boxes);
+    free(bodies);
+    return ssFail(SS_ERROR_OUT_OF_MEMORY, "%s: out of memory for %d boxes", scene, params->body_count);
+  }
+  boxes->bodies = bodies;
+  dWorldSetGravity(world->world, 0, 0, -params->gravity);
+  dCreatePlane(world->space, 0, 0, 1, 0);
+  boxes->recipe = (ssContactRecipe){.world = world->world,
+                                    .space = world->space,
+                                    .contacts = world->contacts,
+                                    .spring = params->spring,
+                                    .max_contacts = 4,
+                                    .surface_mode = dContactApprox1,
+                                    .mu = 0.5};
+  *out = boxes;
+  return SS_OK;
+}
+
+void ssBoxes_Add(ssBoxes* boxes, const ssSceneWorld* world, double mass_kg, double side_m, double x, double y,
+                 double z) {
+  dBodyID box = dBodyCreate(world->world);
+  dMass mass;
+  dMassSetBoxTotal(&mass, mass_kg, side_m, side_m, side_m);
+  dBodySetMass(box, &mass);
+  dBodySetPosition(box, x, y, z);
+  dGeomID geom = dCreateBox(world->space, side_m, side_m, side_m);
+  dGeomSetBody(geom, box);
+  boxes->bodies[boxes->count++] = box;
+}
+
+ssStatus ssBoxes_Watch(void* state, ssStepper* stepper) {
+  ssBoxes* boxes = state;
+  for (int i = 0; i < boxes->count; ++i) {
+    ssStatus status = ssStepper_WatchBody(stepper, boxes->bodies[i]);
+    if (status != SS_OK) return status;
+  }
+  return SS_OK;
+}
+
+void ssBoxes_Collide(void* context, ssMapping mapping, double step_s, double previous_step_s) {
+  ssBoxes* boxes = context;
+  ssContactCollide(&boxes->recipe, mapping, step_s, previous_step_s);
+}
+
+void ssBoxes_Destroy(void* state) {
+  ssBoxes* boxes = state;
+  free(boxes->bodies);
+  free(boxes);
+}
