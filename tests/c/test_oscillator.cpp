@@ -53,6 +53,34 @@ TEST_F(Oscillator, SubstepsFollowImplicitEulerAtEachSubstep) {
   EXPECT_LT(MaxDifference(rig.x, ImplicitEuler(rig, rig.h)), 1e-9);
 }
 
+// Steps world through 150 frames drawn uniformly from 1/45 to 1/15 s, one step each, and returns the largest
+// difference between measure() and the implicit-Euler recurrence of a row of mass (kg or kg·m²) and spring from x0
+// at rest. -1 when the stepper refuses.
+template <typename Measure>
+double WorstAgainstImplicitEuler(dWorldID world, ssRegistry* registry, ssSolver solver, uint64_t seed, double mass,
+                                 ssSpring spring, double x0, Measure measure) {
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = world;
+  def.registry = registry;
+  def.solver = solver;
+  def.max_step_s = 1.0 / 15.0;
+  ssStepper* stepper;
+  if (ssStepper_Create(&def, &stepper) != SS_OK) return -1;
+  std::mt19937_64 random(seed);
+  std::uniform_real_distribution<double> frame(1.0 / 45.0, 1.0 / 15.0);
+  const double k = spring.stiffness, c = spring.damping;
+  double x = x0, v = 0, worst = 0;
+  for (int i = 0; i < 150 && worst >= 0; ++i) {
+    double h = frame(random);
+    if (ssStepper_Step(stepper, h, nullptr) != SS_OK) worst = -1;
+    v = (mass * v - h * k * x) / (mass + h * c + h * h * k);
+    x += h * v;
+    if (worst >= 0) worst = std::fmax(worst, std::fabs(measure() - x));
+  }
+  ssStepper_Destroy(stepper);
+  return worst;
+}
+
 // An angular stop on a hinge: the same recurrence in angle, with the body's inertia about the axis.
 TEST_F(Oscillator, HingeAngularStopFollowsImplicitEuler) {
   const double inertia = 0.02, k = 3.0, c = 0.05, theta0 = 0.3;
@@ -77,25 +105,10 @@ TEST_F(Oscillator, HingeAngularStopFollowsImplicitEuler) {
 
     ssRegistry* registry = ssRegistry_Create(world);
     ASSERT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, ssSpring{k, c}, 0), SS_OK);
-    ssStepperDef def = ssDefaultStepperDef();
-    def.world = world;
-    def.registry = registry;
-    def.solver = solver;
-    def.max_step_s = 1.0 / 15.0;
-    ssStepper* stepper;
-    ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
-    std::mt19937_64 random(11);
-    std::uniform_real_distribution<double> frame(1.0 / 45.0, 1.0 / 15.0);
-    double x = theta0, v = 0, worst = 0;
-    for (int i = 0; i < 150; ++i) {
-      double h = frame(random);
-      ASSERT_EQ(ssStepper_Step(stepper, h, nullptr), SS_OK);
-      v = (inertia * v - h * k * x) / (inertia + h * c + h * h * k);
-      x += h * v;
-      worst = std::fmax(worst, std::fabs(dJointGetHingeAngle(hinge) - x));
-    }
+    double worst = WorstAgainstImplicitEuler(world, registry, solver, 11, inertia, ssSpring{k, c}, theta0,
+                                             [&] { return dJointGetHingeAngle(hinge); });
+    EXPECT_GE(worst, 0) << ssLastError();
     EXPECT_LT(worst, solver == SS_SOLVER_STEP ? 1e-9 : 1e-8) << "solver " << solver;
-    ssStepper_Destroy(stepper);
     ssRegistry_Destroy(registry);
     dWorldDestroy(world);
   }
@@ -126,25 +139,10 @@ TEST_F(Oscillator, Hinge2SuspensionFollowsImplicitEuler) {
     double effective = 0;
     ASSERT_EQ(ssJointEffectiveMass(hinge2, SS_PARAM_SUSPENSION, 1, &effective), SS_OK);
     EXPECT_NEAR(effective, wheel_kg, 1e-12);
-    ssStepperDef def = ssDefaultStepperDef();
-    def.world = world;
-    def.registry = registry;
-    def.solver = solver;
-    def.max_step_s = 1.0 / 15.0;
-    ssStepper* stepper;
-    ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
-    std::mt19937_64 random(5);
-    std::uniform_real_distribution<double> frame(1.0 / 45.0, 1.0 / 15.0);
-    double x = z0, v = 0, worst = 0;
-    for (int i = 0; i < 150; ++i) {
-      double h = frame(random);
-      ASSERT_EQ(ssStepper_Step(stepper, h, nullptr), SS_OK);
-      v = (wheel_kg * v - h * k * x) / (wheel_kg + h * c + h * h * k);
-      x += h * v;
-      worst = std::fmax(worst, std::fabs(dBodyGetPosition(wheel)[2] - x));
-    }
+    double worst = WorstAgainstImplicitEuler(world, registry, solver, 5, wheel_kg, ssSpring{k, c}, z0,
+                                             [&] { return dBodyGetPosition(wheel)[2]; });
+    EXPECT_GE(worst, 0) << ssLastError();
     EXPECT_LT(worst, solver == SS_SOLVER_STEP ? 1e-9 : 1e-8) << "solver " << solver;
-    ssStepper_Destroy(stepper);
     ssRegistry_Destroy(registry);
     dWorldDestroy(world);
   }
