@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "array.h"
 #include "error.h"
 #include "joint_rows.h"
 #include "registry_internal.h"
@@ -67,17 +68,6 @@ void ssRegistry_Destroy(ssRegistry* registry) {
   free(registry);
 }
 
-/* Grows an array of `size`-byte items to hold one more. */
-static int reserveOne(void** items, int count, int* capacity, size_t size) {
-  if (count < *capacity) return 1;
-  int grown = *capacity ? 2 * *capacity : 8;
-  void* larger = realloc(*items, (size_t)grown * size);
-  if (larger == NULL) return 0;
-  *items = larger;
-  *capacity = grown;
-  return 1;
-}
-
 ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effective_mass) {
   ssStatus status = ssValidateSpring(spring);
   if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
@@ -107,7 +97,7 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
       return SS_OK;
     }
   }
-  if (!reserveOne((void**)&registry->joints, registry->joint_count, &registry->joint_capacity, sizeof binding))
+  if (!ssReserveOne((void**)&registry->joints, registry->joint_count, &registry->joint_capacity, sizeof binding))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding a joint");
   registry->joints[registry->joint_count++] = binding;
   registry->generation += 1;
@@ -143,7 +133,7 @@ ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
 static BodyBinding* bodyBinding(ssRegistry* registry, dBodyID body) {
   for (int i = 0; i < registry->body_count; ++i)
     if (registry->bodies[i].body == body) return &registry->bodies[i];
-  if (!reserveOne((void**)&registry->bodies, registry->body_count, &registry->body_capacity, sizeof(BodyBinding)))
+  if (!ssReserveOne((void**)&registry->bodies, registry->body_count, &registry->body_capacity, sizeof(BodyBinding)))
     return NULL;
   BodyBinding* binding = &registry->bodies[registry->body_count++];
   registry->generation += 1;

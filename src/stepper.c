@@ -4,6 +4,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "array.h"
 #include "error.h"
 #include "registry_internal.h"
 #include "steadystep/stepper.h"
@@ -99,13 +100,8 @@ ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body) {
   if (body == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "body = NULL: a body is required");
   for (int i = 0; i < stepper->watched_count; ++i)
     if (stepper->watched[i] == body) return SS_OK;
-  if (stepper->watched_count == stepper->watched_capacity) {
-    int grown = stepper->watched_capacity ? 2 * stepper->watched_capacity : 16;
-    dBodyID* larger = realloc(stepper->watched, (size_t)grown * sizeof *larger);
-    if (larger == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory watching a body");
-    stepper->watched = larger;
-    stepper->watched_capacity = grown;
-  }
+  if (!ssReserveOne((void**)&stepper->watched, stepper->watched_count, &stepper->watched_capacity, sizeof body))
+    return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory watching a body");
   stepper->watched[stepper->watched_count++] = body;
   return SS_OK;
 }
