@@ -78,14 +78,20 @@ struct OscillatorRig {
   }
 };
 
-// The implicit-Euler recurrence of the article, m(v'-v)/h = -k(x + h v') - c v' - m g, x' = x + h v', over the
-// given step lengths from rest at x0: the x after each step.
+// One step of the article's implicit-Euler recurrence, m(v'-v)/h = -k(x + h v') - c v' - m g, x' = x + h v', for a
+// row of mass (kg, or kg·m² with an angular spring).
+inline void ImplicitEulerStep(double mass, ssSpring spring, double gravity, double h, double* x, double* v) {
+  const double k = spring.stiffness, c = spring.damping;
+  *v = (mass * *v - h * k * *x - h * mass * gravity) / (mass + h * c + h * h * k);
+  *x += h * *v;
+}
+
+// The recurrence over the given step lengths from rest at x0: the x after each step.
 inline std::vector<double> ImplicitEuler(const OscillatorRig& rig, const std::vector<double>& steps) {
   std::vector<double> xs;
-  double x = rig.x0, v = 0, m = rig.mass, k = rig.spring.stiffness, c = rig.spring.damping;
+  double x = rig.x0, v = 0;
   for (double h : steps) {
-    v = (m * v - h * k * x - h * m * rig.gravity) / (m + h * c + h * h * k);
-    x += h * v;
+    ImplicitEulerStep(rig.mass, rig.spring, rig.gravity, h, &x, &v);
     xs.push_back(x);
   }
   return xs;

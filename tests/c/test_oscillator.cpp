@@ -68,13 +68,11 @@ double WorstAgainstImplicitEuler(dWorldID world, ssRegistry* registry, ssSolver 
   if (ssStepper_Create(&def, &stepper) != SS_OK) return -1;
   std::mt19937_64 random(seed);
   std::uniform_real_distribution<double> frame(1.0 / 45.0, 1.0 / 15.0);
-  const double k = spring.stiffness, c = spring.damping;
   double x = x0, v = 0, worst = 0;
   for (int i = 0; i < 150 && worst >= 0; ++i) {
     double h = frame(random);
     if (ssStepper_Step(stepper, h, nullptr) != SS_OK) worst = -1;
-    v = (mass * v - h * k * x) / (mass + h * c + h * h * k);
-    x += h * v;
+    ImplicitEulerStep(mass, spring, 0, h, &x, &v);
     if (worst >= 0) worst = std::fmax(worst, std::fabs(measure() - x));
   }
   ssStepper_Destroy(stepper);
