@@ -3,6 +3,7 @@
 
 #include "error.h"
 #include "joint_rows.h"
+#include "registry_internal.h"
 #include "steadystep/registry.h"
 
 ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpring spring, ssMapping mapping,
@@ -17,9 +18,8 @@ ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpri
                     geom->pos[0], geom->pos[1], geom->pos[2]);
   }
   ssSoftness softness;
-  ssStatus status = ssSoftnessFor(mapping, spring, mass, step_s, previous_step_s, &softness);
-  if (status == SS_ERROR_NO_FINITE_MAPPING && mapping == SS_MAPPING_EXACT && spring.damping > 0)
-    status = ssMatchedSoftness(spring, mass, step_s, &softness);
+  int fell_back;
+  ssStatus status = ssSoftnessOrMatched(mapping, spring, mass, step_s, previous_step_s, &fell_back, &softness);
   if (status != SS_OK) return status;
   contact->surface.mode |= dContactSoftERP | dContactSoftCFM;
   contact->surface.soft_erp = softness.erp;

@@ -196,15 +196,23 @@ static int overNyquist(ssSpring spring, double mass, double step_s) {
   return spring.stiffness * step_s * step_s > M_PI * M_PI * mass;
 }
 
-/* The softness of one spring for this step; EXACT falls back to MATCHED where the pair of steps has no finite
- * mapping (counted in the report), which keeps the exact poles and loses only the history correction. */
-static ssStatus softnessFor(ssMapping mapping, ssSpring spring, double mass, double step_s, double previous_step_s,
-                            ssApplyReport* report, ssSoftness* out) {
+ssStatus ssSoftnessOrMatched(ssMapping mapping, ssSpring spring, double mass, double step_s,
+                             double previous_step_s, int* fell_back, ssSoftness* out) {
+  *fell_back = 0;
   ssStatus status = ssSoftnessFor(mapping, spring, mass, step_s, previous_step_s, out);
   if (status == SS_ERROR_NO_FINITE_MAPPING && mapping == SS_MAPPING_EXACT && spring.damping > 0) {
     status = ssMatchedSoftness(spring, mass, step_s, out);
-    if (status == SS_OK) report->rows_exact_fallback += 1;
+    *fell_back = status == SS_OK;
   }
+  return status;
+}
+
+/* The softness of one spring for this step, counting exact's fallbacks in the report. */
+static ssStatus softnessFor(ssMapping mapping, ssSpring spring, double mass, double step_s, double previous_step_s,
+                            ssApplyReport* report, ssSoftness* out) {
+  int fell_back;
+  ssStatus status = ssSoftnessOrMatched(mapping, spring, mass, step_s, previous_step_s, &fell_back, out);
+  report->rows_exact_fallback += fell_back;
   return status;
 }
 
