@@ -4,25 +4,37 @@
 #include "error.h"
 #include "joint_rows.h"
 #include "registry_internal.h"
+#include "row_law.h"
 #include "steadystep/registry.h"
 
-ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpring spring, ssMapping mapping,
-                         double step_s, double previous_step_s) {
-  if (contact == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "contact = NULL: a contact is required");
-  double mass = 1.0; /* unused by the spring mapping */
-  if (mapping != SS_MAPPING_SPRING) {
-    const dContactGeom* geom = &contact->geom;
-    mass = ssRowEffectiveMass(body1, body2, geom->normal, geom->pos, 0);
-    if (!(mass > 0) || !isfinite(mass))
-      return ssFail(SS_ERROR_OUT_OF_RANGE, "contact at (%g, %g, %g): no dynamic body, so no effective mass",
-                    geom->pos[0], geom->pos[1], geom->pos[2]);
-  }
+/* The effective mass along the contact normal; NAN when no dynamic body touches it. */
+static double contactMass(const dContact* contact, dBodyID body1, dBodyID body2) {
+  double mass = ssRowEffectiveMass(body1, body2, contact->geom.normal, contact->geom.pos, 0);
+  return mass > 0 && isfinite(mass) ? mass : NAN;
+}
+
+ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
+                            double step_s, double previous_step_s, int* spring_fallback) {
+  double mass = mapping == SS_MAPPING_SPRING || law->hard ? NAN : contactMass(contact, body1, body2);
   ssSoftness softness;
-  int fell_back;
-  ssStatus status = ssSoftnessOrMatched(mapping, spring, mass, step_s, previous_step_s, &fell_back, &softness);
+  ssRowFallback fallback;
+  ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, &fallback, &softness);
   if (status != SS_OK) return status;
   contact->surface.mode |= dContactSoftERP | dContactSoftCFM;
   contact->surface.soft_erp = softness.erp;
   contact->surface.soft_cfm = softness.cfm;
+  if (spring_fallback != NULL) *spring_fallback = fallback.to_spring;
   return SS_OK;
+}
+
+ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpring spring, ssMapping mapping,
+                         double step_s, double previous_step_s) {
+  if (contact == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "contact = NULL: a contact is required");
+  if (ssMappingName(mapping) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "mapping = %d: unknown", (int)mapping);
+  ssStatus status = ssValidateSpring(spring);
+  if (status == SS_OK) status = ssCheckPositive("step_s", "s", step_s);
+  if (status == SS_OK) status = ssCheckNonNegative("previous_step_s", "s", previous_step_s);
+  if (status != SS_OK) return status;
+  ssRowLaw law = ssRowLawOfSpring(spring);
+  return ssContactSoftenLaw(contact, body1, body2, &law, mapping, step_s, previous_step_s, NULL);
 }

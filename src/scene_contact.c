@@ -5,9 +5,7 @@
 
 typedef struct CollideCall {
   ssContactRecipe* recipe;
-  ssMapping mapping;
-  double step_s;
-  double previous_step_s;
+  ssStepInfo step;
 } CollideCall;
 
 static void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
@@ -24,11 +22,11 @@ static void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
     dContact* contact = &contacts[i];
     contact->surface.mode = recipe->surface_mode;
     contact->surface.mu = recipe->mu;
-    /* Only a validated spring and a dynamic body get here, so softening cannot fail; a contact that could not
-     * be softened is still better dropped than made rigid behind the policy's back. */
-    if (ssContactSoften(contact, body1, body2, recipe->spring, call->mapping, call->step_s, call->previous_step_s) !=
-        SS_OK)
-      continue;
+    /* Only a validated spring gets here, and an accurate mapping that cannot serve a contact hands it to the
+     * spring mapping: softening cannot fail, so no contact is dropped. */
+    const ssStepInfo* step = &call->step;
+    ssContactSoften(contact, body1, body2, recipe->spring, step->mapping, step->softness_step_s,
+                    step->previous_step_s);
     if (contact->geom.depth > recipe->deepest_m) recipe->deepest_m = contact->geom.depth;
     dJointID joint = dJointCreateContact(recipe->world, recipe->contacts, contact);
     dJointAttach(joint, body1, body2);
@@ -36,9 +34,9 @@ static void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
   }
 }
 
-void ssContactCollide(ssContactRecipe* recipe, ssMapping mapping, double step_s, double previous_step_s) {
+void ssContactCollide(ssContactRecipe* recipe, const ssStepper* stepper) {
   recipe->deepest_m = 0;
   recipe->contact_count = 0;
-  CollideCall call = {recipe, mapping, step_s, previous_step_s};
+  CollideCall call = {recipe, ssStepper_CurrentStep(stepper)};
   dSpaceCollide(recipe->space, &call, near_callback);
 }

@@ -1,0 +1,62 @@
+/* Row laws: a spring or a hard row, and the one rule for when an accurate mapping hands a row to the spring one. */
+#include "row_law.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "error.h"
+
+ssRowLaw ssRowLawOfSpring(ssSpring spring) { return (ssRowLaw){.spring = spring, .hard = 0, .hard_rate_per_s = 0}; }
+
+ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tuned_step_s, ssRowLaw* out) {
+  if (!isfinite(erp) || !isfinite(cfm))
+    return ssFail(SS_ERROR_NOT_FINITE, "%s: erp = %g, cfm = %g: must be finite", what, erp, cfm);
+  if (!(erp >= 0 && erp <= 1))
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s: erp = %g: must be in [0, 1] to stand for a spring", what, erp);
+  if (cfm < 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "%s: cfm = %g: must not be negative", what, cfm);
+  ssStatus status = ssCheckPositive("tuned_step_s", "s", tuned_step_s);
+  if (status != SS_OK) return status;
+  /* k = erp/(h0·cfm), c = (1 - erp)/cfm; a cfm so small that they overflow is a hard row in all but name */
+  double stiffness = erp / (tuned_step_s * cfm), damping = (1.0 - erp) / cfm;
+  if (cfm > 0 && isfinite(stiffness) && isfinite(damping) && (stiffness > 0 || damping > 0)) {
+    *out = ssRowLawOfSpring((ssSpring){stiffness, damping});
+    return SS_OK;
+  }
+  /* hard: the error is corrected at r = k/c = erp/(h0·(1 - erp)) per second, which stays finite as cfm -> 0 */
+  double rate = erp == 1 ? INFINITY : erp / (tuned_step_s * (1.0 - erp));
+  *out = (ssRowLaw){.spring = {0, 0}, .hard = 1, .hard_rate_per_s = rate};
+  return SS_OK;
+}
+
+int ssOverNyquist(ssSpring spring, double mass, double step_s) {
+  return spring.stiffness * step_s * step_s > M_PI * M_PI * mass;
+}
+
+ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
+                       ssRowFallback* fallback, ssSoftness* out) {
+  ssRowFallback local;
+  if (fallback == NULL) fallback = &local;
+  *fallback = (ssRowFallback){0, 0};
+  if (law->hard) {
+    double rate_h = law->hard_rate_per_s * step_s;
+    *out = (ssSoftness){.erp = isinf(rate_h) ? 1.0 : rate_h / (rate_h + 1.0), .cfm = 0};
+    return SS_OK;
+  }
+  if (mapping == SS_MAPPING_MATCHED || mapping == SS_MAPPING_EXACT) {
+    /* The accurate mappings need a mass, damping (c = 0 puts the poles on the unit circle) and a frequency the
+     * step can sample: a near-rigid row above Nyquist has poles that no (erp, cfm) of this step reproduces. */
+    int servable = mass > 0 && isfinite(mass) && law->spring.damping > 0 && !ssOverNyquist(law->spring, mass, step_s);
+    if (servable) {
+      ssStatus status = ssSoftnessFor(mapping, law->spring, mass, step_s, previous_step_s, out);
+      if (status == SS_ERROR_NO_FINITE_MAPPING && mapping == SS_MAPPING_EXACT) {
+        status = ssMatchedSoftness(law->spring, mass, step_s, out);
+        fallback->exact_to_matched = status == SS_OK;
+      }
+      if (status == SS_OK) return SS_OK;
+      if (status != SS_ERROR_NO_FINITE_MAPPING) return status;
+    }
+    fallback->exact_to_matched = 0;
+    fallback->to_spring = 1;
+  }
+  return ssSoftnessFromSpring(law->spring, step_s, out);
+}

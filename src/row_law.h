@@ -1,0 +1,39 @@
+/* Internal: what a soft row stands for, independently of the step: a spring, or a hard row whose error is corrected
+ * at a rate per second. The registry, adoption and contacts share it, so the fallback rule of the accurate
+ * mappings is written once. */
+#ifndef STEADYSTEP_ROW_LAW_H
+#define STEADYSTEP_ROW_LAW_H
+
+#include "steadystep/spring.h"
+
+typedef struct ssRowLaw {
+  ssSpring spring;        /* when !hard */
+  int hard;               /* tuned with cfm = 0: kept at cfm = 0 at every step */
+  double hard_rate_per_s; /* hard rows: erp(h) = h·r/(h·r + 1); INFINITY keeps erp = 1 */
+} ssRowLaw;
+
+/* How a row's softness for one step was obtained, beyond the mapping asked for. */
+typedef struct ssRowFallback {
+  int exact_to_matched; /* SS_MAPPING_EXACT had no finite softness for this pair of steps: matched was used */
+  int to_spring;        /* an accurate mapping could not serve the row: the spring mapping was used */
+} ssRowFallback;
+
+/* A spring's law (the spring is not checked here: bind time does). */
+ssRowLaw ssRowLawOfSpring(ssSpring spring);
+
+/* What erp and cfm tuned at a fixed step tuned_step_s stand for: a spring (cfm > 0, erp in [0, 1]; erp = 0 is a
+ * pure damper) or a hard row (cfm = 0). what names the row in messages ("world", "hinge joint 0x.. stop axis 1").
+ * Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (erp outside [0, 1], cfm < 0). */
+ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tuned_step_s, ssRowLaw* out);
+
+/* The softness of the row for a step of step_s under mapping. mass (kg or kg·m²) is read by the accurate mappings
+ * only; pass NAN when the row has none. Where MATCHED or EXACT cannot serve the row (no mass, c = 0, natural
+ * frequency above the step's Nyquist frequency, no finite softness) the spring mapping serves it and
+ * fallback->to_spring says so. fallback may be NULL. Errors: those of ssSoftnessFromSpring. */
+ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
+                       ssRowFallback* fallback, ssSoftness* out);
+
+/* w·h > π, i.e. k·h² > π²·m: the spring's natural frequency is above half the step rate. False for a NAN mass. */
+int ssOverNyquist(ssSpring spring, double mass, double step_s);
+
+#endif
