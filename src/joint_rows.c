@@ -105,6 +105,50 @@ static void setParam(dJointID joint, int axis, int param, double value) {
   }
 }
 
+static double getParam(dJointID joint, int axis, int param) {
+  switch (dJointGetType(joint)) {
+    case dJointTypeBall: return dJointGetBallParam(joint, param);
+    case dJointTypeFixed: return dJointGetFixedParam(joint, param);
+    case dJointTypeDBall: return dJointGetDBallParam(joint, param);
+    case dJointTypeDHinge: return dJointGetDHingeParam(joint, param);
+    case dJointTypeTransmission: return dJointGetTransmissionParam(joint, param);
+    case dJointTypeHinge: return dJointGetHingeParam(joint, param);
+    case dJointTypeSlider: return dJointGetSliderParam(joint, param);
+    case dJointTypeUniversal: return dJointGetUniversalParam(joint, groupParam(param, axis));
+    case dJointTypeHinge2: return dJointGetHinge2Param(joint, groupParam(param, axis));
+    case dJointTypePR: return dJointGetPRParam(joint, groupParam(param, axis));
+    case dJointTypePU: return dJointGetPUParam(joint, groupParam(param, axis));
+    case dJointTypePiston: return dJointGetPistonParam(joint, groupParam(param, axis));
+    case dJointTypeAMotor: return dJointGetAMotorParam(joint, groupParam(param, axis));
+    case dJointTypeLMotor: return dJointGetLMotorParam(joint, groupParam(param, axis));
+    default: return NAN; /* plane-2D has setters only */
+  }
+}
+
+void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* erp, double* cfm) {
+  switch (param) {
+    case SS_PARAM_JOINT:
+      *erp = getParam(joint, axis, dParamERP);
+      *cfm = getParam(joint, axis, dParamCFM);
+      return;
+    case SS_PARAM_STOP:
+      *erp = getParam(joint, axis, dParamStopERP);
+      *cfm = getParam(joint, axis, dParamStopCFM);
+      return;
+    case SS_PARAM_MOTOR: /* a motor row has no position error: its cfm alone is a damper toward the motor's speed */
+      *erp = 0;
+      *cfm = getParam(joint, axis, dParamCFM);
+      return;
+    case SS_PARAM_SUSPENSION:
+      *erp = getParam(joint, axis, dParamSuspensionERP);
+      *cfm = getParam(joint, axis, dParamSuspensionCFM);
+      return;
+  }
+  *erp = *cfm = NAN;
+}
+
+int ssJointLimitAxisCount(dJointID joint) { return limitAxisCount(joint); }
+
 void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm) {
   switch (param) {
     case SS_PARAM_JOINT:

@@ -15,6 +15,13 @@ const char* ssJointParamName(ssJointParam param);
 /* Writes the row's softness. The joint must support param on axis (ssJointSupports). MOTOR rows write only cfm. */
 void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm);
 
+/* Reads the row's softness as ODE holds it (MOTOR rows: erp 0 and the motor's cfm). NAN for plane-2D, which ODE 0.16
+ * cannot read back. */
+void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* erp, double* cfm);
+
+/* The number of limit/motor axes of the joint's type (0: none). */
+int ssJointLimitAxisCount(dJointID joint);
+
 /* The effective mass of a row along (linear) or about (angular) the unit direction `direction` through world point
  * `point` (linear rows only), from body1 and body2 (0 for the static world): 1 / sum over dynamic bodies of
  * 1/m + (r x d)·I⁻¹(r x d) (linear) or d·I⁻¹d (angular). Returns 0 when no dynamic body is attached. */

@@ -9,13 +9,14 @@
 #include "error.h"
 #include "joint_rows.h"
 #include "registry_internal.h"
+#include "row_law.h"
 #include "steadystep/registry.h"
 
 typedef struct JointBinding {
   dJointID joint;
   ssJointParam param;
   int axis;
-  ssSpring spring;
+  ssRowLaw law;
   double effective_mass; /* 0: computed from the bodies at each Apply */
   ssSoftness pending;    /* computed in Apply's first pass */
   ssSoftness written;    /* last written: the registry owns the row, so an unchanged value is not written again */
@@ -25,27 +26,24 @@ typedef struct JointBinding {
   int report_mass_age;
 } JointBinding;
 
-typedef struct BodyBinding {
-  dBodyID body; /* 0: the world's defaults */
-  int has_damping;
-  double linear_rate_per_s, angular_rate_per_s;
-  int has_auto_disable;
-  double idle_time_s, average_window_s;
-  int average_samples_written; /* ODE restarts its average whenever the count is set: write it only on change */
-} BodyBinding;
-
 struct ssRegistry {
   dWorldID world;
   int world_bound;
-  ssSpring world_spring;
+  ssRowLaw world_law;
   double world_mass;
   ssSoftness world_pending;
+  ssSoftness world_written; /* NAN until the registry first writes the world */
+  double tuned_step_s;      /* adoption's tuned step; 0 before any */
+  ssSoftness tuned_world;   /* the world's ERP/CFM as adopted (contacts without soft modes stand for these) */
   JointBinding* joints;
   int joint_count, joint_capacity;
-  BodyBinding* bodies;
+  ssBodyBinding* bodies;
   int body_count, body_capacity;
   unsigned generation; /* changes whenever the set of bound joints or bodies does */
 };
+
+#define REQUIRE_REGISTRY(registry) \
+  if ((registry) == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "registry = NULL: a registry is required")
 
 ssRegistry* ssRegistry_Create(dWorldID world) {
   if (world == 0) {
@@ -58,6 +56,7 @@ ssRegistry* ssRegistry_Create(dWorldID world) {
     return NULL;
   }
   registry->world = world;
+  registry->world_written = (ssSoftness){NAN, NAN};
   return registry;
 }
 
@@ -68,34 +67,40 @@ void ssRegistry_Destroy(ssRegistry* registry) {
   free(registry);
 }
 
+void ssRegistryBindWorldLaw(ssRegistry* registry, ssRowLaw law, double effective_mass) {
+  registry->world_bound = 1;
+  registry->world_law = law;
+  registry->world_mass = effective_mass > 0 ? effective_mass : 1.0;
+}
+
 ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effective_mass) {
+  REQUIRE_REGISTRY(registry);
   ssStatus status = ssValidateSpring(spring);
   if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
   if (status != SS_OK) return status;
-  registry->world_bound = 1;
-  registry->world_spring = spring;
-  registry->world_mass = effective_mass > 0 ? effective_mass : 1.0;
+  ssRegistryBindWorldLaw(registry, ssRowLawOfSpring(spring), effective_mass);
   return SS_OK;
 }
 
-ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssSpring spring,
-                              double effective_mass) {
-  if (joint == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "joint = NULL: a joint is required");
-  if (ssJointParamName(param) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "param = %d: unknown", (int)param);
-  if (!ssJointSupports(joint, param, axis))
-    return ssFail(SS_ERROR_UNSUPPORTED, "axis = %d: a %s joint has no %s parameters on it", axis,
-                  ssJointTypeName(joint), ssJointParamName(param));
-  ssStatus status = ssValidateSpring(spring);
-  if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
-  if (status != SS_OK) return status;
-
-  JointBinding binding = {joint, param, axis, spring, effective_mass, {0, 0}, {NAN, NAN}, 0, NAN, 0};
+static JointBinding* findJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis) {
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* existing = &registry->joints[i];
-    if (existing->joint == joint && existing->param == param && existing->axis == axis) {
-      *existing = binding;
-      return SS_OK;
-    }
+    if (existing->joint == joint && existing->param == param && existing->axis == axis) return existing;
+  }
+  return NULL;
+}
+
+int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam param, int axis) {
+  return findJoint(registry, joint, param, axis) != NULL;
+}
+
+ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
+                                double effective_mass) {
+  JointBinding binding = {joint, param, axis, law, effective_mass, {0, 0}, {NAN, NAN}, 0, NAN, 0};
+  JointBinding* existing = findJoint(registry, joint, param, axis);
+  if (existing != NULL) {
+    *existing = binding;
+    return SS_OK;
   }
   if (!ssReserveOne((void**)&registry->joints, registry->joint_count, &registry->joint_capacity, sizeof binding))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding a joint");
@@ -104,22 +109,36 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
   return SS_OK;
 }
 
+ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssSpring spring,
+                              double effective_mass) {
+  REQUIRE_REGISTRY(registry);
+  if (joint == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "joint = NULL: a joint is required");
+  if (ssJointParamName(param) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "param = %d: unknown", (int)param);
+  if (!ssJointSupports(joint, param, axis))
+    return ssFail(SS_ERROR_UNSUPPORTED, "axis = %d: a %s joint has no %s parameters on it", axis,
+                  ssJointTypeName(joint), ssJointParamName(param));
+  ssStatus status = ssValidateSpring(spring);
+  if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
+  if (status != SS_OK) return status;
+  return ssRegistryBindJointLaw(registry, joint, param, axis, ssRowLawOfSpring(spring), effective_mass);
+}
+
 ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, double load) {
+  REQUIRE_REGISTRY(registry);
   ssStatus status = ssCheckFinite("load", "N or N·m", load);
   if (status != SS_OK) return status;
-  for (int i = 0; i < registry->joint_count; ++i) {
-    JointBinding* binding = &registry->joints[i];
-    if (binding->joint != joint || binding->param != param || binding->axis != axis) continue;
-    if (!ssJointRowHasDirection(joint, param, axis))
-      return ssFail(SS_ERROR_UNSUPPORTED, "a %s joint's %s rows have no single direction to carry a load",
-                    ssJointTypeName(joint), ssJointParamName(param));
-    binding->load = load;
-    return SS_OK;
-  }
-  return ssFail(SS_ERROR_NOT_FOUND, "joint %p, param %d, axis %d: not bound", (void*)joint, (int)param, axis);
+  JointBinding* binding = findJoint(registry, joint, param, axis);
+  if (binding == NULL)
+    return ssFail(SS_ERROR_NOT_FOUND, "joint %p, param %d, axis %d: not bound", (void*)joint, (int)param, axis);
+  if (!ssJointRowHasDirection(joint, param, axis))
+    return ssFail(SS_ERROR_UNSUPPORTED, "a %s joint's %s rows have no single direction to carry a load",
+                  ssJointTypeName(joint), ssJointParamName(param));
+  binding->load = load;
+  return SS_OK;
 }
 
 ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
+  REQUIRE_REGISTRY(registry);
   int kept = 0;
   for (int i = 0; i < registry->joint_count; ++i)
     if (registry->joints[i].joint != joint) registry->joints[kept++] = registry->joints[i];
@@ -129,46 +148,65 @@ ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
   return SS_OK;
 }
 
-/* The binding of body (0: the world's defaults), created empty if absent; NULL when out of memory. */
-static BodyBinding* bodyBinding(ssRegistry* registry, dBodyID body) {
+ssBodyBinding* ssRegistryFindBody(ssRegistry* registry, dBodyID body) {
   for (int i = 0; i < registry->body_count; ++i)
     if (registry->bodies[i].body == body) return &registry->bodies[i];
-  if (!ssReserveOne((void**)&registry->bodies, registry->body_count, &registry->body_capacity, sizeof(BodyBinding)))
+  return NULL;
+}
+
+int ssRegistryHasBody(ssRegistry* registry, dBodyID body) { return ssRegistryFindBody(registry, body) != NULL; }
+
+/* The binding of body (0: the world's defaults), created empty if absent; NULL when out of memory. */
+static ssBodyBinding* bodyBinding(ssRegistry* registry, dBodyID body) {
+  ssBodyBinding* binding = ssRegistryFindBody(registry, body);
+  if (binding != NULL) return binding;
+  if (!ssReserveOne((void**)&registry->bodies, registry->body_count, &registry->body_capacity, sizeof(ssBodyBinding)))
     return NULL;
-  BodyBinding* binding = &registry->bodies[registry->body_count++];
+  binding = &registry->bodies[registry->body_count++];
   registry->generation += 1;
   memset(binding, 0, sizeof *binding);
   binding->body = body;
+  binding->written_step_s = NAN;
   return binding;
+}
+
+ssStatus ssRegistryKnowBody(ssRegistry* registry, dBodyID body) {
+  if (bodyBinding(registry, body) == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding a body");
+  return SS_OK;
 }
 
 ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linear_rate_per_s,
                                 double angular_rate_per_s) {
+  REQUIRE_REGISTRY(registry);
   ssStatus status = ssCheckNonNegative("linear_rate_per_s", "1/s", linear_rate_per_s);
   if (status == SS_OK) status = ssCheckNonNegative("angular_rate_per_s", "1/s", angular_rate_per_s);
   if (status != SS_OK) return status;
-  BodyBinding* binding = bodyBinding(registry, body);
+  ssBodyBinding* binding = bodyBinding(registry, body);
   if (binding == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding damping");
   binding->has_damping = 1;
   binding->linear_rate_per_s = linear_rate_per_s;
   binding->angular_rate_per_s = angular_rate_per_s;
+  binding->written_step_s = NAN;
   return SS_OK;
 }
 
 ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double idle_time_s, double average_window_s) {
+  REQUIRE_REGISTRY(registry);
   ssStatus status = ssCheckPositive("idle_time_s", "s", idle_time_s);
   if (status == SS_OK) status = ssCheckNonNegative("average_window_s", "s", average_window_s);
   if (status != SS_OK) return status;
-  BodyBinding* binding = bodyBinding(registry, body);
+  ssBodyBinding* binding = bodyBinding(registry, body);
   if (binding == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding auto-disable");
   binding->has_auto_disable = 1;
   binding->idle_time_s = idle_time_s;
   binding->average_window_s = average_window_s;
   binding->average_samples_written = 0;
+  binding->written_step_s = NAN;
   return SS_OK;
 }
 
 ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body) {
+  REQUIRE_REGISTRY(registry);
   for (int i = 0; i < registry->body_count; ++i) {
     if (registry->bodies[i].body != body) continue;
     registry->bodies[i] = registry->bodies[--registry->body_count];
@@ -191,49 +229,32 @@ static ssStatus failBinding(ssStatus status, const JointBinding* binding) {
 /* How many Applies of the spring mapping reuse a computed effective mass for the Nyquist report. */
 enum { kReportMassRefresh = 16 };
 
-/* w·h > π, i.e. k·h² > π²·m: the natural frequency is above half the step rate. */
-static int overNyquist(ssSpring spring, double mass, double step_s) {
-  return spring.stiffness * step_s * step_s > M_PI * M_PI * mass;
-}
-
-ssStatus ssSoftnessOrMatched(ssMapping mapping, ssSpring spring, double mass, double step_s,
-                             double previous_step_s, int* fell_back, ssSoftness* out) {
-  *fell_back = 0;
-  ssStatus status = ssSoftnessFor(mapping, spring, mass, step_s, previous_step_s, out);
-  if (status == SS_ERROR_NO_FINITE_MAPPING && mapping == SS_MAPPING_EXACT && spring.damping > 0) {
-    status = ssMatchedSoftness(spring, mass, step_s, out);
-    *fell_back = status == SS_OK;
-  }
+/* The softness of one row for this step, counting the fallbacks in the report. */
+static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass, double step_s,
+                            double previous_step_s, ssApplyReport* report, ssSoftness* out) {
+  ssRowFallback fallback;
+  ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, &fallback, out);
+  report->rows_exact_fallback += fallback.exact_to_matched;
+  report->rows_spring_fallback += fallback.to_spring;
+  if (!law->hard) report->rows_over_nyquist += ssOverNyquist(law->spring, mass, step_s);
   return status;
 }
 
-/* The softness of one spring for this step, counting exact's fallbacks in the report. */
-static ssStatus softnessFor(ssMapping mapping, ssSpring spring, double mass, double step_s, double previous_step_s,
-                            ssApplyReport* report, ssSoftness* out) {
-  int fell_back;
-  ssStatus status = ssSoftnessOrMatched(mapping, spring, mass, step_s, previous_step_s, &fell_back, out);
-  report->rows_exact_fallback += fell_back;
-  return status;
-}
-
-/* The binding's mass for this Apply: given, or computed (every time where the mapping depends on it). NAN when the
- * spring mapping cannot have one, which only skips the Nyquist report. */
-static ssStatus bindingMass(JointBinding* binding, ssMapping mapping, double* mass) {
-  if (binding->effective_mass > 0) {
-    *mass = binding->effective_mass;
-    return SS_OK;
-  }
+/* The binding's mass for this Apply: given, or computed (every time where the mapping depends on it; under the
+ * spring mapping every few Applies, for the Nyquist report). NAN when the row has none (no dynamic body, or a
+ * transmission): the accurate mappings then hand the row to the spring mapping. */
+static double bindingMass(JointBinding* binding, ssMapping mapping) {
+  if (binding->effective_mass > 0) return binding->effective_mass;
+  if (binding->law.hard) return NAN;
   if (mapping == SS_MAPPING_SPRING && binding->report_mass_age > 0) {
     binding->report_mass_age -= 1;
-    *mass = binding->report_mass;
-    return SS_OK;
+    return binding->report_mass;
   }
-  ssStatus status = ssJointEffectiveMass(binding->joint, binding->param, binding->axis, mass);
-  if (status != SS_OK && mapping != SS_MAPPING_SPRING) return status;
-  if (status != SS_OK) *mass = NAN;
-  binding->report_mass = *mass;
+  double mass;
+  if (ssJointEffectiveMass(binding->joint, binding->param, binding->axis, &mass) != SS_OK) mass = NAN;
+  binding->report_mass = mass;
   binding->report_mass_age = kReportMassRefresh;
-  return SS_OK;
+  return mass;
 }
 
 /* Whether two bindings drive rows along the same axis of the same joint (a stop and a motor). */
@@ -243,59 +264,99 @@ static int sharesRow(const JointBinding* a, const JointBinding* b) {
   return a->joint == b->joint && a->axis == b->axis && a_limit && b_limit;
 }
 
+static int sameLaw(const ssRowLaw* a, const ssRowLaw* b) {
+  return a->hard == b->hard && a->spring.stiffness == b->spring.stiffness && a->spring.damping == b->spring.damping &&
+         a->hard_rate_per_s == b->hard_rate_per_s;
+}
+
+/* ODE counts steps: a count of seconds in steps of h, where a whole number of steps computed with rounding error
+ * (10·(1/60)/(1/60) = 10.000000000000002) must not become one more. */
+static double stepsIn(double seconds, double step_s) { return ceil(seconds / step_s - 1e-9); }
+
+static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
+  dBodyID body = binding->body;
+  if (binding->has_damping) {
+    /* ODE scales velocity by (1 - scale) once per step: this scale removes the same fraction per second */
+    double linear = -expm1(-binding->linear_rate_per_s * step_s);
+    double angular = -expm1(-binding->angular_rate_per_s * step_s);
+    if (body) {
+      dBodySetLinearDamping(body, linear);
+      dBodySetAngularDamping(body, angular);
+    } else {
+      dWorldSetLinearDamping(world, linear);
+      dWorldSetAngularDamping(world, angular);
+    }
+  }
+  if (binding->has_auto_disable) {
+    double steps = stepsIn(binding->idle_time_s, step_s);
+    int idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
+    double samples = fmax(1.0, stepsIn(binding->average_window_s, step_s));
+    int average_samples = samples < 1e6 ? (int)samples : 1000000;
+    if (body) {
+      dBodySetAutoDisableSteps(body, idle_steps);
+      dBodySetAutoDisableTime(body, binding->idle_time_s);
+      if (average_samples != binding->average_samples_written)
+        dBodySetAutoDisableAverageSamplesCount(body, (unsigned)average_samples);
+    } else {
+      dWorldSetAutoDisableSteps(world, idle_steps);
+      dWorldSetAutoDisableTime(world, binding->idle_time_s);
+      if (average_samples != binding->average_samples_written)
+        dWorldSetAutoDisableAverageSamplesCount(world, (unsigned)average_samples);
+    }
+    binding->average_samples_written = average_samples;
+  }
+  binding->written_step_s = step_s;
+}
+
 ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
                           ssApplyReport* report) {
+  REQUIRE_REGISTRY(registry);
   ssStatus status = ssCheckPositive("step_s", "s", step_s);
   if (status == SS_OK) status = ssCheckNonNegative("previous_step_s", "s", previous_step_s);
   if (status != SS_OK) return status;
   if (ssMappingName(mapping) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "mapping = %d: unknown", (int)mapping);
 
-  ssApplyReport counts = {0, 0, 0};
+  ssApplyReport counts = {0, 0, 0, 0};
   if (registry->world_bound) {
-    status = softnessFor(mapping, registry->world_spring, registry->world_mass, step_s, previous_step_s, &counts,
+    status = softnessFor(&registry->world_law, mapping, registry->world_mass, step_s, previous_step_s, &counts,
                          &registry->world_pending);
     if (status != SS_OK) return failBinding(status, NULL);
-    counts.rows_over_nyquist += overNyquist(registry->world_spring, registry->world_mass, step_s);
   }
   /* Programs bind many rows to a few springs: under the spring mapping each one's softness is computed once. */
   enum { kCacheSize = 4 };
-  ssSpring cached_spring[kCacheSize];
+  ssRowLaw cached_law[kCacheSize];
   ssSoftness cached_softness[kCacheSize];
   int cached = 0;
   double last_mass = NAN;
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
-    double mass;
     const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
-    if (before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass) {
-      mass = last_mass; /* a stop and a motor on one axis move the same mass: computed once */
-    } else {
-      status = bindingMass(binding, mapping, &mass);
-      if (status != SS_OK) return failBinding(status, binding);
-    }
+    /* a stop and a motor on one axis move the same mass: computed once */
+    int same_row = before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
+    double mass = same_row ? last_mass : bindingMass(binding, mapping);
     last_mass = mass;
     int hit = -1;
     for (int j = 0; j < cached && hit < 0; ++j)
-      if (cached_spring[j].stiffness == binding->spring.stiffness && cached_spring[j].damping == binding->spring.damping)
-        hit = j;
+      if (sameLaw(&cached_law[j], &binding->law)) hit = j;
     if (hit >= 0) {
       binding->pending = cached_softness[hit];
-    } else {
-      status = softnessFor(mapping, binding->spring, mass, step_s, previous_step_s, &counts, &binding->pending);
-      if (status != SS_OK) return failBinding(status, binding);
-      if (mapping == SS_MAPPING_SPRING) {
-        int slot = cached < kCacheSize ? cached++ : i % kCacheSize;
-        cached_spring[slot] = binding->spring;
-        cached_softness[slot] = binding->pending;
-      }
+      if (!binding->law.hard) counts.rows_over_nyquist += ssOverNyquist(binding->law.spring, mass, step_s);
+      continue;
     }
-    counts.rows_over_nyquist += overNyquist(binding->spring, mass, step_s); /* false for a NAN mass */
+    status = softnessFor(&binding->law, mapping, mass, step_s, previous_step_s, &counts, &binding->pending);
+    if (status != SS_OK) return failBinding(status, binding);
+    if (mapping == SS_MAPPING_SPRING || binding->law.hard) {
+      int slot = cached < kCacheSize ? cached++ : i % kCacheSize;
+      cached_law[slot] = binding->law;
+      cached_softness[slot] = binding->pending;
+    }
   }
 
   /* Second pass: nothing below can fail. */
   if (registry->world_bound) {
     dWorldSetERP(registry->world, registry->world_pending.erp);
     dWorldSetCFM(registry->world, registry->world_pending.cfm);
+    registry->world_written = registry->world_pending;
     counts.rows_written += 1;
   }
   for (int i = 0; i < registry->joint_count; ++i) {
@@ -307,53 +368,69 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   if (mapping != SS_MAPPING_SPRING) {
     for (int i = 0; i < registry->joint_count; ++i) {
       const JointBinding* binding = &registry->joints[i];
-      if (binding->load == 0 || binding->spring.stiffness == 0) continue;
+      const ssSpring* spring = &binding->law.spring;
+      if (binding->load == 0 || binding->law.hard || spring->stiffness == 0) continue;
       /* the step's static stiffness is k' = erp/(h·cfm): this force puts the rest position back at load/k */
       double static_stiffness = binding->pending.erp / (step_s * binding->pending.cfm);
       ssJointAddRowForce(binding->joint, binding->param, binding->axis,
-                         binding->load * (static_stiffness / binding->spring.stiffness - 1));
+                         binding->load * (static_stiffness / spring->stiffness - 1));
     }
   }
   counts.rows_written += registry->joint_count;
   for (int i = 0; i < registry->body_count; ++i) {
-    BodyBinding* binding = &registry->bodies[i];
-    dBodyID body = binding->body;
-    if (binding->has_damping) {
-      /* ODE scales velocity by (1 - scale) once per step: this scale removes the same fraction per second */
-      double linear = -expm1(-binding->linear_rate_per_s * step_s);
-      double angular = -expm1(-binding->angular_rate_per_s * step_s);
-      if (body) {
-        dBodySetLinearDamping(body, linear);
-        dBodySetAngularDamping(body, angular);
-      } else {
-        dWorldSetLinearDamping(registry->world, linear);
-        dWorldSetAngularDamping(registry->world, angular);
-      }
-    }
-    if (binding->has_auto_disable) {
-      double steps = ceil(binding->idle_time_s / step_s);
-      int idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
-      double samples = fmax(1.0, ceil(binding->average_window_s / step_s));
-      int average_samples = samples < 1e6 ? (int)samples : 1000000;
-      if (body) {
-        dBodySetAutoDisableSteps(body, idle_steps);
-        dBodySetAutoDisableTime(body, binding->idle_time_s);
-        if (average_samples != binding->average_samples_written)
-          dBodySetAutoDisableAverageSamplesCount(body, (unsigned)average_samples);
-      } else {
-        dWorldSetAutoDisableSteps(registry->world, idle_steps);
-        dWorldSetAutoDisableTime(registry->world, binding->idle_time_s);
-        if (average_samples != binding->average_samples_written)
-          dWorldSetAutoDisableAverageSamplesCount(registry->world, (unsigned)average_samples);
-      }
-      binding->average_samples_written = average_samples;
-    }
+    ssBodyBinding* binding = &registry->bodies[i];
+    if (binding->written_step_s != step_s) writeBody(binding, registry->world, step_s);
   }
   if (report != NULL) *report = counts;
   return SS_OK;
 }
 
-int ssRegistry_JointBindingCount(const ssRegistry* registry) { return registry->joint_count; }
+dWorldID ssRegistryWorld(const ssRegistry* registry) { return registry->world; }
+
+static int reserve(void** items, int count, int more, int* capacity, size_t size) {
+  if (count + more <= *capacity) return 1;
+  int wanted = count + more;
+  void* larger = realloc(*items, (size_t)wanted * size);
+  if (larger == NULL) return 0;
+  *items = larger;
+  *capacity = wanted;
+  return 1;
+}
+
+ssStatus ssRegistryReserve(ssRegistry* registry, int more_joints, int more_bodies) {
+  if (!reserve((void**)&registry->joints, registry->joint_count, more_joints, &registry->joint_capacity,
+               sizeof(JointBinding)) ||
+      !reserve((void**)&registry->bodies, registry->body_count, more_bodies, &registry->body_capacity,
+               sizeof(ssBodyBinding)))
+    return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory reserving %d joint rows and %d bodies", more_joints,
+                  more_bodies);
+  return SS_OK;
+}
+
+double ssRegistry_TunedStep(const ssRegistry* registry) { return registry != NULL ? registry->tuned_step_s : 0; }
+
+void ssRegistrySetTuned(ssRegistry* registry, double tuned_step_s, ssSoftness tuned_world) {
+  registry->tuned_step_s = tuned_step_s;
+  registry->tuned_world = tuned_world;
+}
+
+void ssRegistryForgetWorldAdoption(ssRegistry* registry) {
+  registry->world_bound = 0;
+  registry->tuned_step_s = 0;
+  if (ssRegistryHasBody(registry, 0)) ssRegistry_UnbindBody(registry, 0);
+}
+
+ssSoftness ssRegistryTunedWorld(const ssRegistry* registry) { return registry->tuned_world; }
+
+int ssRegistryWorldBound(const ssRegistry* registry, ssRowLaw* law) {
+  if (registry->world_bound && law != NULL) *law = registry->world_law;
+  return registry->world_bound;
+}
+
+ssSoftness ssRegistryWorldWritten(const ssRegistry* registry) { return registry->world_written; }
+
+
+int ssRegistry_JointBindingCount(const ssRegistry* registry) { return registry != NULL ? registry->joint_count : 0; }
 
 int ssRegistryBodyBindingCount(const ssRegistry* registry) { return registry->body_count; }
 
@@ -387,6 +464,7 @@ static int compareBodies(const void* a, const void* b) {
 }
 
 void ssRegistry_VisitBodies(const ssRegistry* registry, void (*visit)(void* context, dBodyID body), void* context) {
+  if (registry == NULL || visit == NULL) return;
   size_t most = 2 * (size_t)registry->joint_count + (size_t)registry->body_count;
   BodyList list = {malloc((most ? most : 1) * sizeof(dBodyID)), 0};
   if (list.bodies == NULL) { /* rather a body twice than none */

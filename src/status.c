@@ -20,6 +20,7 @@ const char* ssStatusName(ssStatus status) {
     case SS_ERROR_BLOWUP: return "blow-up";
     case SS_ERROR_SPEED_LIMIT: return "speed limit";
     case SS_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case SS_ERROR_FAILED: return "failed earlier";
   }
   return "unknown status";
 }

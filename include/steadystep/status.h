@@ -24,6 +24,7 @@ typedef enum ssStatus {
   SS_ERROR_BLOWUP = 9,            /* a body's state became NaN or infinite */
   SS_ERROR_SPEED_LIMIT = 10,      /* a body moved faster than the configured limit */
   SS_ERROR_OUT_OF_MEMORY = 11,
+  SS_ERROR_FAILED = 12,           /* an earlier frame failed: the stepper refuses frames until ssStepper_Reset */
 } ssStatus;
 
 /** The enum's name without prefix, e.g. "out of range". Never NULL. */

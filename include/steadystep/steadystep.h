@@ -5,6 +5,7 @@
 #include "steadystep/status.h"
 #include "steadystep/spring.h"
 #include "steadystep/registry.h"
+#include "steadystep/adopt.h"
 #include "steadystep/stepper.h"
 #include "steadystep/profile.h"
 #include "steadystep/scene.h"
