@@ -79,9 +79,9 @@ ssStepping ssDefaultStepping(void) {
   return (ssStepping){
       .policy = (int)def.policy,
       .solver = (int)def.solver,
-      .quick_iterations = def.quick_iterations,
+      .quick_iterations = 20, /* ODE's own default, written so that a scene never depends on it */
       .max_step_s = def.max_step_s,
-      .reference_step_s = def.reference_step_s,
+      .reference_step_s = 1.0 / 30.0, /* the scenes' springs are stated for all steps; naive freezes them here */
       .fixed_step_s = def.fixed_step_s,
       .max_steps_per_frame = def.max_steps_per_frame,
   };

@@ -48,9 +48,9 @@ ssStatus ssBoxes_Watch(void* state, ssStepper* stepper) {
   return SS_OK;
 }
 
-void ssBoxes_Collide(void* context, ssMapping mapping, double step_s, double previous_step_s) {
+void ssBoxes_Collide(void* context, ssStepper* stepper) {
   ssBoxes* boxes = context;
-  ssContactCollide(&boxes->recipe, mapping, step_s, previous_step_s);
+  ssContactCollide(&boxes->recipe, stepper);
 }
 
 void ssBoxes_Destroy(void* state) {

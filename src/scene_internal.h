@@ -33,8 +33,8 @@ typedef struct ssSceneDesc {
   ssStatus (*build)(const ssSceneWorld* world, const ssSceneParams* params, void** state);
   /* Registers with the stepper the bodies the registry does not watch already (free bodies). May be NULL. */
   ssStatus (*watch)(void* state, ssStepper* stepper);
-  /* The stepper's collide callback: create contacts for a step of step_s under mapping. May be NULL. */
-  ssCollideFn* collide;
+  /* The stepper's collide callback: create contacts for the stepper's current step. May be NULL. */
+  ssStepCallback* collide;
   /* The followed quantities after a step, info.quantity_count of them. */
   void (*sample)(const void* state, double* out);
   /* Frees the state (ODE objects go with the world). */
@@ -68,8 +68,8 @@ typedef struct ssContactRecipe {
 
 #define SS_MAX_PAIR_CONTACTS 8
 
-/* Runs dSpaceCollide on recipe->space and softens every contact for (mapping, step_s, previous_step_s). */
-void ssContactCollide(ssContactRecipe* recipe, ssMapping mapping, double step_s, double previous_step_s);
+/* Runs dSpaceCollide on recipe->space and softens every contact for the stepper's current step. */
+void ssContactCollide(ssContactRecipe* recipe, const ssStepper* stepper);
 
 /* Boxes of one size on a ground plane whose contacts are soft with the scene's spring (drop, pile). */
 typedef struct ssBoxes {
@@ -86,7 +86,7 @@ void ssBoxes_Add(ssBoxes* boxes, const ssSceneWorld* world, double mass_kg, doub
                  double z);
 /* The ssSceneDesc callbacks of a scene whose state is an ssBoxes. */
 ssStatus ssBoxes_Watch(void* state, ssStepper* stepper);
-void ssBoxes_Collide(void* context, ssMapping mapping, double step_s, double previous_step_s);
+void ssBoxes_Collide(void* context, ssStepper* stepper);
 void ssBoxes_Destroy(void* state);
 
 /* Calls dInitODE2 once per process and allocates ODE's per-thread data once per thread; never dCloseODE. */

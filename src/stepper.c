@@ -1,31 +1,50 @@
-/* The stepper: a frame's time becomes physics steps, each with its softness rewritten for its length. */
+/* The stepper: a frame's time becomes physics steps, each with its softness rewritten for its length, the frame's
+ * forces put back before each one, and the known bodies checked after it. A failure is latched: a broken world is
+ * never stepped again until the program says it has repaired it. */
 #include <math.h>
-#include <stdlib.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "array.h"
 #include "error.h"
 #include "registry_internal.h"
+#include "steadystep/adopt.h"
 #include "steadystep/stepper.h"
 
 /* Frame times are sums of floating-point parts: a frame of exactly 2·max_step_s must not become 3 substeps. */
 static const double kStepCountSlack = 1e-9;
+/* Naive's softness step when neither the program nor an adoption gave one (the lab's oscillator was tuned there). */
+static const double kDefaultReferenceStepS = 1.0 / 30.0;
+
+/* A body whose forces the stepper keeps over a frame and whose state it checks. */
+typedef struct KnownBody {
+  dBodyID body;
+  double frame_force[6]; /* force (N) and torque (N·m) the program added for this frame */
+  double carried[6];     /* momentum (N·s, N·m·s) of frames that took no step, delivered with the next steps */
+} KnownBody;
 
 struct ssStepper {
   ssStepperDef def;
   double previous_step_s; /* 0: no usable history */
   double accumulator_s;   /* FIXED: time not yet stepped */
+  double short_frame_s;   /* other policies: frames too short to step, carried */
   dBodyID* watched;
   int watched_count, watched_capacity;
-  /* the registry's bodies, each once, rebuilt when its generation changes */
-  dBodyID* bound;
-  int bound_count, bound_capacity;
-  unsigned bound_generation;
-  int bound_valid;
-  /* the check of one step, filled by checkBody */
-  dBodyID failed_body;
+  unsigned watched_generation;
+  /* the registry's bodies and the watched ones, each once, sorted; rebuilt when either set changes */
+  KnownBody* known;
+  int known_count;
+  unsigned known_registry_generation, known_watched_generation;
+  int known_valid;
+  int* pushed; /* indices into known of the bodies with a force or carried momentum this frame */
+  int pushed_count;
+  ssStepInfo current;
+  ssFrameReport* report; /* the frame being stepped, for ssStepper_SoftenContact's counts */
+  /* the first failure, latched until ssStepper_Reset */
   ssStatus failed_status;
+  char failed_message[256];
 };
 
 ssStepperDef ssDefaultStepperDef(void) {
@@ -33,11 +52,11 @@ ssStepperDef ssDefaultStepperDef(void) {
   memset(&def, 0, sizeof def);
   def.policy = SS_POLICY_SPRING;
   def.solver = SS_SOLVER_QUICK;
-  def.quick_iterations = 20;
   def.max_step_s = 1.0 / 60.0;
-  def.reference_step_s = 1.0 / 30.0;
   def.fixed_step_s = 1.0 / 60.0;
   def.max_steps_per_frame = 8;
+  def.max_speed = 1e4;
+  def.max_angular_speed = 1e4;
   return def;
 }
 
@@ -53,38 +72,75 @@ const char* ssPolicyName(ssPolicy policy) {
 }
 
 ssStatus ssPolicyParse(const char* name, ssPolicy* out) {
+  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the policy");
   for (int policy = SS_POLICY_NAIVE; policy <= SS_POLICY_FIXED; ++policy) {
     if (name != NULL && strcmp(name, ssPolicyName((ssPolicy)policy)) == 0) {
       *out = (ssPolicy)policy;
       return SS_OK;
     }
   }
-  return ssFail(SS_ERROR_PARSE, "policy \"%s\": unknown (naive, spring, matched, exact, fixed)",
+  return ssFail(SS_ERROR_PARSE, "policy \"%.64s\": unknown (naive, spring, matched, exact, fixed)",
                 name ? name : "(null)");
 }
 
+static ssStatus checkStepLength(const char* name, double value, int allow_zero) {
+  ssStatus status = ssCheckFinite(name, "s", value);
+  if (status != SS_OK || (allow_zero && value == 0)) return status;
+  if (!(value >= SS_MIN_STEP_S && value <= SS_MAX_FRAME_S))
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = %g s: must be in [%g, %g] s%s", name, value, SS_MIN_STEP_S,
+                  SS_MAX_FRAME_S, allow_zero ? " or 0" : "");
+  return SS_OK;
+}
+
 static ssStatus validateDef(const ssStepperDef* def) {
-  if (def == NULL || def->world == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "world = NULL: a world is required");
+  if (def == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "def = NULL: a definition is required");
+  if (def->world == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "world = NULL: a world is required");
   if (ssPolicyName(def->policy) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "policy = %d: unknown", (int)def->policy);
   if (def->solver != SS_SOLVER_QUICK && def->solver != SS_SOLVER_STEP)
     return ssFail(SS_ERROR_UNSUPPORTED, "solver = %d: unknown", (int)def->solver);
-  if (def->quick_iterations <= 0)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "quick_iterations = %d: must be positive", def->quick_iterations);
+  if (def->quick_iterations < 0)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "quick_iterations = %d: must not be negative (0 = the world's own)",
+                  def->quick_iterations);
   if (def->max_steps_per_frame <= 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "max_steps_per_frame = %d: must be positive", def->max_steps_per_frame);
-  ssStatus status = ssCheckPositive("max_step_s", "s", def->max_step_s);
-  if (status == SS_OK) status = ssCheckPositive("reference_step_s", "s", def->reference_step_s);
-  if (status == SS_OK) status = ssCheckPositive("fixed_step_s", "s", def->fixed_step_s);
+  ssStatus status = checkStepLength("max_step_s", def->max_step_s, 0);
+  if (status == SS_OK) status = checkStepLength("reference_step_s", def->reference_step_s, 1);
+  if (status == SS_OK) status = checkStepLength("fixed_step_s", def->fixed_step_s, 0);
   if (status == SS_OK) status = ssCheckNonNegative("max_speed", "m/s", def->max_speed);
+  if (status == SS_OK) status = ssCheckNonNegative("max_angular_speed", "rad/s", def->max_angular_speed);
   return status;
+}
+
+static ssMapping policyMapping(ssPolicy policy) {
+  switch (policy) {
+    case SS_POLICY_MATCHED: return SS_MAPPING_MATCHED;
+    case SS_POLICY_EXACT: return SS_MAPPING_EXACT;
+    default: return SS_MAPPING_SPRING;
+  }
+}
+
+/* NAIVE's softness step: the program's, else the adoption's tuned step, else the lab's default. */
+static double referenceStep(const ssStepper* stepper) {
+  if (stepper->def.reference_step_s > 0) return stepper->def.reference_step_s;
+  double tuned_s = ssRegistry_TunedStep(stepper->def.registry);
+  return tuned_s > 0 ? tuned_s : kDefaultReferenceStepS;
+}
+
+static void describeNextStep(ssStepper* stepper) {
+  ssPolicy policy = stepper->def.policy;
+  double step_s = policy == SS_POLICY_FIXED ? stepper->def.fixed_step_s : stepper->def.max_step_s;
+  double softness_step_s = policy == SS_POLICY_NAIVE ? referenceStep(stepper) : step_s;
+  stepper->current = (ssStepInfo){policyMapping(policy), step_s, softness_step_s, stepper->previous_step_s, 0, 1};
 }
 
 ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   ssStatus status = validateDef(def);
   if (status != SS_OK) return status;
+  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the stepper");
   ssStepper* stepper = calloc(1, sizeof *stepper);
   if (stepper == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating a stepper");
   stepper->def = *def;
+  describeNextStep(stepper);
   *out = stepper;
   return SS_OK;
 }
@@ -92,109 +148,226 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
 void ssStepper_Destroy(ssStepper* stepper) {
   if (stepper == NULL) return;
   free(stepper->watched);
-  free(stepper->bound);
+  free(stepper->known);
+  free(stepper->pushed);
   free(stepper);
 }
 
+#define REQUIRE_STEPPER(stepper) \
+  if ((stepper) == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "stepper = NULL: a stepper is required")
+
 ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body) {
+  REQUIRE_STEPPER(stepper);
   if (body == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "body = NULL: a body is required");
   for (int i = 0; i < stepper->watched_count; ++i)
     if (stepper->watched[i] == body) return SS_OK;
   if (!ssReserveOne((void**)&stepper->watched, stepper->watched_count, &stepper->watched_capacity, sizeof body))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory watching a body");
   stepper->watched[stepper->watched_count++] = body;
+  stepper->watched_generation += 1;
   return SS_OK;
 }
 
 ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body) {
+  REQUIRE_STEPPER(stepper);
+  if (body == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "body = NULL: a body is required");
   for (int i = 0; i < stepper->watched_count; ++i) {
     if (stepper->watched[i] != body) continue;
     stepper->watched[i] = stepper->watched[--stepper->watched_count];
+    stepper->watched_generation += 1;
     return SS_OK;
   }
   return ssFail(SS_ERROR_NOT_FOUND, "body %p: not watched", (void*)body);
 }
 
-void ssStepper_ResetHistory(ssStepper* stepper) { stepper->previous_step_s = 0; }
+static void forgetCarried(ssStepper* stepper) {
+  for (int i = 0; i < stepper->known_count; ++i) memset(stepper->known[i].carried, 0, sizeof stepper->known[i].carried);
+}
+
+void ssStepper_ResetHistory(ssStepper* stepper) {
+  if (stepper != NULL) stepper->previous_step_s = 0;
+}
+
+void ssStepper_Reset(ssStepper* stepper) {
+  if (stepper == NULL) return;
+  stepper->failed_status = SS_OK;
+  stepper->failed_message[0] = '\0';
+  stepper->previous_step_s = 0;
+  stepper->accumulator_s = 0;
+  stepper->short_frame_s = 0;
+  forgetCarried(stepper);
+  describeNextStep(stepper);
+}
 
 ssStatus ssStepper_SetPolicy(ssStepper* stepper, ssPolicy policy) {
+  REQUIRE_STEPPER(stepper);
   if (ssPolicyName(policy) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "policy = %d: unknown", (int)policy);
   stepper->def.policy = policy;
   stepper->previous_step_s = 0;
   stepper->accumulator_s = 0;
+  describeNextStep(stepper);
   return SS_OK;
 }
 
-/* Checks one body after a step; the first failure of the step is kept. Rotation is not read: a non-finite angular
- * velocity makes ODE 0.16 abort inside the step (dxNormalize4), so a rotation that comes back is finite. */
-static void checkBody(ssStepper* stepper, dBodyID body) {
+ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper) { return stepper->current; }
+
+ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
+  REQUIRE_STEPPER(stepper);
+  if (contact == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "contact = NULL: a contact is required");
+  double tuned_step_s = ssRegistry_TunedStep(stepper->def.registry);
+  if (tuned_step_s == 0)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "tuned step = 0 s: adopt the world first (ssRegistry_Adopt), or soften "
+                                         "with a spring of your own (ssContactSoften)");
+  ssSoftness world = ssRegistryTunedWorld(stepper->def.registry);
+  const dSurfaceParameters* surface = &contact->surface;
+  double erp = (surface->mode & dContactSoftERP) ? surface->soft_erp : world.erp;
+  double cfm = (surface->mode & dContactSoftCFM) ? surface->soft_cfm : world.cfm;
+  ssRowLaw law;
+  ssStatus status = ssRowLawFromTuned("contact", erp, cfm, tuned_step_s, &law);
+  if (status != SS_OK) return status;
+  const ssStepInfo* step = &stepper->current;
+  int fell_back = 0;
+  status = ssContactSoftenLaw(contact, body1, body2, &law, step->mapping, step->softness_step_s,
+                              step->previous_step_s, &fell_back);
+  if (status != SS_OK) return status;
+  if (stepper->report != NULL) {
+    stepper->report->contacts_softened += 1;
+    stepper->report->contacts_spring_fallback += fell_back;
+  }
+  return SS_OK;
+}
+
+static int compareKnown(const void* a, const void* b) {
+  uintptr_t x = (uintptr_t)((const KnownBody*)a)->body, y = (uintptr_t)((const KnownBody*)b)->body;
+  return (x > y) - (x < y);
+}
+
+typedef struct KnownList {
+  KnownBody* bodies;
+  int count, capacity;
+} KnownList;
+
+static void appendKnown(void* context, dBodyID body) {
+  KnownList* list = context;
+  if (list->count < list->capacity) list->bodies[list->count++] = (KnownBody){.body = body};
+}
+
+/* The known bodies, each once, sorted; rebuilt only when the registry's bindings or the watch list changed. Momentum
+ * carried for a body that stays known is kept. */
+static ssStatus refreshKnown(ssStepper* stepper) {
+  const ssRegistry* registry = stepper->def.registry;
+  unsigned generation = registry != NULL ? ssRegistryGeneration(registry) : 0;
+  if (stepper->known_valid && stepper->known_registry_generation == generation &&
+      stepper->known_watched_generation == stepper->watched_generation)
+    return SS_OK;
+  int most = stepper->watched_count;
+  if (registry != NULL) most += 2 * ssRegistry_JointBindingCount(registry) + ssRegistryBodyBindingCount(registry);
+  KnownList list = {calloc((size_t)(most > 0 ? most : 1), sizeof(KnownBody)), 0, most};
+  int* pushed = calloc((size_t)(most > 0 ? most : 1), sizeof(int));
+  if (list.bodies == NULL || pushed == NULL) {
+    free(list.bodies);
+    free(pushed);
+    return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
+  }
+  if (registry != NULL) ssRegistry_VisitBodies(registry, appendKnown, &list);
+  for (int i = 0; i < stepper->watched_count; ++i) appendKnown(&list, stepper->watched[i]);
+  qsort(list.bodies, (size_t)list.count, sizeof(KnownBody), compareKnown);
+  int unique = 0;
+  for (int i = 0; i < list.count; ++i) {
+    if (unique > 0 && list.bodies[unique - 1].body == list.bodies[i].body) continue;
+    KnownBody* kept = &list.bodies[unique++];
+    *kept = list.bodies[i];
+    const KnownBody* old = stepper->known_valid ? bsearch(kept, stepper->known, (size_t)stepper->known_count,
+                                                          sizeof(KnownBody), compareKnown)
+                                                : NULL;
+    if (old != NULL) memcpy(kept->carried, old->carried, sizeof kept->carried);
+  }
+  free(stepper->known);
+  free(stepper->pushed);
+  stepper->known = list.bodies;
+  stepper->known_count = unique;
+  stepper->pushed = pushed;
+  stepper->known_registry_generation = generation;
+  stepper->known_watched_generation = stepper->watched_generation;
+  stepper->known_valid = 1;
+  return SS_OK;
+}
+
+static int anyNonZero(const double* values) {
+  return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
+}
+
+/* Reads the forces the program added for this frame, and lists the bodies that have one or carried momentum. */
+static void captureForces(ssStepper* stepper) {
+  stepper->pushed_count = 0;
+  for (int i = 0; i < stepper->known_count; ++i) {
+    KnownBody* known = &stepper->known[i];
+    const dReal* force = dBodyGetForce(known->body);
+    const dReal* torque = dBodyGetTorque(known->body);
+    double* f = known->frame_force;
+    f[0] = force[0], f[1] = force[1], f[2] = force[2], f[3] = torque[0], f[4] = torque[1], f[5] = torque[2];
+    if (anyNonZero(f) || anyNonZero(known->carried)) stepper->pushed[stepper->pushed_count++] = i;
+  }
+}
+
+/* Before each of a frame's `steps` steps of step_s: each pushed body gets the force that delivers its frame's
+ * momentum F·frame_s (plus what was carried) evenly over the frame's simulated time. */
+static void putForces(ssStepper* stepper, double frame_s, int steps, double step_s) {
+  double simulated_s = steps * step_s;
+  for (int p = 0; p < stepper->pushed_count; ++p) {
+    KnownBody* known = &stepper->known[stepper->pushed[p]];
+    double f[6];
+    for (int j = 0; j < 6; ++j) f[j] = (known->frame_force[j] * frame_s + known->carried[j]) / simulated_s;
+    dBodySetForce(known->body, f[0], f[1], f[2]);
+    dBodySetTorque(known->body, f[3], f[4], f[5]);
+  }
+}
+
+/* A frame that takes no step: its forces' momentum waits for the next steps, and the accumulators are emptied so
+ * that the program's next additions are not counted twice. */
+static void carryForces(ssStepper* stepper, double frame_s) {
+  for (int p = 0; p < stepper->pushed_count; ++p) {
+    KnownBody* known = &stepper->known[stepper->pushed[p]];
+    for (int j = 0; j < 6; ++j) known->carried[j] += known->frame_force[j] * frame_s;
+    dBodySetForce(known->body, 0, 0, 0);
+    dBodySetTorque(known->body, 0, 0, 0);
+  }
+}
+
+static void clearCarried(ssStepper* stepper) {
+  for (int p = 0; p < stepper->pushed_count; ++p)
+    memset(stepper->known[stepper->pushed[p]].carried, 0, sizeof stepper->known[0].carried);
+}
+
+/* Checks one body after a step; returns SS_OK or records the failure. A runaway is stopped while its numbers are
+ * still finite: ODE 0.16 aborts inside the next step when a rotation becomes non-finite (dxNormalize4). */
+static ssStatus checkBody(const ssStepper* stepper, dBodyID body) {
   const dReal* position = dBodyGetPosition(body);
   const dReal* velocity = dBodyGetLinearVel(body);
-  /* a NaN or an infinity anywhere makes the sum non-finite: one test for six numbers */
-  double sum = position[0] + position[1] + position[2] + velocity[0] + velocity[1] + velocity[2];
-  double speed_squared = velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2];
-  double max_speed = stepper->def.max_speed;
-  if (isfinite(sum) && (max_speed == 0 || speed_squared <= max_speed * max_speed)) return;
-  stepper->failed_body = body;
-  if (!isfinite(sum) || !isfinite(speed_squared))
-    stepper->failed_status = ssFail(SS_ERROR_BLOWUP, "body %p: position or velocity is not finite", (void*)body);
-  else
-    stepper->failed_status = ssFail(SS_ERROR_SPEED_LIMIT, "body %p: speed %g m/s is above max_speed = %g m/s",
-                                    (void*)body, sqrt(speed_squared), max_speed);
+  const dReal* spin = dBodyGetAngularVel(body);
+  /* a NaN or an infinity anywhere makes the sum non-finite: one test for nine numbers */
+  double sum = position[0] + position[1] + position[2] + velocity[0] + velocity[1] + velocity[2] + spin[0] + spin[1] +
+               spin[2];
+  double speed2 = velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2];
+  double spin2 = spin[0] * spin[0] + spin[1] * spin[1] + spin[2] * spin[2];
+  double max_speed = stepper->def.max_speed, max_spin = stepper->def.max_angular_speed;
+  if (isfinite(sum) && (max_speed == 0 || speed2 <= max_speed * max_speed) &&
+      (max_spin == 0 || spin2 <= max_spin * max_spin))
+    return SS_OK;
+  if (!isfinite(sum) || !isfinite(speed2) || !isfinite(spin2))
+    return ssFail(SS_ERROR_BLOWUP, "body %p: position or velocity is not finite", (void*)body);
+  if (max_speed != 0 && speed2 > max_speed * max_speed)
+    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: speed %g m/s is above max_speed = %g m/s", (void*)body,
+                  sqrt(speed2), max_speed);
+  return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: angular speed %g rad/s is above max_angular_speed = %g rad/s",
+                (void*)body, sqrt(spin2), max_spin);
 }
 
-static void appendBound(void* context, dBodyID body) {
-  ssStepper* stepper = context;
-  if (stepper->bound_count < stepper->bound_capacity) stepper->bound[stepper->bound_count++] = body;
-}
-
-/* The registry's bodies, each once; rebuilt only when the registry's bindings changed. */
-static ssStatus refreshBound(ssStepper* stepper) {
-  const ssRegistry* registry = stepper->def.registry;
-  unsigned generation = ssRegistryGeneration(registry);
-  if (stepper->bound_valid && stepper->bound_generation == generation) return SS_OK;
-  int most = 2 * ssRegistry_JointBindingCount(registry) + ssRegistryBodyBindingCount(registry);
-  if (most > stepper->bound_capacity) {
-    dBodyID* larger = realloc(stepper->bound, (size_t)most * sizeof *larger);
-    if (larger == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the bound bodies");
-    stepper->bound = larger;
-    stepper->bound_capacity = most;
-  }
-  stepper->bound_count = 0;
-  ssRegistry_VisitBodies(registry, appendBound, stepper);
-  stepper->bound_generation = generation;
-  stepper->bound_valid = 1;
-  return SS_OK;
-}
-
-/* One physics step of step_s, the registry having been applied for it. */
-static ssStatus takeStep(ssStepper* stepper, ssMapping mapping, double softness_step_s, double previous_step_s,
-                         double step_s, ssFrameReport* report) {
-  const ssStepperDef* def = &stepper->def;
-  if (def->collide) def->collide(def->collide_context, mapping, softness_step_s, previous_step_s);
-  if (def->solver == SS_SOLVER_STEP) {
-    if (!dWorldStep(def->world, step_s)) return ssFail(SS_ERROR_OUT_OF_MEMORY, "dWorldStep ran out of memory");
-  } else {
-    dWorldSetQuickStepNumIterations(def->world, def->quick_iterations);
-    if (!dWorldQuickStep(def->world, step_s))
-      return ssFail(SS_ERROR_OUT_OF_MEMORY, "dWorldQuickStep ran out of memory");
-  }
-  if (def->contact_group) dJointGroupEmpty(def->contact_group);
-  report->steps += 1;
-  report->step_s = step_s;
-  report->simulated_s += step_s;
-
-  stepper->failed_body = 0;
-  stepper->failed_status = SS_OK;
-  for (int i = 0; i < stepper->watched_count && !stepper->failed_body; ++i) checkBody(stepper, stepper->watched[i]);
-  for (int i = 0; i < stepper->bound_count && !stepper->failed_body; ++i) checkBody(stepper, stepper->bound[i]);
-  if (stepper->failed_body != 0) {
-    report->failed_body = stepper->failed_body;
-    stepper->previous_step_s = 0;
-    return stepper->failed_status;
-  }
-  if (def->step_done) def->step_done(def->step_done_context, step_s);
-  return SS_OK;
+static ssStatus latch(ssStepper* stepper, ssStatus status) {
+  stepper->failed_status = status;
+  snprintf(stepper->failed_message, sizeof stepper->failed_message, "%s", ssLastError());
+  stepper->previous_step_s = 0;
+  return status;
 }
 
 static ssStatus apply(ssStepper* stepper, ssMapping mapping, double step_s, double previous_step_s,
@@ -206,46 +379,81 @@ static ssStatus apply(ssStepper* stepper, ssMapping mapping, double step_s, doub
   report->apply.rows_written += applied.rows_written;
   report->apply.rows_over_nyquist += applied.rows_over_nyquist;
   report->apply.rows_exact_fallback += applied.rows_exact_fallback;
+  report->apply.rows_spring_fallback += applied.rows_spring_fallback;
   return SS_OK;
 }
 
-static ssMapping policyMapping(ssPolicy policy) {
-  switch (policy) {
-    case SS_POLICY_MATCHED: return SS_MAPPING_MATCHED;
-    case SS_POLICY_EXACT: return SS_MAPPING_EXACT;
-    default: return SS_MAPPING_SPRING;
-  }
-}
+/* How a frame is cut: `steps` steps of step_s, softness for softness_step_s under mapping. */
+typedef struct FrameCut {
+  int steps;
+  double step_s;
+  double softness_step_s;
+  ssMapping mapping;
+  int apply_every_step; /* the accurate mappings depend on the history and the bodies; spring on h alone */
+  int use_history;
+} FrameCut;
 
-/* NAIVE: one step of the whole frame, softness frozen at the reference step. */
-static ssStatus stepNaive(ssStepper* stepper, double frame_s, ssFrameReport* report) {
-  double reference_s = stepper->def.reference_step_s;
-  ssStatus status = apply(stepper, SS_MAPPING_SPRING, reference_s, 0, report);
-  if (status != SS_OK) return status;
-  return takeStep(stepper, SS_MAPPING_SPRING, reference_s, 0, frame_s, report);
-}
-
-/* SPRING, MATCHED, EXACT: n equal substeps no longer than max_step_s. */
-static ssStatus stepSubsteps(ssStepper* stepper, double frame_s, ssFrameReport* report) {
-  double count = ceil(frame_s / stepper->def.max_step_s - kStepCountSlack);
-  if (count < 1) count = 1;
-  if (count > (double)INT32_MAX)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: more than %d substeps of max_step_s = %g s", frame_s,
-                  INT32_MAX, stepper->def.max_step_s);
-  int steps = (int)count;
-  double step_s = frame_s / steps;
-  ssMapping mapping = policyMapping(stepper->def.policy);
-  for (int i = 0; i < steps; ++i) {
-    /* the spring mapping depends on h alone, equal for all substeps: one write a frame is enough */
-    if (i == 0 || mapping != SS_MAPPING_SPRING) {
-      ssStatus status = apply(stepper, mapping, step_s, stepper->previous_step_s, report);
+/* Takes the frame's steps. Errors of Apply leave the world as the previous step left it; a failed check latches. */
+static ssStatus takeSteps(ssStepper* stepper, const FrameCut* cut, double frame_s, ssFrameReport* report) {
+  const ssStepperDef* def = &stepper->def;
+  if (def->quick_iterations > 0) dWorldSetQuickStepNumIterations(def->world, def->quick_iterations);
+  for (int i = 0; i < cut->steps; ++i) {
+    double previous_step_s = cut->use_history ? stepper->previous_step_s : 0;
+    putForces(stepper, frame_s, cut->steps, cut->step_s);
+    if (i == 0 || cut->apply_every_step) {
+      ssStatus status = apply(stepper, cut->mapping, cut->softness_step_s, previous_step_s, report);
       if (status != SS_OK) return status;
     }
-    ssStatus status = takeStep(stepper, mapping, step_s, stepper->previous_step_s, step_s, report);
-    if (status != SS_OK) return status;
-    stepper->previous_step_s = step_s;
+    stepper->current = (ssStepInfo){cut->mapping, cut->step_s, cut->softness_step_s, previous_step_s, i, cut->steps};
+    if (def->before_step) def->before_step(def->before_step_context, stepper);
+    if (def->collide) def->collide(def->collide_context, stepper);
+    int stepped = def->solver == SS_SOLVER_STEP ? dWorldStep(def->world, cut->step_s)
+                                                : dWorldQuickStep(def->world, cut->step_s);
+    if (def->contact_group) dJointGroupEmpty(def->contact_group);
+    if (!stepped) return latch(stepper, ssFail(SS_ERROR_OUT_OF_MEMORY, "ODE ran out of memory in its step"));
+    report->steps += 1;
+    report->step_s = cut->step_s;
+    report->simulated_s += cut->step_s;
+    for (int k = 0; k < stepper->known_count; ++k) {
+      ssStatus status = checkBody(stepper, stepper->known[k].body);
+      if (status != SS_OK) {
+        report->failed_body = stepper->known[k].body;
+        return latch(stepper, status);
+      }
+    }
+    stepper->previous_step_s = cut->use_history ? cut->step_s : 0;
+    if (def->step_done) def->step_done(def->step_done_context, cut->step_s);
   }
   return SS_OK;
+}
+
+/* NAIVE: one step of the whole frame, softness frozen at the reference step. Others: n equal substeps no longer
+ * than max_step_s. A frame too short to step waits for the next one. */
+static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* report) {
+  double total_s = frame_s + stepper->short_frame_s;
+  if (total_s < SS_MIN_STEP_S) {
+    stepper->short_frame_s = total_s;
+    report->carried_s = total_s;
+    carryForces(stepper, frame_s);
+    return SS_OK;
+  }
+  FrameCut cut = {1, total_s, total_s, policyMapping(stepper->def.policy), 0, 0};
+  if (stepper->def.policy == SS_POLICY_NAIVE) {
+    cut.softness_step_s = referenceStep(stepper);
+  } else {
+    double count = ceil(total_s / stepper->def.max_step_s - kStepCountSlack);
+    if (count > (double)INT32_MAX)
+      return ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: more than %d substeps of max_step_s = %g s", frame_s,
+                    INT32_MAX, stepper->def.max_step_s);
+    cut.steps = count < 1 ? 1 : (int)count;
+    cut.step_s = cut.softness_step_s = total_s / cut.steps;
+    cut.apply_every_step = cut.mapping != SS_MAPPING_SPRING;
+    cut.use_history = cut.mapping == SS_MAPPING_EXACT;
+  }
+  stepper->short_frame_s = 0;
+  ssStatus status = takeSteps(stepper, &cut, frame_s, report);
+  clearCarried(stepper);
+  return status;
 }
 
 /* FIXED: constant steps from an accumulator, capped against the spiral of death. */
@@ -259,34 +467,39 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
     accumulator_s -= report->dropped_s;
     due = cap;
   }
-  int steps = (int)due;
-  if (steps > 0) {
-    ssStatus status = apply(stepper, SS_MAPPING_SPRING, step_s, 0, report);
-    if (status != SS_OK) return status;
+  FrameCut cut = {(int)due, step_s, step_s, SS_MAPPING_SPRING, 0, 0};
+  ssStatus status = SS_OK;
+  if (cut.steps == 0) {
+    carryForces(stepper, frame_s);
+  } else {
+    status = takeSteps(stepper, &cut, frame_s, report);
+    clearCarried(stepper);
   }
-  for (int i = 0; i < steps; ++i) {
-    ssStatus status = takeStep(stepper, SS_MAPPING_SPRING, step_s, step_s, step_s, report);
-    accumulator_s -= step_s;
-    if (status != SS_OK) {
-      stepper->accumulator_s = fmax(accumulator_s, 0);
-      return status;
-    }
-  }
-  stepper->accumulator_s = fmax(accumulator_s, 0);
+  stepper->accumulator_s = fmax(accumulator_s - report->steps * step_s, 0);
+  report->carried_s = stepper->accumulator_s;
   report->interpolation = fmin(stepper->accumulator_s / step_s, nextafter(1.0, 0.0));
-  return SS_OK;
+  return status;
 }
 
 ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* report) {
   ssFrameReport local;
   if (report == NULL) report = &local;
   memset(report, 0, sizeof *report);
+  REQUIRE_STEPPER(stepper);
+  if (stepper->failed_status != SS_OK)
+    return ssFail(SS_ERROR_FAILED, "an earlier frame failed (%s): repair or restore the bodies, then call "
+                                   "ssStepper_Reset", stepper->failed_message);
+  /* any frame from 0 up is taken: one shorter than SS_MIN_STEP_S waits for the next */
   ssStatus status = ssCheckNonNegative("frame_s", "s", frame_s);
+  if (status == SS_OK && frame_s > SS_MAX_FRAME_S)
+    status = ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: must be at most SS_MAX_FRAME_S = %g s", frame_s,
+                    SS_MAX_FRAME_S);
   if (status != SS_OK || frame_s == 0) return status;
-  if (stepper->def.registry != NULL && (status = refreshBound(stepper)) != SS_OK) return status;
-  switch (stepper->def.policy) {
-    case SS_POLICY_NAIVE: return stepNaive(stepper, frame_s, report);
-    case SS_POLICY_FIXED: return stepFixed(stepper, frame_s, report);
-    default: return stepSubsteps(stepper, frame_s, report);
-  }
+  if ((status = refreshKnown(stepper)) != SS_OK) return status;
+  captureForces(stepper);
+  stepper->report = report;
+  status = stepper->def.policy == SS_POLICY_FIXED ? stepFixed(stepper, frame_s, report)
+                                                   : stepFrame(stepper, frame_s, report);
+  stepper->report = NULL;
+  return status;
 }

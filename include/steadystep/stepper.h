@@ -1,15 +1,23 @@
 /* steadystep: the stepper, one call per rendered frame instead of dWorldQuickStep.
  *
  * A frame of dt seconds becomes n = ceil(dt / max_step_s) equal substeps of h = dt / n (the article: "make sure to
- * specify a largest time step the simulation can handle"). Before each substep the registry rewrites every soft
- * thing for h, the program's collision callback runs (handed h), ODE steps, the contact group is emptied and the
- * watched bodies are checked for NaN, infinity and runaway speed.
+ * specify a largest time step the simulation can handle"). Before each substep the stepper puts back the forces the
+ * program added for the frame, the registry rewrites every soft thing for h, the program's callbacks run, ODE
+ * steps with the program's own solver settings, the contact group is emptied and the known bodies are checked.
  *
  *     ssStepperDef def = ssDefaultStepperDef();
  *     def.world = world; def.registry = registry; def.max_step_s = 1.0 / 60.0;
- *     def.collide = my_near_callback_driver; def.contact_group = contacts;
+ *     def.collide = collide; def.contact_group = contacts;   // collide calls dSpaceCollide(space, stepper, near)
  *     ssStepper* stepper; ssStepper_Create(&def, &stepper);
- *     for (;;) { ssFrameReport report; if (ssStepper_Step(stepper, frame_seconds, &report) != SS_OK) ...; }
+ *     for (;;) {
+ *       add_forces();                                          // once a frame: they act for the whole frame
+ *       ssFrameReport report;
+ *       if (ssStepper_Step(stepper, frame_seconds, &report) != SS_OK) { ...repair or restore...;
+ *                                                                        ssStepper_Reset(stepper); }
+ *     }
+ *
+ * Known bodies: the bodies of the registry (bound, adopted) and those given to ssStepper_WatchBody. They are the
+ * ones whose forces are kept for the whole frame and whose state is checked after every step.
  */
 #ifndef STEADYSTEP_STEPPER_H
 #define STEADYSTEP_STEPPER_H
@@ -34,35 +42,54 @@ typedef enum ssPolicy {
 
 /** Which ODE solver a step calls. */
 typedef enum ssSolver {
-  SS_SOLVER_QUICK = 0, /* dWorldQuickStep, iterative (quick_iterations) */
+  SS_SOLVER_QUICK = 0, /* dWorldQuickStep, iterative: the world's own iteration count and SOR w */
   SS_SOLVER_STEP = 1,  /* dWorldStep, the direct (big matrix) solver */
 } ssSolver;
 
-/** Called before each physics step, after the registry has been applied: run collision detection here, create
- *  contact joints in the stepper's contact_group and soften them with ssContactSoften(contact, b1, b2, spring,
- *  mapping, step_s, previous_step_s). The arguments are the ones the registry was applied with: the policy's
- *  mapping, the step length the softness is for (SS_POLICY_NAIVE: reference_step_s, whatever the frame time) and
- *  the step before (0 if none). */
-typedef void ssCollideFn(void* context, ssMapping mapping, double step_s, double previous_step_s);
+typedef struct ssStepper ssStepper;
 
-/** Called after each physics step that passed the blow-up checks, with its length; for recording. */
+/** The physics step about to be taken, as ssStepper_CurrentStep gives it inside the callbacks. */
+typedef struct ssStepInfo {
+  ssMapping mapping;      /* the mapping this step's softness is written with */
+  double step_s;          /* the length of the physics step about to be taken (s) */
+  double softness_step_s; /* the step length the softness is for (s): step_s, except SS_POLICY_NAIVE's reference */
+  double previous_step_s; /* the step before, for SS_MAPPING_EXACT (s); 0 when there is no usable history */
+  int index;              /* 0-based index of this step within the frame */
+  int count;              /* steps this frame takes */
+} ssStepInfo;
+
+/** A callback before each physics step; ssStepper_CurrentStep(stepper) tells the step. */
+typedef void ssStepCallback(void* context, ssStepper* stepper);
+
+/** Called after each physics step that passed the checks, with its length (s); for recording. */
 typedef void ssStepDoneFn(void* context, double step_s);
 
 /** How a stepper is made. Start from ssDefaultStepperDef(): new fields keep working defaults. */
 typedef struct ssStepperDef {
   dWorldID world;               /* required */
-  ssRegistry* registry;         /* may be NULL: nothing soft is rewritten */
+  ssRegistry* registry;         /* may be NULL: nothing soft is rewritten, only watched bodies are known */
   ssPolicy policy;              /* default SS_POLICY_SPRING */
   ssSolver solver;              /* default SS_SOLVER_QUICK */
-  int quick_iterations;         /* dWorldQuickStep iterations, > 0; default 20 (ODE's default) */
+  /* dWorldQuickStep iterations written into the world before each frame, > 0; default 0: the world's own setting
+   * (dWorldSetQuickStepNumIterations) is left as the program set it. The stepper writes no other solver setting. */
+  int quick_iterations;
   double max_step_s;            /* the longest substep (s), > 0; default 1/60 */
   double reference_step_s;      /* NAIVE: the step its softness was tuned at (s), > 0; default 1/30 */
   double fixed_step_s;          /* FIXED: the constant step (s), > 0; default 1/60 */
   int max_steps_per_frame;      /* FIXED: cap against the spiral of death (later time is dropped), > 0; default 8 */
-  /* a watched body faster than this (m/s) is a blow-up; 0 = no limit; default 0. Set it: ODE 0.16 aborts the
-   * program (dxNormalize4) when a step produces a non-finite rotation, so a runaway must be caught before NaN. */
+  /* A known body faster than this after a step is a runaway (m/s, rad/s); 0 switches the check off. Default
+   * 1e4 m/s and 1e4 rad/s: far above anything a game moves, low enough to stop a blow-up before ODE 0.16 aborts
+   * the process (a non-finite rotation fails an assertion inside the next step). Raise them for faster bodies. */
   double max_speed;
-  ssCollideFn* collide;         /* may be NULL */
+  double max_angular_speed;
+  /* Before each step, after the frame's forces were put back and the registry applied: add forces that depend on
+   * the state (PD controllers, drag, buoyancy). Forces that are constant over a frame can simply be added before
+   * ssStepper_Step. May be NULL. */
+  ssStepCallback* before_step;
+  void* before_step_context;
+  /* Before each step, after before_step: run collision detection, e.g. dSpaceCollide(space, stepper, near), create
+   * contacts in contact_group and soften each with ssStepper_SoftenContact. May be NULL. */
+  ssStepCallback* collide;
   void* collide_context;
   ssStepDoneFn* step_done;      /* may be NULL */
   void* step_done_context;
@@ -74,51 +101,84 @@ typedef struct ssFrameReport {
   int steps;                  /* physics steps taken */
   double step_s;              /* length of the last step taken (s); 0 when none */
   double simulated_s;         /* time simulated this frame (s) */
+  double carried_s;           /* time not simulated yet, carried to the next frame (s): FIXED's accumulator, or a
+                               * frame shorter than SS_MIN_STEP_S */
   double dropped_s;           /* FIXED: time dropped by max_steps_per_frame (s) */
   double interpolation;       /* FIXED: accumulator / fixed_step_s in [0, 1), to blend the last two states */
   ssApplyReport apply;        /* summed over the frame's steps */
+  int contacts_softened;      /* contacts softened with ssStepper_SoftenContact */
+  int contacts_spring_fallback; /* of those, contacts the accurate mapping could not serve: spring mapping used */
   dBodyID failed_body;        /* the body that blew up or ran too fast, else 0 */
 } ssFrameReport;
 
-typedef struct ssStepper ssStepper;
+/** The shortest physics step the stepper hands ODE (s). A frame shorter than this is carried over to the next one. */
+#define SS_MIN_STEP_S 1e-9
+/** The longest frame ssStepper_Step takes (s): longer is refused (a frame is never a day). */
+#define SS_MAX_FRAME_S 3600.0
 
 /** The defaults listed at each field. */
 ssStepperDef ssDefaultStepperDef(void);
 
 /** Makes a stepper. The registry and the world are borrowed: they must outlive it.
- *  Errors: SS_ERROR_OUT_OF_RANGE (no world, or a field outside its range, named), SS_ERROR_NOT_FINITE,
- *  SS_ERROR_UNSUPPORTED (unknown policy or solver), SS_ERROR_OUT_OF_MEMORY. */
+ *  Errors: SS_ERROR_OUT_OF_RANGE (def or out NULL, no world, or a field outside its range, named),
+ *  SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED (unknown policy or solver), SS_ERROR_OUT_OF_MEMORY. */
 ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out);
 
 /** Destroys the stepper. NULL is a no-op. */
 void ssStepper_Destroy(ssStepper* stepper);
 
-/** Advances the world by one frame of frame_s seconds (>= 0; 0 does nothing). report may be NULL.
- *  Errors, with the world left as it was: SS_ERROR_NOT_FINITE or SS_ERROR_OUT_OF_RANGE for frame_s; errors of
- *  ssRegistry_Apply (checked before the first step touches the world).
- *  Errors after stepping: SS_ERROR_BLOWUP (a watched body's position or linear velocity is not finite) and
- *  SS_ERROR_SPEED_LIMIT (faster than max_speed): the frame stops at that step and report->failed_body names it. */
+/** Advances the world by one frame of frame_s seconds (0 <= frame_s <= SS_MAX_FRAME_S; 0 does nothing). report may
+ *  be NULL.
+ *  Forces and torques that the program added to known bodies before this call act for the whole frame: they are
+ *  put back before every substep (ODE clears them after each step), and under SS_POLICY_FIXED they are scaled so
+ *  that the frame's steps deliver the momentum F·frame_s (carried to the next frame when this one takes no step).
+ *  Errors, with the world left as it was: SS_ERROR_OUT_OF_RANGE (stepper NULL, frame_s out of range),
+ *  SS_ERROR_NOT_FINITE; errors of ssRegistry_Apply (checked before the first step touches the world);
+ *  SS_ERROR_FAILED when an earlier frame failed and ssStepper_Reset has not been called.
+ *  Errors after stepping: SS_ERROR_BLOWUP (a known body's position or velocity is not finite) and
+ *  SS_ERROR_SPEED_LIMIT (faster than max_speed or max_angular_speed): the frame stops at that step,
+ *  report->failed_body names the body, and the stepper refuses every later frame until ssStepper_Reset. */
 ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* report);
 
-/** Adds a body to the blow-up checks (bodies of bound joints and bound bodies are watched anyway).
- *  Errors: SS_ERROR_OUT_OF_MEMORY. */
+/** After a failure, once the program has repaired or restored its bodies: accepts frames again. Also forgets the
+ *  step history, the FIXED accumulator and the momentum carried for the next frame. NULL is a no-op. */
+void ssStepper_Reset(ssStepper* stepper);
+
+/** The step about to be taken. Meaningful inside before_step and collide; between frames it describes the next
+ *  step of the default length. stepper must not be NULL. */
+ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
+
+/** In the program's near callback: turns the contact's tuned softness into the softness for the step about to be
+ *  taken. The contact's soft_erp/soft_cfm (where surface.mode has dContactSoftERP/dContactSoftCFM), or else the
+ *  world's ERP/CFM, as the program tuned them at the registry's tuned step (ssRegistry_Adopt), become a spring; it
+ *  is written back as soft_erp/soft_cfm for this step's length and mapping, both mode bits set. body1 and body2
+ *  (either may be 0 for the static world) give the effective mass along the normal for matched and exact; where
+ *  those cannot serve the contact, the spring mapping does (counted in the frame report). A contact tuned with
+ *  cfm = 0 stays hard (erp follows h as for adopted hard rows).
+ *  Errors, with the contact unchanged: SS_ERROR_OUT_OF_RANGE (stepper or contact NULL, no tuned step: adopt
+ *  first, or a tuned erp outside [0, 1] or cfm < 0); SS_ERROR_NOT_FINITE. */
+ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2);
+
+/** Adds a body to the known bodies: forces kept for the whole frame and checks after each step.
+ *  Errors: SS_ERROR_OUT_OF_RANGE (NULL), SS_ERROR_OUT_OF_MEMORY. */
 ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body);
 
-/** Stops watching a body; call it before dBodyDestroy. Errors: SS_ERROR_NOT_FOUND. */
+/** Stops watching a body; call it before dBodyDestroy. Errors: SS_ERROR_OUT_OF_RANGE (NULL), SS_ERROR_NOT_FOUND. */
 ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body);
 
 /** Forgets the previous step length, so the next step of SS_POLICY_EXACT maps the bodies' true velocities. Call it
- *  after teleporting a body or setting its velocity. */
+ *  after teleporting a body or setting its velocity. NULL is a no-op. */
 void ssStepper_ResetHistory(ssStepper* stepper);
 
 /** Changes the policy between frames (resets the history and the FIXED accumulator).
- *  Errors: SS_ERROR_UNSUPPORTED for an unknown policy. */
+ *  Errors: SS_ERROR_OUT_OF_RANGE for a NULL stepper, SS_ERROR_UNSUPPORTED for an unknown policy. */
 ssStatus ssStepper_SetPolicy(ssStepper* stepper, ssPolicy policy);
 
 /** The policy's name: "naive", "spring", "matched", "exact", "fixed"; NULL for an unknown value. */
 const char* ssPolicyName(ssPolicy policy);
 
-/** Parses a policy name as ssPolicyName gives it. Errors: SS_ERROR_PARSE naming the text. */
+/** Parses a policy name as ssPolicyName gives it. Errors: SS_ERROR_PARSE naming the text; SS_ERROR_OUT_OF_RANGE
+ *  for a NULL out. */
 ssStatus ssPolicyParse(const char* name, ssPolicy* out);
 
 #ifdef __cplusplus

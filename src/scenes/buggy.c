@@ -116,9 +116,9 @@ static ssStatus watch(void* state, ssStepper* stepper) {
   return ssStepper_WatchBody(stepper, buggy->chassis);
 }
 
-static void collide(void* context, ssMapping mapping, double step_s, double previous_step_s) {
+static void collide(void* context, ssStepper* stepper) {
   Buggy* buggy = context;
-  ssContactCollide(&buggy->recipe, mapping, step_s, previous_step_s);
+  ssContactCollide(&buggy->recipe, stepper);
 }
 
 static void sample(const void* state, double* out) {

@@ -101,7 +101,9 @@ TEST_F(StepperTest, CreateRefusesBadDefinitionsNamingTheField) {
       {[](ssStepperDef* d) { d->max_step_s = NAN; }, SS_ERROR_NOT_FINITE, "max_step_s"},
       {[](ssStepperDef* d) { d->reference_step_s = -1; }, SS_ERROR_OUT_OF_RANGE, "reference_step_s = -1"},
       {[](ssStepperDef* d) { d->fixed_step_s = INFINITY; }, SS_ERROR_NOT_FINITE, "fixed_step_s"},
-      {[](ssStepperDef* d) { d->quick_iterations = 0; }, SS_ERROR_OUT_OF_RANGE, "quick_iterations = 0"},
+      {[](ssStepperDef* d) { d->quick_iterations = -1; }, SS_ERROR_OUT_OF_RANGE, "quick_iterations = -1"},
+      {[](ssStepperDef* d) { d->max_step_s = 1e-12; }, SS_ERROR_OUT_OF_RANGE, "max_step_s = 1e-12"},
+      {[](ssStepperDef* d) { d->max_angular_speed = -1; }, SS_ERROR_OUT_OF_RANGE, "max_angular_speed = -1"},
       {[](ssStepperDef* d) { d->max_steps_per_frame = -3; }, SS_ERROR_OUT_OF_RANGE, "max_steps_per_frame = -3"},
       {[](ssStepperDef* d) { d->max_speed = -1; }, SS_ERROR_OUT_OF_RANGE, "max_speed = -1"},
       {[](ssStepperDef* d) { d->policy = (ssPolicy)42; }, SS_ERROR_UNSUPPORTED, "policy = 42"},
@@ -132,35 +134,44 @@ TEST_F(StepperTest, PolicyNamesRoundTrip) {
 }
 
 struct CallbackLog {
-  std::vector<double> collide_steps, collide_previous, done_steps;
-  std::vector<int> mappings;
+  std::vector<ssStepInfo> before, collide;
 };
 
 TEST_F(StepperTest, CallbacksAreHandedTheStepAndTheMapping) {
   OscillatorRig rig;
   CallbackLog log;
   rig.def.policy = SS_POLICY_EXACT;
-  rig.def.collide = [](void* context, ssMapping mapping, double step_s, double previous_step_s) {
-    auto* l = static_cast<CallbackLog*>(context);
-    l->mappings.push_back(mapping);
-    l->collide_steps.push_back(step_s);
-    l->collide_previous.push_back(previous_step_s);
+  rig.def.before_step = [](void* context, ssStepper* stepper) {
+    static_cast<CallbackLog*>(context)->before.push_back(ssStepper_CurrentStep(stepper));
+  };
+  rig.def.before_step_context = &log;
+  rig.def.collide = [](void* context, ssStepper* stepper) {
+    static_cast<CallbackLog*>(context)->collide.push_back(ssStepper_CurrentStep(stepper));
   };
   rig.def.collide_context = &log;
   ASSERT_EQ(rig.Build(), SS_OK);
   ASSERT_EQ(ssStepper_Step(rig.stepper, 0.05, nullptr), SS_OK);  // three substeps of 1/60
-  ASSERT_EQ(log.collide_steps.size(), 3u);
-  EXPECT_EQ(log.collide_previous[0], 0.0);
-  EXPECT_DOUBLE_EQ(log.collide_previous[1], 0.05 / 3);
-  EXPECT_EQ(log.mappings[0], SS_MAPPING_EXACT);
+  ASSERT_EQ(log.collide.size(), 3u);
+  ASSERT_EQ(log.before.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(log.collide[i].index, i);
+    EXPECT_EQ(log.collide[i].count, 3);
+    EXPECT_DOUBLE_EQ(log.collide[i].step_s, 0.05 / 3);
+    EXPECT_EQ(log.collide[i].step_s, log.collide[i].softness_step_s);
+    EXPECT_EQ(log.before[i].index, i);
+  }
+  EXPECT_EQ(log.collide[0].previous_step_s, 0.0);
+  EXPECT_DOUBLE_EQ(log.collide[1].previous_step_s, 0.05 / 3);
+  EXPECT_EQ(log.collide[0].mapping, SS_MAPPING_EXACT);
   EXPECT_EQ(rig.h.size(), 3u);
   ssStepper_ResetHistory(rig.stepper);
   ASSERT_EQ(ssStepper_Step(rig.stepper, 0.01, nullptr), SS_OK);
-  EXPECT_EQ(log.collide_previous.back(), 0.0);
+  EXPECT_EQ(log.collide.back().previous_step_s, 0.0);
   ASSERT_EQ(ssStepper_SetPolicy(rig.stepper, SS_POLICY_NAIVE), SS_OK);
   ASSERT_EQ(ssStepper_Step(rig.stepper, 0.01, nullptr), SS_OK);
-  EXPECT_EQ(log.mappings.back(), SS_MAPPING_SPRING);
-  EXPECT_DOUBLE_EQ(log.collide_steps.back(), rig.def.reference_step_s);
+  EXPECT_EQ(log.collide.back().mapping, SS_MAPPING_SPRING);
+  EXPECT_DOUBLE_EQ(log.collide.back().step_s, 0.01);
+  EXPECT_DOUBLE_EQ(log.collide.back().softness_step_s, 1.0 / 30.0);  // no adoption: the lab's reference step
   EXPECT_EQ(ssStepper_SetPolicy(rig.stepper, (ssPolicy)-1), SS_ERROR_UNSUPPORTED);
 }
 
@@ -168,7 +179,7 @@ TEST_F(StepperTest, ContactGroupIsEmptiedAfterEveryStep) {
   OscillatorRig rig;
   dJointGroupID contacts = dJointGroupCreate(0);
   rig.def.contact_group = contacts;
-  rig.def.collide = [](void* context, ssMapping, double, double) {
+  rig.def.collide = [](void* context, ssStepper*) {
     auto* r = static_cast<OscillatorRig*>(context);
     dContact contact = {};
     contact.geom.normal[2] = 1;
@@ -184,7 +195,7 @@ TEST_F(StepperTest, ContactGroupIsEmptiedAfterEveryStep) {
   dJointGroupDestroy(contacts);
 }
 
-TEST_F(StepperTest, BlowUpsAndRunawaySpeedsAreReportedNotPassedOver) {
+TEST_F(StepperTest, BlowUpsAndRunawaysAreReportedAndStepsAreRefusedUntilReset) {
   OscillatorRig rig;
   rig.def.max_speed = 100;
   ASSERT_EQ(rig.Build(), SS_OK);
@@ -197,13 +208,25 @@ TEST_F(StepperTest, BlowUpsAndRunawaySpeedsAreReportedNotPassedOver) {
   EXPECT_EQ(report.steps, 1);  // the frame stops at the step that failed
   EXPECT_NE(std::string(ssLastError()).find("max_speed = 100"), std::string::npos) << ssLastError();
 
-  // A body of a bound joint is watched without being asked.
+  // Latched: every later frame is refused, names the first failure and touches nothing.
   dBodySetLinearVel(loose, 0, 0, 0);
+  const double x = dJointGetSliderPosition(rig.slider);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_FAILED);
+    EXPECT_EQ(report.steps, 0);
+    EXPECT_NE(std::string(ssLastError()).find("max_speed = 100"), std::string::npos) << ssLastError();
+    EXPECT_NE(std::string(ssLastError()).find("ssStepper_Reset"), std::string::npos) << ssLastError();
+  }
+  EXPECT_EQ(dJointGetSliderPosition(rig.slider), x);
+  ssStepper_Reset(rig.stepper);
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_OK) << ssLastError();
+
+  // A body of a bound joint is watched without being asked.
   dBodySetLinearVel(rig.body, 500, 0, 0);
   EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_SPEED_LIMIT);
   EXPECT_EQ(report.failed_body, rig.body);
+  ssStepper_Reset(rig.stepper);
 
-  // ODE aborts on a non-finite rotation, so the blow-up is in a free body's linear motion.
   dBodySetLinearVel(rig.body, 0, 0, 0);
   dBodySetLinearVel(loose, NAN, 0, 0);
   EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_BLOWUP);
@@ -211,6 +234,20 @@ TEST_F(StepperTest, BlowUpsAndRunawaySpeedsAreReportedNotPassedOver) {
   EXPECT_NE(std::string(ssLastError()).find("not finite"), std::string::npos) << ssLastError();
   EXPECT_EQ(ssStepper_UnwatchBody(rig.stepper, loose), SS_OK);
   EXPECT_EQ(ssStepper_UnwatchBody(rig.stepper, loose), SS_ERROR_NOT_FOUND);
+}
+
+TEST_F(StepperTest, TheSpeedGuardIsOnByDefaultForLinearAndAngularSpeed) {
+  ssStepperDef def = ssDefaultStepperDef();
+  EXPECT_GT(def.max_speed, 0);
+  EXPECT_GT(def.max_angular_speed, 0);
+  OscillatorRig rig;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  dBodyID spinning = MakeBody(1.0);
+  ASSERT_EQ(ssStepper_WatchBody(rig.stepper, spinning), SS_OK);
+  dBodySetAngularVel(spinning, 0, 0, 2 * def.max_angular_speed);
+  ssFrameReport report;
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 1.0 / 60, &report), SS_ERROR_SPEED_LIMIT);
+  EXPECT_NE(std::string(ssLastError()).find("max_angular_speed"), std::string::npos) << ssLastError();
 }
 
 TEST_F(StepperTest, FrequenciesAboveHalfTheStepRateAreReported) {
