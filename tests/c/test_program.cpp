@@ -1,0 +1,212 @@
+// What a real ODE program does around the stepper: forces added once a frame, its own solver settings, contacts
+// softened in its own near callback. The truths: momentum F·dt, settings read back, the tuned softness.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "ode_fixture.h"
+#include "steadystep/steadystep.h"
+
+namespace {
+
+class ProgramTest : public OdeTest {};
+
+const ssPolicy kPolicies[] = {SS_POLICY_NAIVE, SS_POLICY_SPRING, SS_POLICY_MATCHED, SS_POLICY_EXACT,
+                              SS_POLICY_FIXED};
+
+TEST_F(ProgramTest, AForceAddedOncePerFrameDeliversFdtPerFrameUnderEveryPolicy) {
+  const double force = 1.0, torque = 0.25, mass = 2.0;
+  // Frames of 50 ms with 1/60 s substeps, and frames shorter than the fixed step, which FIXED carries.
+  const std::vector<double> frames = {0.05, 0.05, 0.004, 0.05, 0.003, 0.002, 0.05, 1e-12, 0.05};
+  for (ssPolicy policy : kPolicies) {
+    dWorldSetGravity(world, 0, 0, 0);
+    dBodyID body = MakeBody(mass);
+    dMass m;
+    dBodyGetMass(body, &m);
+    const double inertia_zz = m.I[10];
+    ssStepperDef def = ssDefaultStepperDef();
+    def.world = world;
+    def.policy = policy;
+    def.fixed_step_s = 0.01;
+    ssStepper* stepper = nullptr;
+    ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
+    ASSERT_EQ(ssStepper_WatchBody(stepper, body), SS_OK);
+    double elapsed_s = 0;
+    for (double frame_s : frames) {
+      dBodyAddForce(body, force, 0, 0);  // once a frame, as a game loop does
+      dBodyAddTorque(body, 0, 0, torque);
+      ssFrameReport report;
+      ASSERT_EQ(ssStepper_Step(stepper, frame_s, &report), SS_OK) << ssLastError();
+      elapsed_s += frame_s;
+      if (report.steps == 0) continue;  // its momentum is carried to the next frame that steps
+      // p = F·Σdt, L = τ·Σdt: every frame's whole impulse, whatever the substeps
+      EXPECT_NEAR(mass * dBodyGetLinearVel(body)[0], force * elapsed_s, 1e-9) << ssPolicyName(policy);
+      EXPECT_NEAR(inertia_zz * dBodyGetAngularVel(body)[2], torque * elapsed_s, 1e-9) << ssPolicyName(policy);
+    }
+    ssStepper_Destroy(stepper);
+    dBodyDestroy(body);
+  }
+}
+
+TEST_F(ProgramTest, StateDependentForcesGoInBeforeStepWithTheStepsLength) {
+  // A PD controller holding a free body at x = 0: force computed from the state before every substep.
+  dWorldSetGravity(world, 0, 0, 0);
+  dBodyID body = MakeBody(1.0, 0.5, 0, 0);
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = world;
+  struct Controller {
+    dBodyID body;
+    std::vector<double> steps;
+  } controller = {body, {}};
+  def.before_step = [](void* context, ssStepper* stepper) {
+    auto* c = static_cast<Controller*>(context);
+    c->steps.push_back(ssStepper_CurrentStep(stepper).step_s);
+    const double x = dBodyGetPosition(c->body)[0], v = dBodyGetLinearVel(c->body)[0];
+    dBodyAddForce(c->body, -40 * x - 8 * v, 0, 0);
+  };
+  def.before_step_context = &controller;
+  ssStepper* stepper = nullptr;
+  ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
+  ASSERT_EQ(ssStepper_WatchBody(stepper, body), SS_OK);
+  for (int frame = 0; frame < 120; ++frame) ASSERT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK);
+  EXPECT_EQ(controller.steps.size(), 360u);  // 3 substeps of 1/60 per frame
+  EXPECT_NEAR(controller.steps.front(), 0.05 / 3, 1e-15);
+  EXPECT_LT(std::fabs(dBodyGetPosition(body)[0]), 1e-3);  // held: the force acted on every substep
+  ssStepper_Destroy(stepper);
+}
+
+TEST_F(ProgramTest, TheWorldsSolverSettingsAreTheProgramsOwn) {
+  dWorldSetQuickStepNumIterations(world, 64);
+  dWorldSetQuickStepW(world, 1.1);
+  dWorldSetContactMaxCorrectingVel(world, 5.0);
+  dWorldSetContactSurfaceLayer(world, 0.002);
+  dWorldSetMaxAngularSpeed(world, 300);
+  dBodyID body = MakeBody(1.0, 0, 0, 1);
+  dJointID hinge = dJointCreateHinge(world, 0);
+  dJointAttach(hinge, body, 0);
+  dSpaceID space = dSimpleSpaceCreate(0);
+  dGeomSetBody(dCreateBox(space, 0.1, 0.1, 0.1), body);
+  ssRegistry* registry = ssRegistry_Create(world);
+  ASSERT_EQ(ssRegistry_Adopt(registry, 1.0 / 60.0, space, nullptr), SS_OK) << ssLastError();
+  for (ssPolicy policy : kPolicies) {
+    ssStepperDef def = ssDefaultStepperDef();
+    def.world = world;
+    def.registry = registry;
+    def.policy = policy;
+    ssStepper* stepper = nullptr;
+    ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
+    for (int frame = 0; frame < 10; ++frame) ASSERT_EQ(ssStepper_Step(stepper, 0.04, nullptr), SS_OK);
+    EXPECT_EQ(dWorldGetQuickStepNumIterations(world), 64) << ssPolicyName(policy);
+    EXPECT_EQ(dWorldGetQuickStepW(world), 1.1);
+    EXPECT_EQ(dWorldGetContactMaxCorrectingVel(world), 5.0);
+    EXPECT_EQ(dWorldGetContactSurfaceLayer(world), 0.002);
+    EXPECT_EQ(dWorldGetMaxAngularSpeed(world), 300);
+    ssStepper_Destroy(stepper);
+  }
+  ssRegistry_Destroy(registry);
+  dSpaceDestroy(space);
+}
+
+// The program's near callback, adopted: the stepper comes in as the data pointer and softens every contact.
+struct Scene {
+  dWorldID world;
+  dSpaceID space;
+  dJointGroupID contacts;
+  int mode;
+  double soft_erp, soft_cfm;
+  std::vector<dSurfaceParameters> softened;
+  std::vector<ssStepInfo> steps;
+};
+Scene* g_scene = nullptr;
+
+void NearCallback(void* data, dGeomID a, dGeomID b) {
+  auto* stepper = static_cast<ssStepper*>(data);
+  dContact contact[4] = {};
+  int count = dCollide(a, b, 4, &contact[0].geom, sizeof(dContact));
+  for (int i = 0; i < count; ++i) {
+    contact[i].surface.mode = g_scene->mode;
+    contact[i].surface.mu = 1;
+    contact[i].surface.soft_erp = g_scene->soft_erp;
+    contact[i].surface.soft_cfm = g_scene->soft_cfm;
+    EXPECT_EQ(ssStepper_SoftenContact(stepper, &contact[i], dGeomGetBody(a), dGeomGetBody(b)), SS_OK)
+        << ssLastError();
+    g_scene->softened.push_back(contact[i].surface);
+    g_scene->steps.push_back(ssStepper_CurrentStep(stepper));
+    dJointAttach(dJointCreateContact(g_scene->world, g_scene->contacts, &contact[i]), dGeomGetBody(a),
+                 dGeomGetBody(b));
+  }
+}
+
+TEST_F(ProgramTest, ContactsAreSoftenedInTheProgramsNearCallbackFromWhatItTuned) {
+  const double tuned_s = 1.0 / 60.0;
+  dWorldSetERP(world, 0.3);
+  dWorldSetCFM(world, 1e-5);
+  dWorldSetGravity(world, 0, 0, -9.81);  // resting on the ground: contacts in every step
+  Scene scene = {world, dSimpleSpaceCreate(0), dJointGroupCreate(0), 0, 0.4, 1e-3, {}, {}};
+  g_scene = &scene;
+  dCreatePlane(scene.space, 0, 0, 1, 0);
+  dBodyID box = MakeBody(1.0, 0, 0, 0.045);
+  dGeomSetBody(dCreateBox(scene.space, 0.1, 0.1, 0.1), box);
+  ssRegistry* registry = ssRegistry_Create(world);
+  ASSERT_EQ(ssRegistry_Adopt(registry, tuned_s, scene.space, nullptr), SS_OK) << ssLastError();
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = world;
+  def.registry = registry;
+  def.contact_group = scene.contacts;
+  def.collide = [](void* context, ssStepper* stepper) {
+    dSpaceCollide(static_cast<Scene*>(context)->space, stepper, NearCallback);
+  };
+  def.collide_context = &scene;
+  ssStepper* stepper = nullptr;
+  ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
+
+  struct Case {
+    int mode;
+    double erp, cfm;  // what the contact stands for, tuned at 1/60 s
+  } cases[] = {{dContactSoftERP | dContactSoftCFM, 0.4, 1e-3},
+               {dContactSoftCFM, 0.3, 1e-3},   // soft CFM only: the world's ERP
+               {0, 0.3, 1e-5}};                // no soft mode: the world's ERP and CFM
+  for (const Case& c : cases) {
+    scene.mode = c.mode;
+    for (double frame_s : {tuned_s, 0.05}) {
+      scene.softened.clear();
+      scene.steps.clear();
+      ssFrameReport report;
+      ASSERT_EQ(ssStepper_Step(stepper, frame_s, &report), SS_OK) << ssLastError();
+      ASSERT_FALSE(scene.softened.empty());
+      EXPECT_EQ(report.contacts_softened, (int)scene.softened.size());
+      const ssSpring spring = {c.erp / (tuned_s * c.cfm), (1 - c.erp) / c.cfm};  // the article's inverse
+      for (size_t i = 0; i < scene.softened.size(); ++i) {
+        const double h = scene.steps[i].step_s;
+        EXPECT_TRUE(scene.softened[i].mode & dContactSoftERP);
+        EXPECT_TRUE(scene.softened[i].mode & dContactSoftCFM);
+        EXPECT_NEAR(scene.softened[i].soft_erp, h * spring.stiffness / (h * spring.stiffness + spring.damping),
+                    1e-12);
+        EXPECT_NEAR(scene.softened[i].soft_cfm, 1 / (h * spring.stiffness + spring.damping), 1e-12 * c.cfm);
+      }
+    }
+  }
+  // Without adoption there is no tuned step to read the contact at: refused by name, contact unchanged.
+  ssStepperDef bare = ssDefaultStepperDef();
+  bare.world = world;
+  ssStepper* unadopted = nullptr;
+  ASSERT_EQ(ssStepper_Create(&bare, &unadopted), SS_OK);
+  dContact contact = {};
+  contact.surface.soft_erp = 0.5;
+  EXPECT_EQ(ssStepper_SoftenContact(unadopted, &contact, box, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("adopt"), std::string::npos) << ssLastError();
+  EXPECT_EQ(contact.surface.soft_erp, 0.5);
+  EXPECT_EQ(ssStepper_SoftenContact(nullptr, &contact, box, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssStepper_SoftenContact(stepper, nullptr, box, 0), SS_ERROR_OUT_OF_RANGE);
+  contact.surface.mode = dContactSoftERP | dContactSoftCFM;
+  contact.surface.soft_cfm = -1;
+  EXPECT_EQ(ssStepper_SoftenContact(stepper, &contact, box, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("cfm = -1"), std::string::npos) << ssLastError();
+  ssStepper_Destroy(unadopted);
+  ssStepper_Destroy(stepper);
+  ssRegistry_Destroy(registry);
+  dJointGroupDestroy(scene.contacts);
+  dSpaceDestroy(scene.space);
+}
+
+}  // namespace
