@@ -90,6 +90,12 @@ static JointBinding* findJoint(ssRegistry* registry, dJointID joint, ssJointPara
   return NULL;
 }
 
+int ssRegistryHasJoint(const ssRegistry* registry, dJointID joint) {
+  for (int i = 0; i < registry->joint_count; ++i)
+    if (registry->joints[i].joint == joint) return 1;
+  return 0;
+}
+
 int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam param, int axis) {
   return findJoint(registry, joint, param, axis) != NULL;
 }

@@ -26,6 +26,7 @@ int ssRegistryBodyBindingCount(const ssRegistry* registry);
 void ssRegistryBindWorldLaw(ssRegistry* registry, ssRowLaw law, double effective_mass);
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass);
+int ssRegistryHasJoint(const ssRegistry* registry, dJointID joint);
 int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam param, int axis);
 
 /* The body's binding (0: the world's defaults), or NULL. */

@@ -180,6 +180,28 @@ ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body) {
   return ssFail(SS_ERROR_NOT_FOUND, "body %p: not watched", (void*)body);
 }
 
+ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body) {
+  REQUIRE_STEPPER(stepper);
+  if (body == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "body = NULL: a body is required");
+  for (int i = 0; i < stepper->watched_count; ++i)
+    if (stepper->watched[i] == body) ssStepper_UnwatchBody(stepper, body);
+  ssRegistry* registry = stepper->def.registry;
+  if (registry != NULL && ssRegistryHasBody(registry, body)) ssRegistry_UnbindBody(registry, body);
+  stepper->watched_generation += 1; /* the known list is rebuilt without it before it is read again */
+  dBodyDestroy(body);
+  return SS_OK;
+}
+
+ssStatus ssStepper_DestroyJoint(ssStepper* stepper, dJointID joint) {
+  REQUIRE_STEPPER(stepper);
+  if (joint == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "joint = NULL: a joint is required");
+  ssRegistry* registry = stepper->def.registry;
+  if (registry != NULL && ssRegistryHasJoint(registry, joint)) ssRegistry_UnbindJoint(registry, joint);
+  stepper->watched_generation += 1;
+  dJointDestroy(joint);
+  return SS_OK;
+}
+
 static void forgetCarried(ssStepper* stepper) {
   for (int i = 0; i < stepper->known_count; ++i) memset(stepper->known[i].carried, 0, sizeof stepper->known[i].carried);
 }

@@ -166,6 +166,18 @@ ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body);
 /** Stops watching a body; call it before dBodyDestroy. Errors: SS_ERROR_OUT_OF_RANGE (NULL), SS_ERROR_NOT_FOUND. */
 ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body);
 
+/** Destroys a body safely: stops watching it, removes its damping and auto-disable bindings from the registry,
+ *  then calls dBodyDestroy. Use it instead of dBodyDestroy for any body the stepper knows: ODE gives no way to tell
+ *  a destroyed body from a live one, so the stepper and the registry would read freed memory (a sanitizer build
+ *  reports it as heap-use-after-free). Joints attached to it stay bound; ODE detaches them.
+ *  Errors, with nothing destroyed: SS_ERROR_OUT_OF_RANGE (stepper or body NULL). */
+ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body);
+
+/** Destroys a joint safely: removes its bindings from the registry, then calls dJointDestroy. Use it instead of
+ *  dJointDestroy for a bound or adopted joint (contact joints in the contact group need nothing).
+ *  Errors, with nothing destroyed: SS_ERROR_OUT_OF_RANGE (stepper or joint NULL). */
+ssStatus ssStepper_DestroyJoint(ssStepper* stepper, dJointID joint);
+
 /** Forgets the previous step length, so the next step of SS_POLICY_EXACT maps the bodies' true velocities. Call it
  *  after teleporting a body or setting its velocity. NULL is a no-op. */
 void ssStepper_ResetHistory(ssStepper* stepper);
