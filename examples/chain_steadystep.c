@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
   exampleHeader(&flags, "t_s,end_x_m,end_z_m");
   record(&flags, 0);
   int code = 0;
-  double started_s = exampleWallSeconds();
+  ExampleClock started = exampleClock();
   for (double time_s = 0; time_s < flags.seconds - 1e-12;) {
     double frame_s = fmin(ssProfile_Next(flags.frames), flags.seconds - time_s);
     push(time_s);
@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
       break;
     }
   }
-  exampleFinish(&flags, exampleWallSeconds() - started_s);
+  exampleFinish(&flags, started);
 
   ssStepper_Destroy(stepper);
   ssRegistry_Destroy(registry);

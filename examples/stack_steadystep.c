@@ -147,7 +147,7 @@ int main(int argc, char** argv) {
   exampleHeader(&flags, "t_s,top_z_m,ground_force_N");
   record(&flags, 0);
   int code = 0;
-  double started_s = exampleWallSeconds();
+  ExampleClock started = exampleClock();
   for (double time_s = 0; time_s < flags.seconds - 1e-12;) {
     double frame_s = fmin(ssProfile_Next(flags.frames), flags.seconds - time_s);
     nudge(time_s);
@@ -164,7 +164,7 @@ int main(int argc, char** argv) {
       break;
     }
   }
-  exampleFinish(&flags, exampleWallSeconds() - started_s);
+  exampleFinish(&flags, started);
 
   ssStepper_Destroy(stepper);
   ssRegistry_Destroy(registry);

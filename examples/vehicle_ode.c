@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
   exampleHeader(&flags, "t_s,height_m,pitch_rad");
   record(&flags, 0);
   int code = 0;
-  double started_s = exampleWallSeconds();
+  ExampleClock started = exampleClock();
   for (double time_s = 0; time_s < flags.seconds - 1e-12;) {
     double frame_s = fmin(ssProfile_Next(flags.frames), flags.seconds - time_s);
     drive(time_s);
@@ -140,7 +140,7 @@ int main(int argc, char** argv) {
       break;
     }
   }
-  exampleFinish(&flags, exampleWallSeconds() - started_s);
+  exampleFinish(&flags, started);
 
   dJointGroupDestroy(contacts);
   dSpaceDestroy(space);

@@ -30,7 +30,8 @@ END { printf \"rows %d, largest difference %g\\n\", rows, worst; exit !(rows > 2
 
   # A pass expression overrides the exit code, so the code is printed and matched too.
   add_test(NAME example_${program}_bad_policy
-           COMMAND sh -c "\"$1\" --policy sideways --seconds 1 2>&1; echo exit $?" sh $<TARGET_FILE:${program}_steadystep>)
+           COMMAND sh -c "\"$1\" --policy sideways --seconds 1 2>&1; echo exit $?"
+                   sh $<TARGET_FILE:${program}_steadystep>)
   set_tests_properties(example_${program}_bad_policy PROPERTIES PASS_REGULAR_EXPRESSION
                        "--policy sideways: [^\n]*\nexit 2\n")
   add_test(NAME example_${program}_bad_profile
