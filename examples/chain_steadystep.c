@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
   if (parsed != 0) return parsed < 0 ? 0 : parsed;
   ssPolicy policy;
   if (ssPolicyParse(flags.policy, &policy) != SS_OK)
-    return exampleBadFlag(PROGRAM, "--policy", flags.policy, ssLastError());
+    return exampleRefuse(&flags, PROGRAM, "--policy", flags.policy, ssLastError());
   dInitODE2(0);
   build();
   /* steadystep: adopt what the program tuned at 60 fps (world, joints, bodies), and make the stepper. */

@@ -35,12 +35,12 @@ typedef struct ExampleFlags {
   int boxes;          /* --boxes (stack), > 0 */
 } ExampleFlags;
 
-static int exampleBadFlag(const char* program, const char* flag, const char* value, const char* why) {
+static inline int exampleBadFlag(const char* program, const char* flag, const char* value, const char* why) {
   fprintf(stderr, "%s: %s %s: %s (see --help)\n", program, flag, value, why);
   return 2;
 }
 
-static int exampleNumber(const char* text, double* out) {
+static inline int exampleNumber(const char* text, double* out) {
   char* end;
   errno = 0;
   *out = strtod(text, &end);
@@ -48,7 +48,7 @@ static int exampleNumber(const char* text, double* out) {
 }
 
 /* Fills flags from argv. Returns 0 to run, 2 for a bad flag (message printed), -1 after printing --help. */
-static int exampleParseFlags(const char* program, int argc, char** argv, int accepts, ExampleFlags* flags) {
+static inline int exampleParseFlags(const char* program, int argc, char** argv, int accepts, ExampleFlags* flags) {
   const char* profile = "uniform:15:45";
   double seed = 1;
   *flags = (ExampleFlags){NULL, 10.0, 0, "spring", 1.0 / 60.0, 8};
@@ -101,25 +101,33 @@ static int exampleParseFlags(const char* program, int argc, char** argv, int acc
   return 0;
 }
 
+/* A flag refused after parsing (an adopted program's --policy): frees the profile, returns 2. */
+static inline int exampleRefuse(ExampleFlags* flags, const char* program, const char* flag, const char* value,
+                                const char* why) {
+  ssProfile_Destroy(flags->frames);
+  flags->frames = NULL;
+  return exampleBadFlag(program, flag, value, why);
+}
+
 /* The stepping loop's cost: wall clock and process CPU time (s), from C11's clocks (no POSIX feature macro needed
  * before the program's own includes). */
 typedef struct ExampleClock {
   double wall_s, cpu_s;
 } ExampleClock;
 
-static ExampleClock exampleClock(void) {
+static inline ExampleClock exampleClock(void) {
   struct timespec now;
   timespec_get(&now, TIME_UTC);
   return (ExampleClock){(double)now.tv_sec + 1e-9 * (double)now.tv_nsec, (double)clock() / CLOCKS_PER_SEC};
 }
 
 /* Prints the CSV header unless --quiet. */
-static void exampleHeader(const ExampleFlags* flags, const char* header) {
+static inline void exampleHeader(const ExampleFlags* flags, const char* header) {
   if (!flags->quiet) printf("%s\n", header);
 }
 
 /* Prints one CSV row (unless --quiet) at full precision. Returns 0 when a value is not finite: the frame failed. */
-static int exampleRow(const ExampleFlags* flags, double time_s, int count, const double* values) {
+static inline int exampleRow(const ExampleFlags* flags, double time_s, int count, const double* values) {
   int finite = 1;
   for (int i = 0; i < count; ++i) finite = finite && isfinite(values[i]);
   if (flags->quiet) return finite;
@@ -130,7 +138,7 @@ static int exampleRow(const ExampleFlags* flags, double time_s, int count, const
 }
 
 /* After the loop: under --quiet, the time since started to stderr as "WALL CPU" (s); frees the profile. */
-static void exampleFinish(ExampleFlags* flags, ExampleClock started) {
+static inline void exampleFinish(ExampleFlags* flags, ExampleClock started) {
   ExampleClock now = exampleClock();
   if (flags->quiet) fprintf(stderr, "%.9f %.9f\n", now.wall_s - started.wall_s, now.cpu_s - started.cpu_s);
   ssProfile_Destroy(flags->frames);

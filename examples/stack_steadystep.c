@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   if (parsed != 0) return parsed < 0 ? 0 : parsed;
   ssPolicy policy;
   if (ssPolicyParse(flags.policy, &policy) != SS_OK)
-    return exampleBadFlag(PROGRAM, "--policy", flags.policy, ssLastError());
+    return exampleRefuse(&flags, PROGRAM, "--policy", flags.policy, ssLastError());
   box_count = flags.boxes;
   boxes = calloc((size_t)box_count, sizeof *boxes);
   ground_feedback = calloc((size_t)box_count * MAX_CONTACTS, sizeof *ground_feedback);
