@@ -185,7 +185,9 @@ TEST_F(AdoptTest, OdeDefaultsAreAdoptedLikeTunedValues) {
     EXPECT_NEAR(dJointGetBallParam(ball, dParamCFM), cfm, 1e-12 * cfm);
     EXPECT_NEAR(dJointGetBallParam(ball, dParamERP), erp, 1e-12);
     // near-rigid: far above the step's Nyquist frequency, so the accurate mappings hand the rows to spring
-    if (mapping != SS_MAPPING_SPRING) EXPECT_GE(applied.rows_spring_fallback, 2) << ssMappingName(mapping);
+    if (mapping != SS_MAPPING_SPRING) {
+      EXPECT_GE(applied.rows_spring_fallback, 2) << ssMappingName(mapping);
+    }
   }
 }
 
