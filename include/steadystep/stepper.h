@@ -169,7 +169,7 @@ ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body);
 /** Destroys a body safely: stops watching it, removes its damping and auto-disable bindings from the registry,
  *  then calls dBodyDestroy. Use it instead of dBodyDestroy for any body the stepper knows: ODE gives no way to tell
  *  a destroyed body from a live one, so the stepper and the registry would read freed memory (a sanitizer build
- *  reports it as heap-use-after-free). Joints attached to it stay bound; ODE detaches them.
+ *  stops there with a report). Joints attached to it stay bound; ODE detaches them.
  *  Errors, with nothing destroyed: SS_ERROR_OUT_OF_RANGE (stepper or body NULL). */
 ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body);
 

@@ -247,7 +247,8 @@ TEST_F(DestroyTest, BoundAndWatchedObjectsAreDestroyedThroughTheStepper) {
 
 #if STEADYSTEP_TESTS_SANITIZED
 // Forgetting it cannot be detected by the library (ODE has no way to tell a freed joint from a live one); a
-// sanitizer build catches the read of freed memory at the next step.
+// sanitizer build stops at the next step with a report that points at the registry's read of the freed joint
+// (ODE itself is not instrumented, so the report is a use-after-free or a wild read, by what the memory holds).
 TEST_F(DestroyTest, ForgettingItIsCaughtByTheSanitizer) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   EXPECT_DEATH(
@@ -266,7 +267,7 @@ TEST_F(DestroyTest, ForgettingItIsCaughtByTheSanitizer) {
         dJointDestroy(slider);  // behind the registry's back
         ssStepper_Step(stepper, 0.05, nullptr);
       },
-      "heap-use-after-free");
+      "AddressSanitizer: (heap-use-after-free|SEGV)");
 }
 #endif
 
