@@ -2,7 +2,10 @@
  * stepped through ssStepper_Step versus plain dWorldQuickStep with the same parameters set once. Two identical
  * worlds are stepped in alternating blocks so that both see the same machine; the ratio is measured in this run.
  *
- *   bench_stepper [frames]      (default 600 frames, each 1/90 to 1/60 s) */
+ * The order of the worlds rotates from block to block, and the whole measurement is repeated: the median ratio and
+ * its range over the repeats are printed.
+ *
+ *   bench_stepper [frames] [repeats]      (default 300 frames, 7 repeats) */
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
@@ -87,61 +90,84 @@ static double stepBlock(Scene* scene, int with_stepper, const double* frames_s, 
   return nowSeconds() - start;
 }
 
-typedef struct Ratios {
-  double plain_s, spring_s, matched_s;
-} Ratios;
+enum { kWorlds = 4 }; /* plain, spring, matched, exact */
+static const char* const kWorldNames[kWorlds] = {"plain dWorldQuickStep", "ssStepper_Step, spring",
+                                                 "ssStepper_Step, matched", "ssStepper_Step, exact"};
 
-/* Steps three fresh worlds through the same frames in alternating blocks. profile = NULL: constant 1/60 s frames. */
-static Ratios measure(const char* profile_spec, int frames) {
-  Scene plain = build(0), stepped = build(1), matched = build(1);
-  check(ssStepper_SetPolicy(matched.stepper, SS_POLICY_MATCHED), "policy");
+/* One repeat: four fresh worlds stepped through the same frames, interleaved block by block so that all four see
+ * the same machine. profile = NULL: constant 1/60 s frames. Returns the seconds of each world. */
+static void measure(const char* profile_spec, int frames, double seconds[kWorlds]) {
+  Scene scenes[kWorlds] = {build(0), build(1), build(1), build(1)};
+  check(ssStepper_SetPolicy(scenes[2].stepper, SS_POLICY_MATCHED), "policy");
+  check(ssStepper_SetPolicy(scenes[3].stepper, SS_POLICY_EXACT), "policy");
   ssProfile* profile = NULL;
   if (profile_spec) check(ssProfile_Create(profile_spec, 1, &profile), "profile");
   double frames_s[kBlock];
-  Ratios seconds = {0, 0, 0};
-  for (int done = 0; done < frames; done += kBlock) {
+  for (int w = 0; w < kWorlds; ++w) seconds[w] = 0;
+  for (int done = 0, block = 0; done < frames; done += kBlock, ++block) {
     for (int i = 0; i < kBlock; ++i) frames_s[i] = profile ? ssProfile_Next(profile) : kFrame_s;
-    seconds.plain_s += stepBlock(&plain, 0, frames_s, kBlock);
-    seconds.spring_s += stepBlock(&stepped, 1, frames_s, kBlock);
-    seconds.matched_s += stepBlock(&matched, 1, frames_s, kBlock);
+    for (int k = 0; k < kWorlds; ++k) {
+      int w = (k + block) % kWorlds; /* rotate the order: none is always first after the frame times change */
+      seconds[w] += stepBlock(&scenes[w], w > 0, frames_s, kBlock);
+    }
   }
   ssProfile_Destroy(profile);
-  Scene* scenes[] = {&plain, &stepped, &matched};
-  for (int i = 0; i < 3; ++i) {
-    ssStepper_Destroy(scenes[i]->stepper);
-    ssRegistry_Destroy(scenes[i]->registry);
-    dWorldDestroy(scenes[i]->world);
+  for (int w = 0; w < kWorlds; ++w) {
+    ssStepper_Destroy(scenes[w].stepper);
+    ssRegistry_Destroy(scenes[w].registry);
+    dWorldDestroy(scenes[w].world);
   }
-  return seconds;
 }
 
-static void print(const char* title, Ratios s, int steps) {
-  printf("%s\n", title);
-  printf("  plain dWorldQuickStep      %8.1f us/step\n", 1e6 * s.plain_s / steps);
-  printf("  ssStepper_Step, spring     %8.1f us/step   ratio %.3f (target <= 1.02)\n", 1e6 * s.spring_s / steps,
-         s.spring_s / s.plain_s);
-  printf("  ssStepper_Step, matched    %8.1f us/step   ratio %.3f (effective masses computed every step)\n",
-         1e6 * s.matched_s / steps, s.matched_s / s.plain_s);
+static int compareDoubles(const void* a, const void* b) {
+  double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
+/* Repeats the measurement and prints, for each stepped world, the median ratio to plain ODE and its range. */
+static void report(const char* title, const char* profile_spec, int frames, int repeats) {
+  double ratios[kWorlds][64], plain_us = 0;
+  for (int r = 0; r < repeats; ++r) {
+    double seconds[kWorlds];
+    measure(profile_spec, frames, seconds);
+    for (int w = 1; w < kWorlds; ++w) ratios[w][r] = seconds[w] / seconds[0];
+    plain_us += 1e6 * seconds[0] / frames / repeats;
+  }
+  printf("%s\n  %-26s %8.1f us/frame\n", title, kWorldNames[0], plain_us);
+  for (int w = 1; w < kWorlds; ++w) {
+    qsort(ratios[w], (size_t)repeats, sizeof(double), compareDoubles);
+    printf("  %-26s median ratio %.3f   (%.3f to %.3f over %d repeats)\n", kWorldNames[w], ratios[w][repeats / 2],
+           ratios[w][0], ratios[w][repeats - 1], repeats);
+  }
 }
 
 int main(int argc, char** argv) {
-  int frames = argc > 1 ? atoi(argv[1]) : 600;
-  if (frames <= 0) {
-    fprintf(stderr, "bench_stepper: frames must be a positive whole number\n");
+  int frames = argc > 1 ? atoi(argv[1]) : 300;
+  int repeats = argc > 2 ? atoi(argv[2]) : 7;
+  if (frames <= 0 || repeats <= 0 || repeats > 64) {
+    fprintf(stderr, "usage: bench_stepper [frames > 0] [repeats 1..64]\n");
     return 2;
   }
   dInitODE2(0);
-  int steps = (frames + kBlock - 1) / kBlock * kBlock;
-  printf("bench_stepper: %d bodies in %d chains, %d soft parameter sets, %d frames, QuickStep 20 iterations\n",
-         kChains * kLinks, kChains, 2 * kChains * kLinks, steps);
-  print("frames of 1/60 s (the same motion in all three worlds):", measure(NULL, frames), steps);
-  print("frames of 1/90 to 1/60 s (every value rewritten every step):", measure("uniform:60:90", frames), steps);
+  frames = (frames + kBlock - 1) / kBlock * kBlock;
+  printf("bench_stepper: %d bodies in %d chains, %d soft parameter sets, %d frames a repeat, QuickStep 20 iterations\n"
+         "targets: spring <= 1.02, matched and exact <= 1.05\n",
+         kChains * kLinks, kChains, 2 * kChains * kLinks, frames);
+  report("frames of 1/60 s:", NULL, frames, repeats);
+  report("frames of 1/90 to 1/60 s (every value rewritten every frame):", "uniform:60:90", frames, repeats);
 
   /* the registry alone, every value recomputed and rewritten */
-  Scene scene = build(1);
-  double start = nowSeconds();
-  for (int i = 0; i < steps; ++i)
-    check(ssRegistry_Apply(scene.registry, SS_MAPPING_SPRING, i % 2 ? kFrame_s : 0.5 * kFrame_s, 0, NULL), "apply");
-  printf("ssRegistry_Apply alone, 2000 sets rewritten: %.1f us/step\n", 1e6 * (nowSeconds() - start) / steps);
+  for (int m = SS_MAPPING_SPRING; m <= SS_MAPPING_EXACT; ++m) {
+    Scene scene = build(1);
+    double start = nowSeconds();
+    for (int i = 0; i < frames; ++i)
+      check(ssRegistry_Apply(scene.registry, (ssMapping)m, i % 2 ? kFrame_s : 0.5 * kFrame_s, kFrame_s, NULL),
+            "apply");
+    printf("ssRegistry_Apply alone, %-7s 2000 sets: %.1f us\n", ssMappingName((ssMapping)m),
+           1e6 * (nowSeconds() - start) / frames);
+    ssStepper_Destroy(scene.stepper);
+    ssRegistry_Destroy(scene.registry);
+    dWorldDestroy(scene.world);
+  }
   return 0;
 }
