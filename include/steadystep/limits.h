@@ -21,7 +21,8 @@
  *                 on h; finite from 1e-300 kg to 1e100 kg (inertia scaled alike).
  * The bounds below sit many orders of magnitude inside those edges, at values no physical program needs to pass,
  * so that products with a state that has not (yet) blown up stay finite too. tests/c/test_limits.cpp runs the
- * probe at every corner of these ranges and checks that ODE neither aborts nor loses finiteness.
+ * probe at every corner of these ranges (10 steps from near rest, and one step from SS_MAX_SAFE_SPEED) and checks
+ * that ODE neither aborts nor loses finiteness; and that it does abort at h = 1e-200 s, so the probe can fail.
  */
 #ifndef STEADYSTEP_LIMITS_H
 #define STEADYSTEP_LIMITS_H
@@ -35,8 +36,10 @@
 #define SS_MAX_STEP_S 1e3
 
 /** The largest |erp| (non-dimensional) handed to ODE: 1e9. The matched and exact mappings may exceed 1 (ODE
- *  accepts that); this bound keeps erp·error/h² finite at SS_MIN_STEP_S for any error below 1e270 m, and keeps a
- *  runaway row growing slowly enough for a speed guard to see it. ODE aborts from about 1e50. */
+ *  accepts that; their cfm keeps the row stable). This bound keeps erp·error/h² finite at SS_MIN_STEP_S for any
+ *  error below 1e270 m. A row with erp far above 2 and a small cfm is unstable and grows by about |erp| a step:
+ *  at erp = 1e9, cfm = 0 the probe aborts within 30 steps, so a stepper must stop such a runaway while it is still
+ *  finite (SS_MAX_SAFE_SPEED). ODE aborts from about erp = 1e50 within 10 steps. */
 #define SS_MAX_ERP 1e9
 
 /** The largest cfm (m/(N·s) for a linear row; what ODE multiplies the row force by) handed to ODE: 1e20, i.e. a
@@ -45,10 +48,18 @@
 #define SS_MAX_CFM 1e20
 
 /** The lightest and heaviest body mass (kg) the library hands to ODE (dBodySetMass): 1e-12 kg to 1e12 kg. ODE aborts
- *  on 1e-320 kg (a denormal, whose inverse is infinite) and from about 1e140 kg. Principal moments of inertia
- *  (kg·m²) must lie in the same range. */
+ *  on 1e-320 kg (a denormal, whose inverse is infinite) and from about 1e140 kg (probed with inertia in kg·m² equal
+ *  to the mass in kg). The margins, 1e288 below and 1e128 above, leave room for a body's inertia, mass times the
+ *  square of its size. */
 #define SS_MIN_MASS_KG 1e-12
 #define SS_MAX_MASS_KG 1e12
+
+/** The speed (m/s for a body's linear velocity, rad/s for its angular velocity) below which one step at any corner
+ *  of the ranges above stays finite: 1e50. ODE aborts instead of returning a non-finite state (dxNormalize4 on
+ *  the orientation), so a blow-up must be caught while the state is finite: a stepper that refuses to step once
+ *  any body is faster than this never hands ODE a state it cannot step. Probed: one step from speeds of 1e80 is
+ *  finite at all 64 corners (both solvers, h, erp, cfm and mass at their bounds); from 1e90, 16 of them abort. */
+#define SS_MAX_SAFE_SPEED 1e50
 
 /** The shortest and longest frame (s) a lab profile hands out (profile.h): 1e-12 s to SS_MAX_STEP_S. Frames
  *  shorter than SS_MIN_STEP_S are allowed on purpose, to exercise carrying a frame over. */
