@@ -38,7 +38,3 @@ ssStatus ssCheckComputedSoftness(const char* name, ssSoftness softness) {
 ssStatus ssCheckMass(const char* name, double mass_kg) {
   return check_range(name, " kg", mass_kg, SS_MIN_MASS_KG, SS_MAX_MASS_KG);
 }
-
-ssStatus ssCheckInertia(const char* name, double inertia_kg_m2) {
-  return check_range(name, " kg*m^2", inertia_kg_m2, SS_MIN_MASS_KG, SS_MAX_MASS_KG);
-}

@@ -24,7 +24,4 @@ ssStatus ssCheckComputedSoftness(const char* name, ssSoftness softness);
 /* A body mass (kg) for dBodySetMass: finite and in [SS_MIN_MASS_KG, SS_MAX_MASS_KG]. */
 ssStatus ssCheckMass(const char* name, double mass_kg);
 
-/* A principal moment of inertia (kg·m²): finite and in [SS_MIN_MASS_KG, SS_MAX_MASS_KG] (numerically). */
-ssStatus ssCheckInertia(const char* name, double inertia_kg_m2);
-
 #endif
