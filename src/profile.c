@@ -2,7 +2,7 @@
  *
  * Parsing is strict on purpose: a profile that silently read "fixed:3O" as 3 fps would make a whole report wrong,
  * so every field must be one complete number and every refusal names the spec and the field. Every frame handed
- * out lies in [SS_MIN_FRAME_S, SS_MAX_FRAME_S] (limits.h): the spec is refused when its frames could leave it.
+ * out lies in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S] (limits.h): the spec is refused when its frames could leave it.
  * Specs, paths and trace lines are quoted in messages with every byte outside printable ASCII written as \xNN, so
  * a message is ASCII whatever bytes came in (Python decodes it as text). */
 #include "steadystep/profile.h"
@@ -111,12 +111,12 @@ static ssStatus check_positive(const char* raw_spec, const char* field, double v
   return SS_OK;
 }
 
-/* A frame length (s) the field stands for: inside [SS_MIN_FRAME_S, SS_MAX_FRAME_S], or the field is refused. */
+/* A frame length (s) the field stands for: inside [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S], or the field is refused. */
 static ssStatus check_frame(const char* raw_spec, const char* field, double field_value, double frame_s) {
   char spec[96];
-  if (!(frame_s >= SS_MIN_FRAME_S && frame_s <= SS_MAX_FRAME_S))
+  if (!(frame_s >= SS_MIN_PROFILE_FRAME_S && frame_s <= SS_MAX_PROFILE_FRAME_S))
     return ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": %s = %g gives frames of %g s, outside [%g, %g] s",
-                  SPEC_TEXT(raw_spec, spec), field, field_value, frame_s, SS_MIN_FRAME_S, SS_MAX_FRAME_S);
+                  SPEC_TEXT(raw_spec, spec), field, field_value, frame_s, SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S);
   return SS_OK;
 }
 
@@ -197,9 +197,9 @@ static ssStatus parse_trace_line(const char* path_text, long number, char* line,
   if (end == text || *end != '\0' || !isfinite(parsed) || parsed <= 0)
     return ssFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: \"%s\" is not a positive finite duration in seconds",
                   path_text, number, escaped(text, strlen(text), line_text, sizeof line_text));
-  if (!(parsed >= SS_MIN_FRAME_S && parsed <= SS_MAX_FRAME_S))
+  if (!(parsed >= SS_MIN_PROFILE_FRAME_S && parsed <= SS_MAX_PROFILE_FRAME_S))
     return ssFail(SS_ERROR_OUT_OF_RANGE, "trace \"%s\" line %ld: %g s is outside [%g, %g] s", path_text, number,
-                  parsed, SS_MIN_FRAME_S, SS_MAX_FRAME_S);
+                  parsed, SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S);
   *value = parsed;
   *has_value = 1;
   return SS_OK;

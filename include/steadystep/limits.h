@@ -28,12 +28,14 @@
 #define STEADYSTEP_LIMITS_H
 
 /** The shortest step (s) the library hands to dWorldStep or dWorldQuickStep: a nanosecond. ODE aborts below about
- *  1e-155 s, where (1/h)² overflows. A frame shorter than this is carried over, never stepped. */
+ *  1e-155 s, where (1/h)² overflows. A frame shorter than this is carried over, never stepped. (stepper.h defines
+ *  the same macro with the same tokens, which C allows; one of the two should go.) */
 #define SS_MIN_STEP_S 1e-9
 
-/** The longest step (s): 1000 s. ODE keeps a falling world finite to about 1e50 s; a step is a product of h with
+/** The longest step (s): an hour, the longest frame the stepper takes (SS_MAX_FRAME_S in stepper.h), which the
+ *  naive policy steps whole. ODE keeps a falling world finite to about 1e50 s; a step is a product of h with
  *  speeds and forces, so the bound keeps a wide margin for states far from rest. */
-#define SS_MAX_STEP_S 1e3
+#define SS_MAX_STEP_S 3600.0
 
 /** The largest |erp| (non-dimensional) handed to ODE: 1e9. The matched and exact mappings may exceed 1 (ODE
  *  accepts that; their cfm keeps the row stable). This bound keeps erp·error/h² finite at SS_MIN_STEP_S for any
@@ -63,8 +65,8 @@
 
 /** The shortest and longest frame (s) a lab profile hands out (profile.h): 1e-12 s to SS_MAX_STEP_S. Frames
  *  shorter than SS_MIN_STEP_S are allowed on purpose, to exercise carrying a frame over. */
-#define SS_MIN_FRAME_S 1e-12
-#define SS_MAX_FRAME_S SS_MAX_STEP_S
+#define SS_MIN_PROFILE_FRAME_S 1e-12
+#define SS_MAX_PROFILE_FRAME_S SS_MAX_STEP_S
 
 /** A lab run (scene.h) takes at most this many frames and this many physics steps: 10^7 each. A run records 2 + 4
  *  doubles per step, so the largest run holds about 480 MB. A run expected to need more is refused before it

@@ -15,9 +15,9 @@
  *                             SS_MAX_TRACE_LINE_CHARS characters and no NUL byte, at most SS_MAX_TRACE_FRAMES
  *                             durations
  * Rates are in frames per second (> 0), durations in seconds (> 0). Every frame a profile hands out is finite and
- * lies in [SS_MIN_FRAME_S, SS_MAX_FRAME_S] = [1e-12 s, 1000 s] (limits.h): a spec whose frames could leave that
- * range is refused, naming the field (so a rate is in [1e-3, 1e12] fps, a jitter's mean ± 3 deviations and a
- * hitch's SECONDS inside the range, EVERY a whole number in [1, 1e9]).
+ * lies in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S] = [1e-12 s, 3600 s] (limits.h): a spec whose frames
+ * could leave that range is refused, naming the field (so a rate is in [1/3600, 1e12] fps, a jitter's mean ± 3
+ * deviations and a hitch's SECONDS inside the range, EVERY a whole number in [1, 1e9]).
  * Messages quote the spec, path and trace line with bytes outside printable ASCII written as \xNN.
  */
 #ifndef STEADYSTEP_PROFILE_H
@@ -43,7 +43,7 @@ typedef struct ssProfile ssProfile;
  *  Errors (*out untouched): SS_ERROR_OUT_OF_RANGE for spec = NULL or out = NULL; SS_ERROR_PARSE naming the spec
  *  and the part at fault (unknown kind, missing or extra field, a number that does not parse), SS_ERROR_NOT_FINITE
  *  (a field that reads as nan or inf), SS_ERROR_OUT_OF_RANGE (a rate or duration <= 0 or giving frames outside
- *  [SS_MIN_FRAME_S, SS_MAX_FRAME_S], min above max, spread too large, EVERY not a whole number in [1, 1e9]),
+ *  [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S], min above max, spread too large, EVERY not a whole number in [1, 1e9]),
  *  SS_ERROR_IO (trace file missing, unreadable, not a regular file or larger than SS_MAX_TRACE_BYTES, named),
  *  SS_ERROR_PARSE for a malformed trace line (with its number: not a number, a NUL byte, too long),
  *  SS_ERROR_OUT_OF_RANGE for a trace duration outside the frame range or more than SS_MAX_TRACE_FRAMES of them,
@@ -53,7 +53,7 @@ ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out);
 /** Destroys the profile. NULL is a no-op. */
 void ssProfile_Destroy(ssProfile* profile);
 
-/** The next frame duration (s), finite and in [SS_MIN_FRAME_S, SS_MAX_FRAME_S].
+/** The next frame duration (s), finite and in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S].
  *  profile = NULL: returns NaN (which every consumer refuses) and records "profile = NULL: ..." for ssLastError(). */
 double ssProfile_Next(ssProfile* profile);
 

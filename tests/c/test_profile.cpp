@@ -210,7 +210,7 @@ TEST(Profile, NullHandlesAndOutputsAreRefusedByName) {
 
 TEST(Profile, FramesOutsideTheFrameRangeAreRefusedNamingTheField) {
   ExpectRefused("fixed:1e-320", SS_ERROR_OUT_OF_RANGE, "FPS = 9.99989e-321 gives frames of inf s");
-  ExpectRefused("fixed:1e-4", SS_ERROR_OUT_OF_RANGE, "FPS = 0.0001");
+  ExpectRefused("fixed:2e-4", SS_ERROR_OUT_OF_RANGE, "FPS = 0.0002");
   ExpectRefused("fixed:1e13", SS_ERROR_OUT_OF_RANGE, "FPS = 1e+13");
   ExpectRefused("uniform:1e-320:30", SS_ERROR_OUT_OF_RANGE, "MINFPS = 9.99989e-321");
   ExpectRefused("uniform:15:1e300", SS_ERROR_OUT_OF_RANGE, "MAXFPS = 1e+300");
@@ -219,13 +219,13 @@ TEST(Profile, FramesOutsideTheFrameRangeAreRefusedNamingTheField) {
   ExpectRefused("hitch:60:5:1e4", SS_ERROR_OUT_OF_RANGE, "SECONDS = 10000");
   ExpectRefused("hitch:60:5:1e-300", SS_ERROR_OUT_OF_RANGE, "SECONDS = 1e-300");
   ExpectRefused("vsync:60:1e-320", SS_ERROR_OUT_OF_RANGE, "FPS_B = 9.99989e-321");
-  ExpectRefused("jitter:1e-3:1e5", SS_ERROR_OUT_OF_RANGE, "SPREAD_MS");
+  ExpectRefused("jitter:3e-4:1e6", SS_ERROR_OUT_OF_RANGE, "SPREAD_MS = 1e+06 gives frames of 6333");
   // the edges themselves are served
-  for (const char* spec : {"fixed:1e-3", "fixed:1e12", "hitch:60:1e9:1000", "uniform:1e-3:1e12"}) {
+  for (const char* spec : {"fixed:2.8e-4", "fixed:1e12", "hitch:60:1e9:3600", "uniform:2.8e-4:1e12"}) {
     ssProfile* profile = Make(spec);
     for (double frame : Draw(profile, 100)) {
-      EXPECT_GE(frame, SS_MIN_FRAME_S) << spec;
-      EXPECT_LE(frame, SS_MAX_FRAME_S) << spec;
+      EXPECT_GE(frame, SS_MIN_PROFILE_FRAME_S) << spec;
+      EXPECT_LE(frame, SS_MAX_PROFILE_FRAME_S) << spec;
     }
     ssProfile_Destroy(profile);
   }
@@ -262,8 +262,8 @@ TEST(Profile, EveryAcceptedSpecHandsOutFramesInsideTheRange) {
     ++accepted;
     for (double frame : Draw(profile, 200)) {
       ASSERT_TRUE(std::isfinite(frame)) << spec;
-      ASSERT_GE(frame, SS_MIN_FRAME_S) << spec;
-      ASSERT_LE(frame, SS_MAX_FRAME_S) << spec;
+      ASSERT_GE(frame, SS_MIN_PROFILE_FRAME_S) << spec;
+      ASSERT_LE(frame, SS_MAX_PROFILE_FRAME_S) << spec;
     }
     ssProfile_Destroy(profile);
   }
