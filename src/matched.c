@@ -13,8 +13,10 @@
  *    x_(n+1) = (1 + (aρ - erp)/(1+a))·x_n - aρ/(1+a)·x_(n-1), so a = -β/(ρ + β), erp = aρ - (α - 1)(1 + a).
  *    Without history (h_p = 0) the step maps the true (x0, v0): a/(1+a) = e^(-σh)S(h)/h, erp = (1 - φ11)(1 + a). */
 #include <math.h>
+#include <stddef.h>
 
 #include "error.h"
+#include "ode_bounds.h"
 #include "steadystep/spring.h"
 
 /* e^(-σt)·C(t) and e^(-σt)·S(t), and C(t)/S(t), computed without overflow for strongly over-damped springs and
@@ -42,10 +44,11 @@ static Propagator propagate(double sigma, double q, double t) {
   return (Propagator){0.5 * (slow + fast), (slow - fast) / (2.0 * mu), mu / tanh(mu * t)};
 }
 
-static ssStatus validate(ssSpring spring, double mass, double step_s) {
+static ssStatus validate(ssSpring spring, double mass, double step_s, const ssSoftness* out) {
+  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: the mapping needs somewhere to write");
   ssStatus status = ssValidateSpring(spring);
   if (status == SS_OK) status = ssCheckPositive("mass", "kg", mass);
-  if (status == SS_OK) status = ssCheckPositive("step_s", "s", step_s);
+  if (status == SS_OK) status = ssCheckStepLength("step_s", step_s);
   if (status != SS_OK) return status;
   if (spring.damping == 0)
     return ssFail(SS_ERROR_NO_FINITE_MAPPING,
@@ -53,17 +56,20 @@ static ssStatus validate(ssSpring spring, double mass, double step_s) {
   return SS_OK;
 }
 
+/* Every exit with a result passes here: NaN, infinities and values beyond ODE's range (limits.h) from any
+ * intermediate overflow or underflow end as a refusal, never as output. */
 static ssStatus finish(double a, double erp, double step_s, double mass, ssSoftness* out) {
   double cfm = a * step_s / mass;
-  if (!(isfinite(erp) && isfinite(cfm) && cfm > 0))
-    return ssFail(SS_ERROR_NO_FINITE_MAPPING, "step_s = %g s gives erp = %g, cfm = %g: not a usable softness", step_s,
-                  erp, cfm);
+  if (!(isfinite(erp) && isfinite(cfm) && cfm > 0 && cfm <= SS_MAX_CFM && fabs(erp) <= SS_MAX_ERP))
+    return ssFail(SS_ERROR_NO_FINITE_MAPPING,
+                  "step_s = %g s gives erp = %g, cfm = %g: not a usable softness (finite, |erp| <= %g, 0 < cfm <= %g)",
+                  step_s, erp, cfm, SS_MAX_ERP, SS_MAX_CFM);
   *out = (ssSoftness){.erp = erp, .cfm = cfm};
   return SS_OK;
 }
 
 ssStatus ssMatchedSoftness(ssSpring spring, double mass, double step_s, ssSoftness* out) {
-  ssStatus status = validate(spring, mass, step_s);
+  ssStatus status = validate(spring, mass, step_s, out);
   if (status != SS_OK) return status;
   double sigma = spring.damping / (2.0 * mass);
   double q = spring.stiffness / mass - sigma * sigma;
@@ -76,8 +82,9 @@ ssStatus ssMatchedSoftness(ssSpring spring, double mass, double step_s, ssSoftne
 }
 
 ssStatus ssExactSoftness(ssSpring spring, double mass, double step_s, double previous_step_s, ssSoftness* out) {
-  ssStatus status = validate(spring, mass, step_s);
+  ssStatus status = validate(spring, mass, step_s, out);
   if (status == SS_OK) status = ssCheckNonNegative("previous_step_s", "s", previous_step_s);
+  if (status == SS_OK && previous_step_s != 0) status = ssCheckStepLength("previous_step_s", previous_step_s);
   if (status != SS_OK) return status;
   double sigma = spring.damping / (2.0 * mass);
   double q = spring.stiffness / mass - sigma * sigma;

@@ -1,18 +1,26 @@
 /* Frame-time profiles: the sequences of frame durations a renderer produces, parsed from a text spec.
  *
  * Parsing is strict on purpose: a profile that silently read "fixed:3O" as 3 fps would make a whole report wrong,
- * so every field must be one complete number and every refusal names the spec and the field. */
+ * so every field must be one complete number and every refusal names the spec and the field. Every frame handed
+ * out lies in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S] (limits.h): the spec is refused when its frames could leave it.
+ * Specs, paths and trace lines are quoted in messages with every byte outside printable ASCII written as \xNN, so
+ * a message is ASCII whatever bytes came in (Python decodes it as text). */
 #include "steadystep/profile.h"
 
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "error.h"
+#include "profile_internal.h"
 #include "rng.h"
+#include "steadystep/limits.h"
 
 typedef enum ssProfileKind {
   SS_PROFILE_FIXED,
@@ -55,58 +63,179 @@ static const ssKindDesc kinds[] = {
     {"trace", SS_PROFILE_TRACE, 1, {"FILE"}},
 };
 
+/* text[0..length) as printable ASCII, other bytes as \xNN, cut with "..." to fit out (at least 8 bytes). */
+static const char* escaped(const char* text, size_t length, char* out, size_t out_size) {
+  size_t used = 0;
+  for (size_t i = 0; i < length; ++i) {
+    unsigned char byte = (unsigned char)text[i];
+    int printable = byte >= 0x20 && byte < 0x7f && byte != '\\';
+    size_t need = printable ? 1 : 4;
+    if (used + need + 4 > out_size) {
+      memcpy(out + used, "...", 4);
+      return out;
+    }
+    if (printable)
+      out[used++] = (char)byte;
+    else
+      used += (size_t)snprintf(out + used, 5, "\\x%02x", byte);
+  }
+  out[used] = '\0';
+  return out;
+}
+
+/* The spec for messages, escaped; a buffer per call site keeps this free of shared state. */
+#define SPEC_TEXT(spec, buffer) escaped((spec), strlen(spec), (buffer), sizeof(buffer))
+
 /* A whole token as a number: "" , "3x", "3 " are malformed; nan and inf parse but are not finite. */
-static ssStatus parse_number(const char* spec, const char* field, const char* token, double* out) {
+static ssStatus parse_number(const char* raw_spec, const char* field, const char* token, double* out) {
+  char spec[96], token_text[96];
+  SPEC_TEXT(raw_spec, spec);
+  escaped(token, strlen(token), token_text, sizeof token_text);
   if (token[0] == '\0') return ssFail(SS_ERROR_PARSE, "profile \"%s\": %s is empty", spec, field);
   char* end = NULL;
   errno = 0;
   double value = strtod(token, &end);
   if (end == token || *end != '\0' || isspace((unsigned char)token[0]))
-    return ssFail(SS_ERROR_PARSE, "profile \"%s\": %s = \"%s\" is not a number", spec, field, token);
+    return ssFail(SS_ERROR_PARSE, "profile \"%s\": %s = \"%s\" is not a number", spec, field, token_text);
   if (!isfinite(value))
-    return ssFail(SS_ERROR_NOT_FINITE, "profile \"%s\": %s = %s: must be finite", spec, field, token);
+    return ssFail(SS_ERROR_NOT_FINITE, "profile \"%s\": %s = %s: must be finite", spec, field, token_text);
   *out = value;
   return SS_OK;
 }
 
-static ssStatus check_positive(const char* spec, const char* field, double value) {
-  if (value <= 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": %s = %g: must be positive", spec, field, value);
+static ssStatus check_positive(const char* raw_spec, const char* field, double value) {
+  char spec[96];
+  if (value <= 0)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": %s = %g: must be positive", SPEC_TEXT(raw_spec, spec),
+                  field, value);
   return SS_OK;
 }
 
-/* Reads a trace file: one duration (s) per line, blank lines and # comments skipped. */
-static ssStatus read_trace(const char* spec, const char* path, double** values_out, long* count_out) {
-  FILE* file = fopen(path, "r");
-  if (file == NULL)
-    return ssFail(SS_ERROR_IO, "profile \"%s\": trace file \"%s\" cannot be opened: %s", spec, path, strerror(errno));
+/* A frame length (s) the field stands for: inside [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S], or the field is refused. */
+static ssStatus check_frame(const char* raw_spec, const char* field, double field_value, double frame_s) {
+  char spec[96];
+  if (!(frame_s >= SS_MIN_PROFILE_FRAME_S && frame_s <= SS_MAX_PROFILE_FRAME_S))
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": %s = %g gives frames of %g s, outside [%g, %g] s",
+                  SPEC_TEXT(raw_spec, spec), field, field_value, frame_s, SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S);
+  return SS_OK;
+}
+
+/* A rate (frames per second) whose frames 1/rate must lie in the frame range. */
+static ssStatus check_rate(const char* spec, const char* field, double rate) {
+  ssStatus status = check_positive(spec, field, rate);
+  if (status == SS_OK) status = check_frame(spec, field, rate, 1.0 / rate);
+  return status;
+}
+
+/* Reads at most SS_MAX_TRACE_BYTES + 1 bytes of a regular file into a NUL-terminated buffer: a device (/dev/zero),
+ * a pipe or a file that keeps growing is refused, never read forever. */
+static ssStatus read_bounded(const char* path_text, const char* raw_path, char** text_out, size_t* length_out) {
+  /* Non-blocking, so that opening a FIFO without a writer returns at once instead of waiting for one. */
+  int fd = open(raw_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return ssFail(SS_ERROR_IO, "trace \"%s\" cannot be opened: %s", path_text, strerror(errno));
+  struct stat info;
+  if (fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
+    close(fd);
+    return ssFail(SS_ERROR_IO, "trace \"%s\": not a regular file (devices and pipes are not read)", path_text);
+  }
+  if (info.st_size > SS_MAX_TRACE_BYTES) {
+    close(fd);
+    return ssFail(SS_ERROR_IO, "trace \"%s\": %lld bytes, larger than %d", path_text, (long long)info.st_size,
+                  SS_MAX_TRACE_BYTES);
+  }
+  FILE* file = fdopen(fd, "rb");
+  if (file == NULL) {
+    close(fd);
+    return ssFail(SS_ERROR_IO, "trace \"%s\" cannot be read: %s", path_text, strerror(errno));
+  }
+  /* Start from the size the file reports and grow to the bound: /proc-like files report 0, growing files more. */
+  size_t capacity = (size_t)(info.st_size < SS_MAX_TRACE_BYTES ? info.st_size : SS_MAX_TRACE_BYTES) + 2;
+  char* text = malloc(capacity);
+  size_t length = 0;
+  ssStatus status = SS_OK;
+  while (text != NULL) {
+    length += fread(text + length, 1, capacity - 1 - length, file);
+    if (length < capacity - 1 || length > SS_MAX_TRACE_BYTES) break; /* the end, or past the bound */
+    size_t grown = 2 * capacity > (size_t)SS_MAX_TRACE_BYTES + 2 ? (size_t)SS_MAX_TRACE_BYTES + 2 : 2 * capacity;
+    char* more = realloc(text, grown);
+    if (more == NULL) free(text);
+    text = more;
+    capacity = grown;
+  }
+  int failed = ferror(file);
+  fclose(file);
+  if (text == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "trace \"%s\": out of memory", path_text);
+  if (failed) status = ssFail(SS_ERROR_IO, "trace \"%s\": read error", path_text);
+  else if (length > SS_MAX_TRACE_BYTES)
+    status = ssFail(SS_ERROR_IO, "trace \"%s\": larger than %d bytes", path_text, SS_MAX_TRACE_BYTES);
+  if (status != SS_OK) {
+    free(text);
+    return status;
+  }
+  text[length] = '\0';
+  *text_out = text;
+  *length_out = length;
+  return SS_OK;
+}
+
+/* One line's duration, or SS_OK with *has_value = 0 for a blank or comment line. line is NUL-terminated. */
+static ssStatus parse_trace_line(const char* path_text, long number, char* line, size_t length, double* value,
+                                 int* has_value) {
+  char line_text[96];
+  *has_value = 0;
+  if (memchr(line, '\0', length) != NULL)
+    return ssFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: contains a NUL byte", path_text, number);
+  if (length > SS_MAX_TRACE_LINE_CHARS)
+    return ssFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: longer than %d characters", path_text, number,
+                  SS_MAX_TRACE_LINE_CHARS);
+  while (length > 0 && isspace((unsigned char)line[length - 1])) line[--length] = '\0';
+  const char* text = line;
+  while (isspace((unsigned char)*text)) ++text;
+  if (*text == '\0' || *text == '#') return SS_OK;
+  char* end = NULL;
+  double parsed = strtod(text, &end);
+  if (end == text || *end != '\0' || !isfinite(parsed) || parsed <= 0)
+    return ssFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: \"%s\" is not a positive finite duration in seconds",
+                  path_text, number, escaped(text, strlen(text), line_text, sizeof line_text));
+  if (!(parsed >= SS_MIN_PROFILE_FRAME_S && parsed <= SS_MAX_PROFILE_FRAME_S))
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "trace \"%s\" line %ld: %g s is outside [%g, %g] s", path_text, number,
+                  parsed, SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S);
+  *value = parsed;
+  *has_value = 1;
+  return SS_OK;
+}
+
+/* Reads a trace file: one duration (s) per line, blank lines and # comments skipped; the last line may lack its
+ * newline. Bounded in bytes, line length and frames (profile.h). */
+static ssStatus read_trace(const char* raw_path, double** values_out, long* count_out) {
+  char path_text[128];
+  escaped(raw_path, strlen(raw_path), path_text, sizeof path_text);
+  char* text = NULL;
+  size_t length = 0;
+  ssStatus status = read_bounded(path_text, raw_path, &text, &length);
+  if (status != SS_OK) return status;
   double* values = NULL;
   long count = 0, capacity = 0, line_number = 0;
-  char line[512];
-  ssStatus status = SS_OK;
-  while (status == SS_OK && fgets(line, sizeof line, file) != NULL) {
+  for (size_t start = 0; status == SS_OK && start < length;) {
+    char* newline = memchr(text + start, '\n', length - start);
+    size_t stop = newline != NULL ? (size_t)(newline - text) : length;
+    text[stop] = '\0';
     ++line_number;
-    size_t length = strlen(line);
-    if (length == sizeof line - 1 && line[length - 1] != '\n' && !feof(file)) {
-      status = ssFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: longer than %zu characters", path, line_number,
-                      sizeof line - 2);
-      break;
-    }
-    while (length > 0 && isspace((unsigned char)line[length - 1])) line[--length] = '\0';
-    const char* text = line;
-    while (isspace((unsigned char)*text)) ++text;
-    if (*text == '\0' || *text == '#') continue;
-    char* end = NULL;
-    double value = strtod(text, &end);
-    if (end == text || *end != '\0' || !isfinite(value) || value <= 0) {
-      status = ssFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: \"%s\" is not a positive finite duration in seconds",
-                      path, line_number, text);
+    double value = 0;
+    int has_value = 0;
+    status = parse_trace_line(path_text, line_number, text + start, stop - start, &value, &has_value);
+    start = stop + 1;
+    if (status != SS_OK || !has_value) continue;
+    if (count == SS_MAX_TRACE_FRAMES) {
+      status = ssFail(SS_ERROR_OUT_OF_RANGE, "trace \"%s\": more than %d frame durations", path_text,
+                      SS_MAX_TRACE_FRAMES);
       break;
     }
     if (count == capacity) {
       long grown = capacity ? 2 * capacity : 64;
       double* more = realloc(values, (size_t)grown * sizeof *values);
       if (more == NULL) {
-        status = ssFail(SS_ERROR_OUT_OF_MEMORY, "trace \"%s\": out of memory at line %ld", path, line_number);
+        status = ssFail(SS_ERROR_OUT_OF_MEMORY, "trace \"%s\": out of memory at line %ld", path_text, line_number);
         break;
       }
       values = more;
@@ -114,10 +243,9 @@ static ssStatus read_trace(const char* spec, const char* path, double** values_o
     }
     values[count++] = value;
   }
-  if (status == SS_OK && ferror(file)) status = ssFail(SS_ERROR_IO, "trace \"%s\": read error", path);
-  fclose(file);
+  free(text);
   if (status == SS_OK && count == 0)
-    status = ssFail(SS_ERROR_PARSE, "trace \"%s\": no frame durations in the file", path);
+    status = ssFail(SS_ERROR_PARSE, "trace \"%s\": no frame durations in the file", path_text);
   if (status != SS_OK) {
     free(values);
     return status;
@@ -127,24 +255,26 @@ static ssStatus read_trace(const char* spec, const char* path, double** values_o
   return SS_OK;
 }
 
-/* Checks the numeric fields of a kind and fills the profile's parameters. */
-static ssStatus set_parameters(ssProfile* p, const char* spec, const ssKindDesc* kind, const double* v) {
+/* Checks the numeric fields of a kind and fills the profile's parameters; nothing is converted before its check. */
+static ssStatus set_parameters(ssProfile* p, const char* raw_spec, const ssKindDesc* kind, const double* v) {
+  char spec[96];
+  SPEC_TEXT(raw_spec, spec);
   ssStatus status = SS_OK;
   switch (kind->kind) {
     case SS_PROFILE_FIXED:
-      status = check_positive(spec, "FPS", v[0]);
+      status = check_rate(raw_spec, "FPS", v[0]);
       p->a_s = 1.0 / v[0];
       break;
     case SS_PROFILE_UNIFORM:
-      status = check_positive(spec, "MINFPS", v[0]);
-      if (status == SS_OK) status = check_positive(spec, "MAXFPS", v[1]);
+      status = check_rate(raw_spec, "MINFPS", v[0]);
+      if (status == SS_OK) status = check_rate(raw_spec, "MAXFPS", v[1]);
       if (status == SS_OK && v[0] > v[1])
         status = ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": MINFPS = %g is above MAXFPS = %g", spec, v[0], v[1]);
       p->a_s = 1.0 / v[1];
       p->b_s = 1.0 / v[0];
       break;
     case SS_PROFILE_JITTER:
-      status = check_positive(spec, "FPS", v[0]);
+      status = check_rate(raw_spec, "FPS", v[0]);
       if (status == SS_OK && v[1] < 0)
         status = ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": SPREAD_MS = %g: must not be negative", spec, v[1]);
       if (status == SS_OK && 3.0 * v[1] >= 1000.0 / v[0])
@@ -153,20 +283,24 @@ static ssStatus set_parameters(ssProfile* p, const char* spec, const ssKindDesc*
                         v[1], 1000.0 / v[0]);
       p->a_s = 1.0 / v[0];
       p->b_s = v[1] / 1000.0;
+      if (status == SS_OK) status = check_frame(raw_spec, "SPREAD_MS", v[1], p->a_s - 3.0 * p->b_s);
+      if (status == SS_OK) status = check_frame(raw_spec, "SPREAD_MS", v[1], p->a_s + 3.0 * p->b_s);
       break;
     case SS_PROFILE_HITCH:
-      status = check_positive(spec, "FPS", v[0]);
-      if (status == SS_OK && (v[1] < 1 || v[1] != floor(v[1]) || v[1] > 1e9))
-        status = ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": EVERY = %g: must be a whole number of frames >= 1",
-                        spec, v[1]);
-      if (status == SS_OK) status = check_positive(spec, "SECONDS", v[2]);
+      status = check_rate(raw_spec, "FPS", v[0]);
+      if (status == SS_OK && !(v[1] >= 1 && v[1] <= 1e9 && v[1] == floor(v[1])))
+        status = ssFail(SS_ERROR_OUT_OF_RANGE,
+                        "profile \"%s\": EVERY = %g: must be a whole number of frames in [1, 1e9]", spec, v[1]);
+      if (status == SS_OK) status = check_positive(raw_spec, "SECONDS", v[2]);
+      if (status == SS_OK) status = check_frame(raw_spec, "SECONDS", v[2], v[2]);
+      if (status != SS_OK) break;
       p->a_s = 1.0 / v[0];
       p->every = (long)v[1];
       p->b_s = v[2];
       break;
     case SS_PROFILE_VSYNC:
-      status = check_positive(spec, "FPS_A", v[0]);
-      if (status == SS_OK) status = check_positive(spec, "FPS_B", v[1]);
+      status = check_rate(raw_spec, "FPS_A", v[0]);
+      if (status == SS_OK) status = check_rate(raw_spec, "FPS_B", v[1]);
       p->a_s = 1.0 / v[0];
       p->b_s = 1.0 / v[1];
       break;
@@ -177,24 +311,27 @@ static ssStatus set_parameters(ssProfile* p, const char* spec, const ssKindDesc*
 }
 
 ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out) {
-  if (spec == NULL) return ssFail(SS_ERROR_PARSE, "profile spec is NULL");
+  if (spec == NULL || out == NULL)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssProfile_Create needs a spec and somewhere to write",
+                  spec == NULL ? "spec" : "out");
+  char spec_text[96];
+  SPEC_TEXT(spec, spec_text);
   const char* colon = strchr(spec, ':');
   size_t name_length = colon ? (size_t)(colon - spec) : strlen(spec);
   const ssKindDesc* kind = NULL;
   for (size_t i = 0; i < sizeof kinds / sizeof kinds[0]; ++i)
     if (strlen(kinds[i].name) == name_length && strncmp(kinds[i].name, spec, name_length) == 0) kind = &kinds[i];
   if (kind == NULL)
-    return ssFail(SS_ERROR_PARSE,
-                  "profile \"%s\": unknown kind \"%.*s\" (fixed, uniform, jitter, hitch, vsync or trace)", spec,
-                  (int)name_length, spec);
-  if (colon == NULL) return ssFail(SS_ERROR_PARSE, "profile \"%s\": missing field %s", spec, kind->fields[0]);
+    return ssFail(SS_ERROR_PARSE, "profile \"%s\": unknown kind (fixed, uniform, jitter, hitch, vsync or trace)",
+                  spec_text);
+  if (colon == NULL) return ssFail(SS_ERROR_PARSE, "profile \"%s\": missing field %s", spec_text, kind->fields[0]);
 
   ssProfile profile = {.kind = kind->kind, .seed = seed};
   if (kind->kind == SS_PROFILE_TRACE) {
     /* The path is the rest of the spec: it may itself contain colons. */
     const char* path = colon + 1;
-    if (*path == '\0') return ssFail(SS_ERROR_PARSE, "profile \"%s\": FILE is empty", spec);
-    ssStatus status = read_trace(spec, path, &profile.trace_s, &profile.trace_count);
+    if (*path == '\0') return ssFail(SS_ERROR_PARSE, "profile \"%s\": FILE is empty", spec_text);
+    ssStatus status = read_trace(path, &profile.trace_s, &profile.trace_count);
     if (status != SS_OK) return status;
   } else {
     double values[SS_MAX_FIELDS] = {0};
@@ -204,16 +341,15 @@ ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out) {
       size_t length = field_end ? (size_t)(field_end - field_start) : strlen(field_start);
       char token[64];
       if (length >= sizeof token)
-        return ssFail(SS_ERROR_PARSE, "profile \"%s\": %s is too long", spec, kind->fields[i]);
+        return ssFail(SS_ERROR_PARSE, "profile \"%s\": %s is too long", spec_text, kind->fields[i]);
       memcpy(token, field_start, length);
       token[length] = '\0';
       ssStatus status = parse_number(spec, kind->fields[i], token, &values[i]);
       if (status != SS_OK) return status;
       if (i + 1 < kind->field_count && field_end == NULL)
-        return ssFail(SS_ERROR_PARSE, "profile \"%s\": missing field %s", spec, kind->fields[i + 1]);
+        return ssFail(SS_ERROR_PARSE, "profile \"%s\": missing field %s", spec_text, kind->fields[i + 1]);
       if (i + 1 == kind->field_count && field_end != NULL)
-        return ssFail(SS_ERROR_PARSE, "profile \"%s\": extra field \"%s\" after %s", spec, field_end + 1,
-                      kind->fields[i]);
+        return ssFail(SS_ERROR_PARSE, "profile \"%s\": extra field after %s", spec_text, kind->fields[i]);
       field_start = field_end ? field_end + 1 : NULL;
     }
     ssStatus status = set_parameters(&profile, spec, kind, values);
@@ -226,7 +362,7 @@ ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out) {
     free(made);
     free(spec_copy);
     free(profile.trace_s);
-    return ssFail(SS_ERROR_OUT_OF_MEMORY, "profile \"%s\": out of memory", spec);
+    return ssFail(SS_ERROR_OUT_OF_MEMORY, "profile \"%s\": out of memory", spec_text);
   }
   strcpy(spec_copy, spec);
   profile.spec = spec_copy;
@@ -244,26 +380,43 @@ void ssProfile_Destroy(ssProfile* profile) {
 }
 
 void ssProfile_Reset(ssProfile* profile) {
+  if (profile == NULL) {
+    ssFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to reset");
+    return;
+  }
   ssRng_Seed(&profile->rng, profile->seed);
   profile->frame_index = 0;
   profile->on_b = 0;
 }
 
-const char* ssProfile_Spec(const ssProfile* profile) { return profile->spec; }
+const char* ssProfile_Spec(const ssProfile* profile) {
+  if (profile == NULL) {
+    ssFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to describe");
+    return "";
+  }
+  return profile->spec;
+}
+
+/* Rounding in a + (b - a)·u and a + b·z could step a hair outside [a, b]; the range is a promise, so clamp. */
+static double clamp(double value, double low, double high) { return value < low ? low : value > high ? high : value; }
 
 double ssProfile_Next(ssProfile* p) {
+  if (p == NULL) {
+    ssFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to draw a frame from");
+    return NAN;
+  }
   long index = p->frame_index++;
   switch (p->kind) {
     case SS_PROFILE_FIXED:
       return p->a_s;
     case SS_PROFILE_UNIFORM:
-      return p->a_s + (p->b_s - p->a_s) * ssRng_Uniform(&p->rng);
+      return clamp(p->a_s + (p->b_s - p->a_s) * ssRng_Uniform(&p->rng), p->a_s, p->b_s);
     case SS_PROFILE_JITTER: {
       /* Redrawing outside three deviations keeps the distribution symmetric, so the mean stays 1/FPS. */
       double z;
       do z = ssRng_Normal(&p->rng);
       while (fabs(z) > 3.0);
-      return p->a_s + p->b_s * z;
+      return clamp(p->a_s + p->b_s * z, p->a_s - 3.0 * p->b_s, p->a_s + 3.0 * p->b_s);
     }
     case SS_PROFILE_HITCH:
       return (index + 1) % p->every == 0 ? p->b_s : p->a_s;
@@ -273,6 +426,25 @@ double ssProfile_Next(ssProfile* p) {
       return p->on_b ? p->b_s : p->a_s;
     case SS_PROFILE_TRACE:
       return p->trace_s[index % p->trace_count];
+  }
+  return p->a_s;
+}
+
+double ssProfile_MeanFrame(const ssProfile* p) {
+  switch (p->kind) {
+    case SS_PROFILE_FIXED:
+    case SS_PROFILE_JITTER:
+      return p->a_s;
+    case SS_PROFILE_UNIFORM:
+    case SS_PROFILE_VSYNC: /* switching both ways with the same probability spends half the frames at each rate */
+      return 0.5 * (p->a_s + p->b_s);
+    case SS_PROFILE_HITCH:
+      return p->a_s + (p->b_s - p->a_s) / (double)p->every;
+    case SS_PROFILE_TRACE: {
+      double sum = 0;
+      for (long i = 0; i < p->trace_count; ++i) sum += p->trace_s[i];
+      return sum / (double)p->trace_count;
+    }
   }
   return p->a_s;
 }

@@ -2,15 +2,20 @@
  *
  * Records come from the scene's step observer rather than after each frame, because a frame may hold several
  * substeps (or, for policy fixed, none) and the comparison between policies is about the physics, not the frames.
- * The last frame is shortened so that every run ends at duration_s of frame time exactly. */
+ * The last frame is shortened so that every run ends at duration_s of frame time exactly. A run is bounded
+ * (limits.h): its duration, the frames it is expected to take (refused before it starts) and the frames and steps it
+ * does take (stopped with an error when an unlucky random profile reaches them). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "error.h"
+#include "profile_internal.h"
 #include "scene_internal.h"
+#include "steadystep/limits.h"
 #include "steadystep/profile.h"
+#include "steadystep/stepper.h"
 
 struct ssRun {
   int count, capacity;
@@ -23,6 +28,7 @@ struct ssRun {
   ssStatus status;
   char message[256];
   int out_of_memory;
+  int too_many_steps; /* a step past SS_MAX_RUN_STEPS was not recorded */
 };
 
 void ssRun_Destroy(ssRun* run) {
@@ -52,6 +58,10 @@ static int reserve(ssRun* run, int needed) {
 
 static void record(void* context, const ssScene* scene, double step_s) {
   ssRun* run = context;
+  if (run->count >= SS_MAX_RUN_STEPS) {
+    run->too_many_steps = 1;
+    return;
+  }
   if (!reserve(run, run->count + 1)) {
     run->out_of_memory = 1;
     return;
@@ -76,6 +86,9 @@ static ssStatus play(ssRun* run, ssScene* scene, ssProfile* profile, double dura
   const double end_tolerance_s = 1e-9 * fmax(1.0, duration_s);
   double elapsed_s = 0;
   while (duration_s - elapsed_s > end_tolerance_s) {
+    if (run->frame_count >= SS_MAX_RUN_FRAMES)
+      return ssFail(SS_ERROR_OUT_OF_RANGE, "run: %d frames and %g of duration_s = %g s left: a run takes at most %d frames",
+                    run->frame_count, duration_s - elapsed_s, duration_s, SS_MAX_RUN_FRAMES);
     double frame_s = fmin(ssProfile_Next(profile), duration_s - elapsed_s);
     double start_s = now_s();
     ssStatus status = ssScene_Frame(scene, frame_s, NULL);
@@ -83,6 +96,9 @@ static ssStatus play(ssRun* run, ssScene* scene, ssProfile* profile, double dura
     ++run->frame_count;
     elapsed_s += frame_s;
     if (run->out_of_memory) return ssFail(SS_ERROR_OUT_OF_MEMORY, "run: out of memory after %d steps", run->count);
+    if (run->too_many_steps)
+      return ssFail(SS_ERROR_OUT_OF_RANGE, "run: %d steps after %g s of duration_s = %g s: a run takes at most %d steps",
+                    run->count, elapsed_s, duration_s, SS_MAX_RUN_STEPS);
     if (status == SS_ERROR_BLOWUP || status == SS_ERROR_SPEED_LIMIT) {
       run->status = status;
       strncpy(run->message, ssLastError(), sizeof run->message - 1);
@@ -93,20 +109,54 @@ static ssStatus play(ssRun* run, ssScene* scene, ssProfile* profile, double dura
   return SS_OK;
 }
 
+/* The physics steps a run of frames of mean_frame_s will take, roughly: one per frame, more when a policy cuts
+ * frames into substeps, duration / fixed_step_s under the accumulator. */
+static double expected_steps(const ssStepping* stepping, double duration_s, double frames, double mean_frame_s) {
+  if (stepping->policy == SS_POLICY_FIXED) return duration_s / stepping->fixed_step_s;
+  if (stepping->policy == SS_POLICY_NAIVE) return frames;
+  double per_frame = fmin(ceil(mean_frame_s / stepping->max_step_s), (double)stepping->max_steps_per_frame);
+  return frames * fmax(per_frame, 1.0);
+}
+
+/* Refuses, before anything runs, a run that would take more frames or steps than limits.h allows. */
+static ssStatus check_size(const ssRunDef* def, const ssProfile* profile) {
+  double mean_frame_s = ssProfile_MeanFrame(profile);
+  double frames = def->duration_s / mean_frame_s;
+  if (frames > SS_MAX_RUN_FRAMES)
+    return ssFail(SS_ERROR_OUT_OF_RANGE,
+                  "duration_s = %g s: profile \"%s\" (mean frame %g s) needs about %.3g frames, a run takes at most %d",
+                  def->duration_s, ssProfile_Spec(profile), mean_frame_s, frames, SS_MAX_RUN_FRAMES);
+  double steps = expected_steps(&def->stepping, def->duration_s, frames, mean_frame_s);
+  if (steps > SS_MAX_RUN_STEPS)
+    return ssFail(SS_ERROR_OUT_OF_RANGE,
+                  "duration_s = %g s: policy %s with max_step_s = %g s, fixed_step_s = %g s needs about %.3g steps, "
+                  "a run takes at most %d",
+                  def->duration_s, ssPolicyName((ssPolicy)def->stepping.policy), def->stepping.max_step_s,
+                  def->stepping.fixed_step_s, steps, SS_MAX_RUN_STEPS);
+  return SS_OK;
+}
+
 ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
   if (def == NULL || out == NULL)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssRun_Execute needs a definition and out",
                   def == NULL ? "def" : "out");
+  if (def->scene == NULL || def->profile == NULL)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "def.%s = NULL: a run needs a scene name and a profile spec",
+                  def->scene == NULL ? "scene" : "profile");
   ssStatus status = ssCheckPositive("duration_s", "s", def->duration_s);
+  if (status == SS_OK && def->duration_s > SS_MAX_RUN_DURATION_S)
+    status = ssFail(SS_ERROR_OUT_OF_RANGE, "duration_s = %g s: a run lasts at most %g s", def->duration_s,
+                    SS_MAX_RUN_DURATION_S);
   if (status != SS_OK) return status;
   const ssSceneInfo* info = ssSceneFind(def->scene);
-  if (info == NULL) return ssFail(SS_ERROR_NOT_FOUND, "scene = \"%s\": unknown (oscillator, buggy, drop, chain, pile)",
-                                  def->scene != NULL ? def->scene : "(null)");
+  if (info == NULL)
+    return ssFail(SS_ERROR_NOT_FOUND, "scene = \"%.64s\": unknown (oscillator, buggy, drop, chain, pile)", def->scene);
   ssProfile* profile = NULL;
   status = ssProfile_Create(def->profile, def->seed, &profile);
   if (status != SS_OK) return status;
   ssScene* scene = NULL;
   status = ssScene_Create(def->scene, &def->params, &def->stepping, &scene);
+  if (status == SS_OK) status = check_size(def, profile); /* after the scene has checked the stepping's fields */
   ssRun* run = status == SS_OK ? calloc(1, sizeof *run) : NULL;
   if (status == SS_OK && run == NULL) status = ssFail(SS_ERROR_OUT_OF_MEMORY, "run: out of memory");
   if (status == SS_OK) {
@@ -124,16 +174,23 @@ ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
   return SS_OK;
 }
 
-int ssRun_StepCount(const ssRun* run) { return run->count; }
-const double* ssRun_Times(const ssRun* run) { return run->times_s; }
-const double* ssRun_StepLengths(const ssRun* run) { return run->steps_s; }
+/* The accessors of a NULL run record why and answer with nothing: 0, NULL, or an error status. */
+static int null_run(const ssRun* run, const char* what) {
+  if (run != NULL) return 0;
+  ssFail(SS_ERROR_OUT_OF_RANGE, "run = NULL: no run to read %s from", what);
+  return 1;
+}
+
+int ssRun_StepCount(const ssRun* run) { return null_run(run, "a step count") ? 0 : run->count; }
+const double* ssRun_Times(const ssRun* run) { return null_run(run, "times") ? NULL : run->times_s; }
+const double* ssRun_StepLengths(const ssRun* run) { return null_run(run, "step lengths") ? NULL : run->steps_s; }
 
 const double* ssRun_Quantity(const ssRun* run, int index) {
-  if (index < 0 || index >= run->quantity_count) return NULL;
+  if (null_run(run, "a quantity") || index < 0 || index >= run->quantity_count) return NULL;
   return run->quantities[index];
 }
 
-int ssRun_FrameCount(const ssRun* run) { return run->frame_count; }
-double ssRun_WallSeconds(const ssRun* run) { return run->wall_s; }
-ssStatus ssRun_Status(const ssRun* run) { return run->status; }
-const char* ssRun_Message(const ssRun* run) { return run->message; }
+int ssRun_FrameCount(const ssRun* run) { return null_run(run, "a frame count") ? 0 : run->frame_count; }
+double ssRun_WallSeconds(const ssRun* run) { return null_run(run, "wall seconds") ? 0 : run->wall_s; }
+ssStatus ssRun_Status(const ssRun* run) { return null_run(run, "a status") ? SS_ERROR_OUT_OF_RANGE : run->status; }
+const char* ssRun_Message(const ssRun* run) { return null_run(run, "a message") ? "" : run->message; }

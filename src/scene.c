@@ -3,11 +3,13 @@
  * Everything a caller can get wrong is checked before ODE is touched, so a refused scene leaves no world behind
  * and the message names the value. The stepper gets a speed limit so that a scene that explodes ends its run with
  * SS_ERROR_SPEED_LIMIT instead of running on with nonsense. */
+#include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "error.h"
+#include "ode_bounds.h"
 #include "scene_internal.h"
 
 /* No reference scene moves anything faster than a few m/s; 100 m/s means it exploded. */
@@ -59,6 +61,7 @@ const ssSceneInfo* ssSceneFind(const char* name) {
 }
 
 static ssStatus find_or_fail(const char* name, const ssSceneDesc** out) {
+  if (name == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "name = NULL: needs a scene name (oscillator, buggy, ...)");
   *out = find_desc(name);
   if (*out != NULL) return SS_OK;
   return ssFail(SS_ERROR_NOT_FOUND, "scene = \"%s\": unknown (oscillator, buggy, drop, chain, pile)",
@@ -97,10 +100,16 @@ ssStepping ssReferenceStepping(double step_s) {
 
 static ssStatus validate_params(const ssSceneDesc* desc, const ssSceneParams* params) {
   ssStatus status = ssValidateSpring(params->spring);
-  if (status == SS_OK) status = ssCheckPositive("mass", "kg", params->mass);
+  if (status == SS_OK) status = ssCheckMass("mass", params->mass);
   if (status == SS_OK) status = ssCheckFinite("x0", "m", params->x0);
   if (status == SS_OK) status = ssCheckFinite("gravity", "m/s^2", params->gravity);
   if (status != SS_OK) return status;
+  /* A scene is a few metres across and moves at a few m/s; far beyond that, ODE's products overflow in a step. */
+  if (!(fabs(params->x0) <= SS_SCENE_MAX_X0_M))
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "x0 = %g m: must be within +-%g m", params->x0, SS_SCENE_MAX_X0_M);
+  if (!(fabs(params->gravity) <= SS_SCENE_MAX_GRAVITY_M_PER_S2))
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "gravity = %g m/s^2: must be within +-%g m/s^2", params->gravity,
+                  SS_SCENE_MAX_GRAVITY_M_PER_S2);
   if (params->body_count < 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "body_count = %d: must not be negative (0 = the scene's default)",
                   params->body_count);
@@ -122,9 +131,9 @@ static ssStatus validate_stepping(const ssStepping* stepping, const ssSpring* sp
   if (stepping->max_steps_per_frame <= 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.max_steps_per_frame = %d: must be positive",
                   stepping->max_steps_per_frame);
-  ssStatus status = ssCheckPositive("stepping.max_step_s", "s", stepping->max_step_s);
-  if (status == SS_OK) status = ssCheckPositive("stepping.reference_step_s", "s", stepping->reference_step_s);
-  if (status == SS_OK) status = ssCheckPositive("stepping.fixed_step_s", "s", stepping->fixed_step_s);
+  ssStatus status = ssCheckStepLength("stepping.max_step_s", stepping->max_step_s);
+  if (status == SS_OK) status = ssCheckStepLength("stepping.reference_step_s", stepping->reference_step_s);
+  if (status == SS_OK) status = ssCheckStepLength("stepping.fixed_step_s", stepping->fixed_step_s);
   if (status != SS_OK) return status;
   /* Found here rather than at the first frame, where it would stop a run that could never have worked. */
   int exact_poles = stepping->policy == SS_POLICY_MATCHED || stepping->policy == SS_POLICY_EXACT;
@@ -231,9 +240,22 @@ ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps) {
   return status;
 }
 
-void ssScene_Sample(const ssScene* scene, double* out) { scene->desc->sample(scene->state, out); }
+void ssScene_Sample(const ssScene* scene, double* out) {
+  if (scene == NULL || out == NULL) {
+    ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_Sample needs a scene and somewhere to write",
+           scene == NULL ? "scene" : "out");
+    return;
+  }
+  scene->desc->sample(scene->state, out);
+}
 
-double ssScene_Time(const ssScene* scene) { return scene->time_s; }
+double ssScene_Time(const ssScene* scene) {
+  if (scene == NULL) {
+    ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read the time of");
+    return NAN;
+  }
+  return scene->time_s;
+}
 
 void ssScene_SetStepObserver(ssScene* scene, ssSceneStepFn* observer, void* context) {
   scene->observer = observer;

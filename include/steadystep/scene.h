@@ -19,6 +19,7 @@
 
 #include <stdint.h>
 
+#include "steadystep/limits.h"
 #include "steadystep/spring.h"
 #include "steadystep/status.h"
 
@@ -28,12 +29,20 @@ extern "C" {
 
 #define SS_MAX_QUANTITIES 4
 
+/** The largest |x0| (m) and |gravity| (m/s²) a scene takes: scenes are a few metres across; far beyond these, ODE's
+ *  products of error, stiffness and step overflow inside a step (limits.h). */
+#define SS_SCENE_MAX_X0_M 1e3
+#define SS_SCENE_MAX_GRAVITY_M_PER_S2 1e4
+
 /** A scene's parameters. Start from ssDefaultSceneParams(name): each scene has its own defaults. */
 typedef struct ssSceneParams {
   ssSpring spring;     /* the scene's soft constraint: slider stop, suspension, contact or joint limit */
-  double mass;         /* kg: the oscillator's body, a buggy's chassis, each dropped box, each chain link */
-  double x0;           /* m: the oscillator's initial extension (released at rest); unused elsewhere */
-  double gravity;      /* m/s² along the scene's "down": oscillator 0 by default (along the slider), others 9.81 */
+  double mass;         /* kg, in [SS_MIN_MASS_KG, SS_MAX_MASS_KG]: the oscillator's body, a buggy's chassis, each
+                        * dropped box, each chain link */
+  double x0;           /* m, |x0| <= SS_SCENE_MAX_X0_M: the oscillator's initial extension (released at rest);
+                        * unused elsewhere */
+  double gravity;      /* m/s² along the scene's "down", |gravity| <= SS_SCENE_MAX_GRAVITY_M_PER_S2: oscillator 0
+                        * by default (along the slider), others 9.81 */
   int body_count;      /* pile: boxes; chain: links; drop: boxes; 0 = the scene's default */
 } ssSceneParams;
 
@@ -51,7 +60,7 @@ typedef struct ssStepping {
   int policy;              /* an ssPolicy value */
   int solver;              /* an ssSolver value */
   int quick_iterations;    /* default 20 */
-  double max_step_s;       /* default 1/60 */
+  double max_step_s;       /* default 1/60; the three step lengths in [SS_MIN_STEP_S, SS_MAX_STEP_S] (limits.h) */
   double reference_step_s; /* default 1/30 */
   double fixed_step_s;     /* default 1/60 */
   int max_steps_per_frame; /* default 8 */
@@ -60,10 +69,11 @@ typedef struct ssStepping {
 /** The number of scenes, and each scene's description (NULL past the end). */
 int ssSceneCount(void);
 const ssSceneInfo* ssSceneInfoAt(int index);
-/** The scene called name, or NULL. */
+/** The scene called name, or NULL (also for name = NULL). */
 const ssSceneInfo* ssSceneFind(const char* name);
 
-/** The default parameters of a scene. Errors: SS_ERROR_NOT_FOUND for an unknown scene (named). */
+/** The default parameters of a scene. Errors (*out untouched): SS_ERROR_NOT_FOUND for an unknown scene (named),
+ *  SS_ERROR_OUT_OF_RANGE for name = NULL or out = NULL. */
 ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
 
 /** The stepper's defaults as an ssStepping. */
@@ -76,9 +86,11 @@ ssStepping ssReferenceStepping(double step_s);
 
 typedef struct ssScene ssScene;
 
-/** Builds a scene. Errors: SS_ERROR_NOT_FOUND (unknown scene), those of ssValidateSpring, SS_ERROR_OUT_OF_RANGE
- *  (mass <= 0, body_count < 0, a stepping field out of range), SS_ERROR_UNSUPPORTED (unknown policy or solver),
- *  SS_ERROR_OUT_OF_MEMORY. */
+/** Builds a scene. Errors (*out untouched): SS_ERROR_NOT_FOUND (unknown scene), those of ssValidateSpring,
+ *  SS_ERROR_OUT_OF_RANGE (name, params, stepping or out NULL; mass outside [SS_MIN_MASS_KG, SS_MAX_MASS_KG], x0 or
+ *  gravity beyond their bounds above, body_count < 0 or above the scene's maximum, a step length outside
+ *  [SS_MIN_STEP_S, SS_MAX_STEP_S], another stepping field out of range), SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED
+ *  (unknown policy or solver), SS_ERROR_OUT_OF_MEMORY. */
 ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssStepping* stepping, ssScene** out);
 
 /** Destroys the scene and its ODE world. NULL is a no-op. */
@@ -88,13 +100,15 @@ void ssScene_Destroy(ssScene* scene);
  *  steps taken. Every body is watched, with a speed limit of 100 m/s (no scene moves anything near that fast).
  *  Each scene keeps its own state of ODE's process-wide random generator (dWorldQuickStep shuffles its rows with
  *  it), so a run does not depend on what else ran in the process; step scenes from one thread at a time.
- *  Errors: those of ssStepper_Step (SS_ERROR_BLOWUP, SS_ERROR_SPEED_LIMIT when the scene explodes). */
+ *  Errors: those of ssStepper_Step (SS_ERROR_BLOWUP, SS_ERROR_SPEED_LIMIT when the scene explodes),
+ *  SS_ERROR_OUT_OF_RANGE for scene = NULL. */
 ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps);
 
-/** The followed quantities now, quantity_count of them, into out. */
+/** The followed quantities now, quantity_count of them, into out. scene or out NULL: writes nothing and records
+ *  "scene = NULL: ..." (or out) for ssLastError(). */
 void ssScene_Sample(const ssScene* scene, double* out);
 
-/** The scene's simulated time (s). */
+/** The scene's simulated time (s). scene = NULL: NaN, and records "scene = NULL: ..." for ssLastError(). */
 double ssScene_Time(const ssScene* scene);
 
 /** A run: a scene under a profile for duration_s, one record after every physics step. */
@@ -104,20 +118,27 @@ typedef struct ssRunDef {
   ssStepping stepping;      /* from ssDefaultStepping */
   const char* profile;      /* profile spec (profile.h) */
   uint64_t seed;            /* profile seed */
-  double duration_s;        /* simulated seconds, > 0 */
+  double duration_s;        /* simulated seconds, in (0, SS_MAX_RUN_DURATION_S] (limits.h) */
 } ssRunDef;
 
 typedef struct ssRun ssRun;
 
 /** Runs def to the end, or to the first blow-up (which is recorded in the run, not an error).
- *  Errors: those of ssScene_Create and ssProfile_Create; SS_ERROR_OUT_OF_RANGE for duration_s. */
+ *  A run takes at most SS_MAX_RUN_FRAMES frames and SS_MAX_RUN_STEPS physics steps (limits.h). One expected to
+ *  need more (duration_s over the profile's mean frame; steps from the policy's cut) is refused before it starts,
+ *  naming duration_s; one that reaches a bound anyway (a random profile's draw) ends with SS_ERROR_OUT_OF_RANGE.
+ *  Errors (*out untouched): those of ssScene_Create and ssProfile_Create; SS_ERROR_OUT_OF_RANGE for def, out,
+ *  def->scene or def->profile NULL, for duration_s outside (0, SS_MAX_RUN_DURATION_S] and for the bounds above;
+ *  SS_ERROR_NOT_FINITE for duration_s. */
 ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out);
 
 /** Destroys the run. NULL is a no-op. */
 void ssRun_Destroy(ssRun* run);
 
 /** Records: one per physics step, time (s) after the step, the step's length (s), and each quantity (NULL for an
- *  index outside [0, quantity_count)). The arrays belong to the run. */
+ *  index outside [0, quantity_count)). The arrays belong to the run.
+ *  Every ssRun_ accessor given run = NULL records "run = NULL: ..." for ssLastError() and returns 0, NULL, "" or
+ *  (ssRun_Status) SS_ERROR_OUT_OF_RANGE. */
 int ssRun_StepCount(const ssRun* run);
 const double* ssRun_Times(const ssRun* run);
 const double* ssRun_StepLengths(const ssRun* run);

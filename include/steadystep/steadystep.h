@@ -3,6 +3,7 @@
 #define STEADYSTEP_H
 
 #include "steadystep/status.h"
+#include "steadystep/limits.h"
 #include "steadystep/spring.h"
 #include "steadystep/registry.h"
 #include "steadystep/adopt.h"

@@ -8,6 +8,12 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <random>
+
+#include "steadystep/limits.h"
 #include "steadystep/profile.h"
 
 namespace {
@@ -33,8 +39,14 @@ double Mean(const std::vector<double>& values) {
 
 std::string TempFile(const std::string& name, const std::string& text) {
   std::string path = ::testing::TempDir() + "steadystep_" + name;
-  std::ofstream(path) << text;
+  std::ofstream(path, std::ios::binary) << text;
   return path;
+}
+
+// Clears ssLastError() by recording a failure that names nothing a test looks for.
+void ssFail_Clear() {
+  ssProfile* unused = nullptr;
+  ssProfile_Create("unknown-kind", 0, &unused);
 }
 
 void ExpectRefused(const std::string& spec, ssStatus expected, const std::string& named) {
@@ -177,8 +189,157 @@ TEST(Profile, BadSpecsAreRefusedNamingTheField) {
 
 TEST(Profile, NullSpecIsRefused) {
   ssProfile* profile = nullptr;
-  EXPECT_EQ(ssProfile_Create(nullptr, 1, &profile), SS_ERROR_PARSE);
+  EXPECT_EQ(ssProfile_Create(nullptr, 1, &profile), SS_ERROR_OUT_OF_RANGE);
   EXPECT_EQ(profile, nullptr);
+  EXPECT_NE(std::string(ssLastError()).find("spec = NULL"), std::string::npos) << ssLastError();
+}
+
+TEST(Profile, NullHandlesAndOutputsAreRefusedByName) {
+  EXPECT_EQ(ssProfile_Create("fixed:60", 1, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("out = NULL"), std::string::npos) << ssLastError();
+  EXPECT_TRUE(std::isnan(ssProfile_Next(nullptr)));
+  EXPECT_NE(std::string(ssLastError()).find("profile = NULL"), std::string::npos) << ssLastError();
+  ssFail_Clear();
+  ssProfile_Reset(nullptr);
+  EXPECT_NE(std::string(ssLastError()).find("profile = NULL"), std::string::npos) << ssLastError();
+  ssFail_Clear();
+  EXPECT_STREQ(ssProfile_Spec(nullptr), "");
+  EXPECT_NE(std::string(ssLastError()).find("profile = NULL"), std::string::npos) << ssLastError();
+  ssProfile_Destroy(nullptr);
+}
+
+TEST(Profile, FramesOutsideTheFrameRangeAreRefusedNamingTheField) {
+  ExpectRefused("fixed:1e-320", SS_ERROR_OUT_OF_RANGE, "FPS = 9.99989e-321 gives frames of inf s");
+  ExpectRefused("fixed:2e-4", SS_ERROR_OUT_OF_RANGE, "FPS = 0.0002");
+  ExpectRefused("fixed:1e13", SS_ERROR_OUT_OF_RANGE, "FPS = 1e+13");
+  ExpectRefused("uniform:1e-320:30", SS_ERROR_OUT_OF_RANGE, "MINFPS = 9.99989e-321");
+  ExpectRefused("uniform:15:1e300", SS_ERROR_OUT_OF_RANGE, "MAXFPS = 1e+300");
+  ExpectRefused("hitch:60:1e19:1", SS_ERROR_OUT_OF_RANGE, "EVERY = 1e+19");
+  ExpectRefused("hitch:60:-1e300:1", SS_ERROR_OUT_OF_RANGE, "EVERY = -1e+300");
+  ExpectRefused("hitch:60:5:1e4", SS_ERROR_OUT_OF_RANGE, "SECONDS = 10000");
+  ExpectRefused("hitch:60:5:1e-300", SS_ERROR_OUT_OF_RANGE, "SECONDS = 1e-300");
+  ExpectRefused("vsync:60:1e-320", SS_ERROR_OUT_OF_RANGE, "FPS_B = 9.99989e-321");
+  ExpectRefused("jitter:3e-4:1e6", SS_ERROR_OUT_OF_RANGE, "SPREAD_MS = 1e+06 gives frames of 6333");
+  // the edges themselves are served
+  for (const char* spec : {"fixed:2.8e-4", "fixed:1e12", "hitch:60:1e9:3600", "uniform:2.8e-4:1e12"}) {
+    ssProfile* profile = Make(spec);
+    for (double frame : Draw(profile, 100)) {
+      EXPECT_GE(frame, SS_MIN_PROFILE_FRAME_S) << spec;
+      EXPECT_LE(frame, SS_MAX_PROFILE_FRAME_S) << spec;
+    }
+    ssProfile_Destroy(profile);
+  }
+}
+
+// Random specs of every kind with fields drawn from the whole double range: each is refused by name, or hands out
+// only finite frames inside the documented range.
+TEST(Profile, EveryAcceptedSpecHandsOutFramesInsideTheRange) {
+  std::mt19937_64 rng(5);
+  const char* specials[] = {"0", "-0", "1e-320", "1e-300", "1e-13", "1e-12", "1e-3", "0.5", "1", "3", "15", "60",
+                            "1e3", "1e9", "1e12", "1e13", "1e19", "1e300", "1.8e308", "nan", "inf", "-1"};
+  const size_t special_count = sizeof specials / sizeof specials[0];
+  const char* kinds[] = {"fixed", "uniform", "jitter", "hitch", "vsync"};
+  const int fields[] = {1, 2, 2, 3, 2};
+  int accepted = 0;
+  for (int i = 0; i < 20000; ++i) {
+    int kind = static_cast<int>(rng() % 5);
+    std::string spec = kinds[kind];
+    for (int f = 0; f < fields[kind]; ++f) {
+      char number[64];
+      if (rng() % 2)
+        std::snprintf(number, sizeof number, "%s", specials[rng() % special_count]);
+      else
+        std::snprintf(number, sizeof number, "%.6g", std::pow(10.0, std::uniform_real_distribution<>(-15, 15)(rng)));
+      spec += std::string(":") + number;
+    }
+    ssProfile* profile = nullptr;
+    if (ssProfile_Create(spec.c_str(), i, &profile) != SS_OK) {
+      EXPECT_EQ(profile, nullptr) << spec;
+      EXPECT_NE(std::string(ssLastError()).find(spec.substr(0, spec.find(':'))), std::string::npos)
+          << spec << ": " << ssLastError();
+      continue;
+    }
+    ++accepted;
+    for (double frame : Draw(profile, 200)) {
+      ASSERT_TRUE(std::isfinite(frame)) << spec;
+      ASSERT_GE(frame, SS_MIN_PROFILE_FRAME_S) << spec;
+      ASSERT_LE(frame, SS_MAX_PROFILE_FRAME_S) << spec;
+    }
+    ssProfile_Destroy(profile);
+  }
+  EXPECT_GT(accepted, 1000);
+}
+
+TEST(Profile, TraceOfADeviceOrPipeIsRefusedNotRead) {
+  ExpectRefused("trace:/dev/zero", SS_ERROR_IO, "not a regular file");
+  std::string fifo = ::testing::TempDir() + "steadystep_trace_fifo";
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  ExpectRefused("trace:" + fifo, SS_ERROR_IO, "not a regular file");  // no writer: must not wait for one
+  std::remove(fifo.c_str());
+  ExpectRefused("trace:" + ::testing::TempDir(), SS_ERROR_IO, "not a regular file");
+}
+
+TEST(Profile, TraceLargerThanTheBoundIsRefusedWithoutReadingIt) {
+  std::string path = ::testing::TempDir() + "steadystep_trace_huge";
+  FILE* file = std::fopen(path.c_str(), "wb");
+  ASSERT_NE(file, nullptr);
+  ASSERT_EQ(ftruncate(fileno(file), static_cast<off_t>(SS_MAX_TRACE_BYTES) + 1), 0);  // sparse: costs no disk
+  std::fclose(file);
+  ExpectRefused("trace:" + path, SS_ERROR_IO, "larger than");
+  std::remove(path.c_str());
+}
+
+TEST(Profile, TraceWithANulByteIsRefused) {
+  std::string path = TempFile("trace_nul.txt", std::string("0.016\n0.5\0garbage\n", sizeof "0.016\n0.5\0garbage\n" - 1));
+  ExpectRefused("trace:" + path, SS_ERROR_PARSE, "line 2: contains a NUL byte");
+  std::remove(path.c_str());
+}
+
+TEST(Profile, TraceLinesUpToTheBoundAreReadWithOrWithoutAFinalNewline) {
+  std::string last = "0.02" + std::string(507, ' ');  // 511 characters, no newline
+  std::string path = TempFile("trace_long_last.txt", "0.016\n" + last);
+  ssProfile* profile = Make("trace:" + path);
+  EXPECT_EQ(Draw(profile, 2), (std::vector<double>{0.016, 0.02}));
+  ssProfile_Destroy(profile);
+  std::string at_bound = "0.03" + std::string(SS_MAX_TRACE_LINE_CHARS - 4, ' ');
+  TempFile("trace_long_last.txt", at_bound + "\n");
+  profile = Make("trace:" + path);
+  EXPECT_EQ(ssProfile_Next(profile), 0.03);
+  ssProfile_Destroy(profile);
+  TempFile("trace_long_last.txt", "0.016\n" + at_bound + " ");
+  ExpectRefused("trace:" + path, SS_ERROR_PARSE, "line 2: longer than");
+  std::remove(path.c_str());
+}
+
+TEST(Profile, TraceDurationsOutsideTheFrameRangeAreRefusedWithTheirLine) {
+  for (const char* bad : {"1e-13", "1e4", "1e-320"}) {
+    std::string path = TempFile("trace_range.txt", std::string("0.016\n") + bad + "\n");
+    ExpectRefused("trace:" + path, SS_ERROR_OUT_OF_RANGE, "line 2");
+    std::remove(path.c_str());
+  }
+}
+
+bool Ascii(const char* text) {
+  for (; *text; ++text)
+    if (static_cast<unsigned char>(*text) >= 0x80) return false;
+  return true;
+}
+
+TEST(Profile, MessagesAreAsciiWhateverBytesCameIn) {
+  std::string path = TempFile("trace_binary.txt", "0.016\n\xff\xfe\x80garbage\xc3\n");
+  ExpectRefused("trace:" + path, SS_ERROR_PARSE, "\\xff\\xfe\\x80garbage\\xc3");
+  EXPECT_TRUE(Ascii(ssLastError())) << ssLastError();
+  std::remove(path.c_str());
+  ExpectRefused("fixed:\xff\xfe", SS_ERROR_PARSE, "\\xff");
+  EXPECT_TRUE(Ascii(ssLastError()));
+  ExpectRefused("\xe2\x82\xac:1", SS_ERROR_PARSE, "unknown kind");
+  EXPECT_TRUE(Ascii(ssLastError()));
+  std::string long_spec = "fixed:" + std::string(300, '\xc3');
+  ExpectRefused(long_spec, SS_ERROR_PARSE, "FPS");
+  EXPECT_TRUE(Ascii(ssLastError()));
+  ExpectRefused("trace:/nonexistent/\xff\xfe", SS_ERROR_IO, "\\xff\\xfe");
+  EXPECT_TRUE(Ascii(ssLastError()));
 }
 
 TEST(Profile, MissingTraceFileIsAnIoErrorNamingThePath) {

@@ -334,3 +334,144 @@ TEST(Scenes, SpringPolicySpreadIsAtMostHalfOfNaive) {
     EXPECT_LE(spread[1], 0.5 * spread[0]) << scene;
   }
 }
+
+// Values ODE cannot take (limits.h) are refused by name before any world exists: masses that abort ODE, steps
+// around 1e-200 s, extensions and gravity far beyond a scene's size.
+TEST(Scenes, ValuesOutsideOdesRangeAreRefusedByName) {
+  ssRunDef good = Def("oscillator", "fixed:60", 1.0);
+  struct ParamCase {
+    void (*spoil)(ssSceneParams&);
+    const char* named;
+  };
+  const ParamCase param_cases[] = {
+      {[](ssSceneParams& p) { p.mass = 1e300; }, "mass = 1e+300"},
+      {[](ssSceneParams& p) { p.mass = 1e-320; }, "mass = 9.99989e-321"},
+      {[](ssSceneParams& p) { p.mass = 1e13; }, "mass = 1e+13"},
+      {[](ssSceneParams& p) { p.x0 = 1e300; }, "x0 = 1e+300"},
+      {[](ssSceneParams& p) { p.gravity = -1e300; }, "gravity = -1e+300"},
+  };
+  for (const char* scene : {"oscillator", "buggy", "drop", "chain", "pile"}) {
+    for (const ParamCase& c : param_cases) {
+      ssRunDef def = Def(scene, "fixed:60", 1.0);
+      c.spoil(def.params);
+      ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, c.named);
+      ExpectSceneRefused(scene, def.params, def.stepping, SS_ERROR_OUT_OF_RANGE, c.named);
+    }
+  }
+  struct SteppingCase {
+    void (*spoil)(ssStepping&);
+    const char* named;
+  };
+  const SteppingCase stepping_cases[] = {
+      {[](ssStepping& s) { s.max_step_s = 1e-200; }, "stepping.max_step_s = 1e-200"},
+      {[](ssStepping& s) { s.reference_step_s = 1.7e308; }, "stepping.reference_step_s = 1.7e+308"},
+      {[](ssStepping& s) { s.fixed_step_s = 1e-10; }, "stepping.fixed_step_s = 1e-10"},
+      {[](ssStepping& s) { s.max_step_s = 1e4; }, "stepping.max_step_s = 10000"},
+  };
+  for (const SteppingCase& c : stepping_cases) {
+    ssRunDef def = good;
+    c.spoil(def.stepping);
+    ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, c.named);
+    ExpectSceneRefused("oscillator", def.params, def.stepping, SS_ERROR_OUT_OF_RANGE, c.named);
+  }
+  // The edges themselves are served: the lightest and heaviest masses and the bounds of x0 and gravity build and
+  // step without ODE aborting (a speed-limit stop is a served answer).
+  for (double mass : {SS_MIN_MASS_KG, SS_MAX_MASS_KG}) {
+    for (const char* scene : {"oscillator", "buggy", "drop", "chain", "pile"}) {
+      ssRunDef def = Def(scene, "fixed:60", 0.2);
+      def.params.mass = mass;
+      def.params.body_count = std::min(def.params.body_count, 4);
+      Recorded run = Execute(def);
+      EXPECT_GT(run.frames, 0) << scene << " mass " << mass;
+    }
+  }
+  ssRunDef edge = Def("oscillator", "fixed:60", 0.2);
+  edge.params.x0 = SS_SCENE_MAX_X0_M;
+  edge.params.gravity = -SS_SCENE_MAX_GRAVITY_M_PER_S2;
+  Recorded run = Execute(edge);
+  EXPECT_GT(run.frames, 0);  // stepped (here the speed limit stops it at once): ODE did not abort
+}
+
+// Runs have a bound (limits.h): one that would never end, or grow without limit, is refused before it starts.
+TEST(Scenes, RunsAboveTheirBoundsAreRefusedNamingTheValue) {
+  ssRunDef def = Def("oscillator", "fixed:60", 1e9);
+  ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, "duration_s = 1e+09");
+  def = Def("oscillator", "fixed:60", 1e6);  // within the duration bound: 6e7 frames are too many
+  ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, "duration_s = 1e+06");
+  EXPECT_NE(std::string(ssLastError()).find("frames"), std::string::npos) << ssLastError();
+  def = Def("oscillator", "fixed:1e12", 1.0);  // frames of 1e-12 s: 1e12 of them
+  ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, "fixed:1e12");
+  def = Def("oscillator", "fixed:1", 1000.0);  // 1000 frames, but the accumulator at 1e-9 s: 1e12 steps
+  def.stepping.policy = SS_POLICY_FIXED;
+  def.stepping.fixed_step_s = 1e-9;
+  ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, "steps");
+  def = Def("oscillator", "fixed:1", 1e5);  // 1e5 frames cut into up to 8 substeps of at most 1e-3 s: 8e5 steps...
+  def.stepping.max_step_s = 1e-6;            // ...of at most 1e-6 s: every frame takes all 8 it may: 8e5 steps
+  def.stepping.max_steps_per_frame = 1000;   // with 1000 per frame: 1e8 steps
+  ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, "steps");
+}
+
+TEST(Scenes, NullHandlesAndOutputsAreRefusedByName) {
+  auto names = [](const char* fragment) {
+    return std::string(ssLastError()).find(fragment) != std::string::npos;
+  };
+  ssSceneParams params;
+  EXPECT_EQ(ssDefaultSceneParams(nullptr, &params), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("name = NULL")) << ssLastError();
+  EXPECT_EQ(ssDefaultSceneParams("oscillator", nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("out = NULL")) << ssLastError();
+  EXPECT_EQ(ssSceneFind(nullptr), nullptr);
+  ASSERT_EQ(ssDefaultSceneParams("oscillator", &params), SS_OK);
+  ssStepping stepping = ssDefaultStepping();
+  ssScene* scene = nullptr;
+  EXPECT_EQ(ssScene_Create(nullptr, &params, &stepping, &scene), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("name = NULL")) << ssLastError();
+  EXPECT_EQ(ssScene_Create("oscillator", nullptr, &stepping, &scene), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("params = NULL")) << ssLastError();
+  EXPECT_EQ(ssScene_Create("oscillator", &params, nullptr, &scene), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("stepping = NULL")) << ssLastError();
+  EXPECT_EQ(ssScene_Create("oscillator", &params, &stepping, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("out = NULL")) << ssLastError();
+  EXPECT_EQ(scene, nullptr);
+  int steps = -1;
+  EXPECT_EQ(ssScene_Frame(nullptr, 0.01, &steps), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("scene = NULL")) << ssLastError();
+  EXPECT_EQ(steps, -1);
+  double sample[SS_MAX_QUANTITIES] = {-7, -7, -7, -7};
+  ssScene_Sample(nullptr, sample);
+  EXPECT_TRUE(names("scene = NULL")) << ssLastError();
+  EXPECT_EQ(sample[0], -7);
+  EXPECT_TRUE(std::isnan(ssScene_Time(nullptr)));
+  EXPECT_TRUE(names("scene = NULL")) << ssLastError();
+  ASSERT_EQ(ssScene_Create("oscillator", &params, &stepping, &scene), SS_OK) << ssLastError();
+  ssScene_Sample(scene, nullptr);
+  EXPECT_TRUE(names("out = NULL")) << ssLastError();
+  ssScene_Destroy(scene);
+  ssScene_Destroy(nullptr);
+
+  ssRunDef def = Def("oscillator", "fixed:60", 0.1);
+  ssRun* run = nullptr;
+  EXPECT_EQ(ssRun_Execute(nullptr, &run), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("def = NULL")) << ssLastError();
+  EXPECT_EQ(ssRun_Execute(&def, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("out = NULL")) << ssLastError();
+  def.scene = nullptr;
+  EXPECT_EQ(ssRun_Execute(&def, &run), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("def.scene = NULL")) << ssLastError();
+  def = Def("oscillator", nullptr, 0.1);
+  EXPECT_EQ(ssRun_Execute(&def, &run), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(names("def.profile = NULL")) << ssLastError();
+  EXPECT_EQ(run, nullptr);
+
+  EXPECT_EQ(ssRun_StepCount(nullptr), 0);
+  EXPECT_TRUE(names("run = NULL")) << ssLastError();
+  EXPECT_EQ(ssRun_Times(nullptr), nullptr);
+  EXPECT_EQ(ssRun_StepLengths(nullptr), nullptr);
+  EXPECT_EQ(ssRun_Quantity(nullptr, 0), nullptr);
+  EXPECT_EQ(ssRun_FrameCount(nullptr), 0);
+  EXPECT_EQ(ssRun_WallSeconds(nullptr), 0);
+  EXPECT_EQ(ssRun_Status(nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_STREQ(ssRun_Message(nullptr), "");
+  EXPECT_TRUE(names("run = NULL")) << ssLastError();
+  ssRun_Destroy(nullptr);
+}

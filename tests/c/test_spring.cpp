@@ -5,10 +5,12 @@
 
 #include <cmath>
 #include <complex>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
 
+#include "steadystep/limits.h"
 #include "steadystep/spring.h"
 
 namespace {
@@ -118,9 +120,10 @@ TEST(Frequency, RoundTripsAndMatchesTheDefinition) {
   ASSERT_EQ(ssFrequencyFromSpring(spring, 4.0, &hz, &ratio), SS_OK);
   EXPECT_NEAR(hz, 2.0, 1e-12);
   EXPECT_NEAR(ratio, 0.3, 1e-12);
-  ASSERT_EQ(ssFrequencyFromSpring(ssSpring{0, 2}, 1.0, &hz, &ratio), SS_OK);
-  EXPECT_EQ(hz, 0);
-  EXPECT_TRUE(std::isinf(ratio));
+  // A pure damper has no natural frequency: its damping ratio would be infinite, which no caller can use.
+  EXPECT_EQ(ssFrequencyFromSpring(ssSpring{0, 2}, 1.0, &hz, &ratio), SS_ERROR_NO_FINITE_MAPPING);
+  EXPECT_TRUE(MessageNames("k = 0")) << ssLastError();
+  EXPECT_NEAR(hz, 2.0, 1e-12);
 }
 
 TEST(BadInput, SpringsAreRefusedNamingTheValue) {
@@ -169,7 +172,7 @@ TEST(BadInput, SoftnessOutsideItsRangeIsRefused) {
     ssStatus status;
     const char* names;
   } cases[] = {
-      {{0, 0.1}, SS_ERROR_OUT_OF_RANGE, "erp = 0"},     {{1.5, 0.1}, SS_ERROR_OUT_OF_RANGE, "erp = 1.5"},
+      {{1.5, 0.1}, SS_ERROR_OUT_OF_RANGE, "erp = 1.5"},  {{0.5, 1e21}, SS_ERROR_OUT_OF_RANGE, "cfm = 1e+21"},
       {{-0.2, 0.1}, SS_ERROR_OUT_OF_RANGE, "erp = -0.2"}, {{0.5, 0}, SS_ERROR_OUT_OF_RANGE, "cfm = 0"},
       {{0.5, -1}, SS_ERROR_OUT_OF_RANGE, "cfm = -1"},   {{kNaN, 0.1}, SS_ERROR_NOT_FINITE, "erp = nan"},
       {{0.5, kInf}, SS_ERROR_NOT_FINITE, "cfm = inf"},
@@ -287,6 +290,228 @@ TEST(ExactMapping, RefusesAStepThatWouldNeedNegativeCfm) {
   EXPECT_EQ(ssExactSoftness(ssSpring{400, 0.01}, 1, 0.001, 0.1, &s), SS_ERROR_NO_FINITE_MAPPING);
   EXPECT_TRUE(MessageNames("step_s = 0.001")) << ssLastError();
   ExpectUnchanged(s);
+}
+
+// ---- The conversions' contract over many inputs, extremes included: SS_OK only with a finite result that is valid
+// input for the library (and converts back), otherwise an error naming a value and the output bytes untouched.
+
+// Doubles from the edges of the format as often as from its middle: zeros of both signs, denormals, the normal
+// limits, huge values, infinities and NaN, and log-uniform values of either sign across the whole exponent range.
+class ExtremeDoubles {
+ public:
+  explicit ExtremeDoubles(uint64_t seed) : rng_(seed) {}
+  double operator()() {
+    static const double kSpecial[] = {0.0,   -0.0,   std::numeric_limits<double>::denorm_min(), 1e-320, 1e-310,
+                                      std::numeric_limits<double>::min(), 1e-300, 1e-200, 1e-20, 1e-9, 1e-3, 0.2,
+                                      0.5,   1.0,    10.0,   1e3,    1e9,    1e20,   1e21,   1e200,  1e300, 1e308,
+                                      std::numeric_limits<double>::max(), kInf, kNaN};
+    const size_t special_count = sizeof kSpecial / sizeof kSpecial[0];
+    uint64_t pick = rng_() % 4;
+    double sign = rng_() % 5 == 0 ? -1.0 : 1.0;
+    if (pick == 0) return sign * kSpecial[rng_() % special_count];
+    if (pick == 1) return sign * std::pow(10.0, std::uniform_real_distribution<double>(-330, 309)(rng_));
+    return std::pow(10.0, std::uniform_real_distribution<double>(-4, 4)(rng_));  // the ordinary middle, often
+  }
+  double Unit() { return std::uniform_real_distribution<double>(0, 1)(rng_); }
+
+ private:
+  std::mt19937_64 rng_;
+};
+
+template <typename T>
+T Filled() {  // an output filled with a byte pattern that no conversion writes
+  T value;
+  std::memset(&value, 0xA5, sizeof value);
+  return value;
+}
+
+template <typename T>
+bool Untouched(const T& value) {
+  T pattern = Filled<T>();
+  return std::memcmp(&value, &pattern, sizeof value) == 0;
+}
+
+bool ValidSoftness(ssSoftness s) {
+  return std::isfinite(s.erp) && std::isfinite(s.cfm) && std::abs(s.erp) <= SS_MAX_ERP && s.cfm > 0 &&
+         s.cfm <= SS_MAX_CFM;
+}
+
+bool NamesSomething() { return std::string(ssLastError()).find(" = ") != std::string::npos; }
+
+const int kDraws = 200000;
+
+TEST(ConversionContract, SoftnessFromSpring) {
+  ExtremeDoubles draw(11);
+  int ok = 0;
+  for (int i = 0; i < kDraws; ++i) {
+    ssSpring spring{draw(), draw()};
+    double h = draw();
+    ssSoftness s = Filled<ssSoftness>();
+    if (ssSoftnessFromSpring(spring, h, &s) == SS_OK) {
+      ++ok;
+      ASSERT_TRUE(ValidSoftness(s)) << spring.stiffness << " " << spring.damping << " " << h;
+      ASSERT_GE(s.erp, 0);
+      ASSERT_LE(s.erp, 1);
+      ASSERT_EQ(ssValidateSpring(spring), SS_OK);
+      ASSERT_GE(h, SS_MIN_STEP_S);
+      ASSERT_LE(h, SS_MAX_STEP_S);
+    } else {
+      ASSERT_TRUE(Untouched(s)) << spring.stiffness << " " << spring.damping << " " << h;
+      ASSERT_TRUE(NamesSomething()) << ssLastError();
+    }
+  }
+  EXPECT_GT(ok, kDraws / 20);  // the draw reaches the accepted region often, so the OK branch is exercised
+}
+
+TEST(ConversionContract, SpringFromSoftnessRoundTrips) {
+  ExtremeDoubles draw(12);
+  int ok = 0;
+  for (int i = 0; i < kDraws; ++i) {
+    // erp from the extremes and from [0, 1] (with its ends), where most tuned values live
+    double erp = i % 3 == 0 ? draw() : i % 3 == 1 ? draw.Unit() : (i % 2 ? 0.0 : 1.0);
+    ssSoftness softness{erp, draw()};
+    double h = draw();
+    ssSpring spring = Filled<ssSpring>();
+    if (ssSpringFromSoftness(softness, h, &spring) == SS_OK) {
+      ++ok;
+      ASSERT_TRUE(std::isfinite(spring.stiffness) && std::isfinite(spring.damping));
+      ASSERT_EQ(ssValidateSpring(spring), SS_OK) << ssLastError();
+      ssSoftness back;
+      ASSERT_EQ(ssSoftnessFromSpring(spring, h, &back), SS_OK) << ssLastError();
+      ASSERT_NEAR(back.erp, softness.erp, 1e-12) << softness.erp << " " << softness.cfm << " " << h;
+      ASSERT_NEAR(back.cfm / softness.cfm, 1, 1e-12) << softness.erp << " " << softness.cfm << " " << h;
+    } else {
+      ASSERT_TRUE(Untouched(spring)) << softness.erp << " " << softness.cfm << " " << h;
+      ASSERT_TRUE(NamesSomething()) << ssLastError();
+    }
+  }
+  EXPECT_GT(ok, kDraws / 20);
+}
+
+TEST(ConversionContract, SpringFromFrequencyRoundTrips) {
+  ExtremeDoubles draw(13);
+  int ok = 0;
+  for (int i = 0; i < kDraws; ++i) {
+    double hz = draw(), ratio = i % 4 == 0 ? 0.0 : draw(), mass = draw();
+    ssSpring spring = Filled<ssSpring>();
+    if (ssSpringFromFrequency(hz, ratio, mass, &spring) == SS_OK) {
+      ++ok;
+      ASSERT_TRUE(std::isfinite(spring.stiffness) && std::isfinite(spring.damping));
+      ASSERT_EQ(ssValidateSpring(spring), SS_OK) << ssLastError();
+      double hz_back, ratio_back;
+      ASSERT_EQ(ssFrequencyFromSpring(spring, mass, &hz_back, &ratio_back), SS_OK) << ssLastError();
+      ASSERT_NEAR(hz_back / hz, 1, 1e-12) << hz << " " << ratio << " " << mass;
+      ASSERT_NEAR(ratio_back, ratio, 1e-12 * ratio) << hz << " " << ratio << " " << mass;
+    } else {
+      ASSERT_TRUE(Untouched(spring)) << hz << " " << ratio << " " << mass;
+      ASSERT_TRUE(NamesSomething()) << ssLastError();
+    }
+  }
+  EXPECT_GT(ok, kDraws / 20);
+}
+
+TEST(ConversionContract, FrequencyFromSpringRoundTrips) {
+  ExtremeDoubles draw(14);
+  int ok = 0;
+  for (int i = 0; i < kDraws; ++i) {
+    ssSpring spring{draw(), i % 4 == 0 ? 0.0 : draw()};
+    double mass = draw();
+    double hz = Filled<double>(), ratio = Filled<double>();
+    if (ssFrequencyFromSpring(spring, mass, &hz, &ratio) == SS_OK) {
+      ++ok;
+      ASSERT_TRUE(std::isfinite(hz) && hz > 0 && std::isfinite(ratio) && ratio >= 0);
+      ssSpring back;
+      ASSERT_EQ(ssSpringFromFrequency(hz, ratio, mass, &back), SS_OK)
+          << spring.stiffness << " " << spring.damping << " " << mass << ": " << ssLastError();
+      ASSERT_NEAR(back.stiffness / spring.stiffness, 1, 1e-12);
+      ASSERT_NEAR(back.damping, spring.damping, 1e-12 * spring.damping);
+    } else {
+      ASSERT_TRUE(Untouched(hz) && Untouched(ratio));
+      ASSERT_TRUE(NamesSomething()) << ssLastError();
+    }
+  }
+  EXPECT_GT(ok, kDraws / 20);
+}
+
+TEST(ConversionContract, MatchedAndExactGiveSoftnessOdeHandles) {
+  ExtremeDoubles draw(15);
+  int ok = 0;
+  for (int i = 0; i < kDraws; ++i) {
+    ssSpring spring{draw(), draw()};
+    double mass = draw(), h = draw(), previous = i % 3 == 0 ? 0.0 : draw();
+    for (ssMapping mapping : {SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
+      ssSoftness s = Filled<ssSoftness>();
+      if (ssSoftnessFor(mapping, spring, mass, h, previous, &s) == SS_OK) {
+        ++ok;
+        ASSERT_TRUE(ValidSoftness(s)) << spring.stiffness << " " << spring.damping << " " << mass << " " << h;
+      } else {
+        ASSERT_TRUE(Untouched(s));
+        ASSERT_TRUE(NamesSomething()) << ssLastError();
+      }
+    }
+  }
+  EXPECT_GT(ok, kDraws / 50);
+}
+
+TEST(ConversionContract, TheReportedCasesAreRefusedOrServed) {
+  ssSoftness s = Filled<ssSoftness>();
+  // h·k overflows: was OK with erp = NaN, and wrote {0, inf} before other refusals.
+  EXPECT_EQ(ssSoftnessFromSpring(ssSpring{1e308, 1}, 10, &s), SS_ERROR_NO_FINITE_MAPPING);
+  EXPECT_TRUE(MessageNames("k = 1e+308")) << ssLastError();
+  EXPECT_TRUE(Untouched(s));
+  EXPECT_EQ(ssSoftnessFromSpring(ssSpring{0, 1e-307}, 1.0 / 60, &s), SS_ERROR_NO_FINITE_MAPPING);  // cfm = 1e307
+  EXPECT_TRUE(Untouched(s));
+  EXPECT_EQ(ssSoftnessFromSpring(ssSpring{1, 1}, 1e-200, &s), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(MessageNames("step_s = 1e-200")) << ssLastError();
+  ssSpring spring = Filled<ssSpring>();
+  // denormals: were k = inf, or k = c = 0
+  EXPECT_NE(ssSpringFromSoftness(ssSoftness{1, 1e-320}, 1.0 / 60, &spring), SS_OK);
+  EXPECT_NE(ssSpringFromSoftness(ssSoftness{0.5, 4.9e-324}, 1.0 / 60, &spring), SS_OK);
+  EXPECT_NE(ssSpringFromSoftness(ssSoftness{1e-320, 1e300}, 1.0 / 60, &spring), SS_OK);
+  EXPECT_TRUE(Untouched(spring));
+  EXPECT_EQ(ssSpringFromFrequency(1e200, 0.5, 1, &spring), SS_ERROR_NO_FINITE_MAPPING);
+  EXPECT_TRUE(MessageNames("frequency_hz = 1e+200")) << ssLastError();
+  EXPECT_EQ(ssSpringFromFrequency(1e-200, 0.5, 1, &spring), SS_ERROR_NO_FINITE_MAPPING);
+  EXPECT_TRUE(Untouched(spring));
+  double hz = Filled<double>(), ratio = Filled<double>();
+  EXPECT_EQ(ssFrequencyFromSpring(ssSpring{1e-320, 1}, 1e300, &hz, &ratio), SS_ERROR_NO_FINITE_MAPPING);
+  EXPECT_TRUE(Untouched(hz) && Untouched(ratio));
+}
+
+TEST(ConversionContract, ZeroErpIsAPureDamper) {
+  ssSpring spring;
+  ASSERT_EQ(ssSpringFromSoftness(ssSoftness{0, 0.25}, 1.0 / 60, &spring), SS_OK);
+  EXPECT_EQ(spring.stiffness, 0);
+  EXPECT_FALSE(std::signbit(spring.stiffness));
+  EXPECT_DOUBLE_EQ(spring.damping, 4);
+  ASSERT_EQ(ssSpringFromSoftness(ssSoftness{-0.0, 0.25}, 1.0 / 60, &spring), SS_OK);
+  EXPECT_FALSE(std::signbit(spring.stiffness));
+  // A damper is the same at every step: erp 0, cfm 1/c.
+  ssSoftness s;
+  ASSERT_EQ(ssSoftnessFromSpring(spring, 1.0 / 15, &s), SS_OK);
+  EXPECT_EQ(s.erp, 0);
+  EXPECT_DOUBLE_EQ(s.cfm, 0.25);
+}
+
+TEST(ConversionContract, NullOutputsAreRefusedByName) {
+  double hz;
+  EXPECT_EQ(ssSoftnessFromSpring(ssSpring{1, 1}, 0.01, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(MessageNames("out = NULL"));
+  EXPECT_EQ(ssSpringFromSoftness(ssSoftness{0.5, 0.1}, 0.01, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(MessageNames("out = NULL"));
+  EXPECT_EQ(ssSpringFromFrequency(1, 0.5, 1, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(MessageNames("out = NULL"));
+  EXPECT_EQ(ssFrequencyFromSpring(ssSpring{1, 1}, 1, nullptr, &hz), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(MessageNames("frequency_hz = NULL"));
+  EXPECT_EQ(ssFrequencyFromSpring(ssSpring{1, 1}, 1, &hz, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(MessageNames("damping_ratio = NULL"));
+  for (ssMapping mapping : {SS_MAPPING_SPRING, SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
+    EXPECT_EQ(ssSoftnessFor(mapping, ssSpring{1, 1}, 1, 0.01, 0.01, nullptr), SS_ERROR_OUT_OF_RANGE);
+    EXPECT_TRUE(MessageNames("out = NULL"));
+  }
+  EXPECT_EQ(ssMatchedSoftness(ssSpring{1, 1}, 1, 0.01, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssExactSoftness(ssSpring{1, 1}, 1, 0.01, 0, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(MessageNames("out = NULL"));
 }
 
 }  // namespace
