@@ -2,6 +2,7 @@
 #include <math.h>
 
 #include "error.h"
+#include "ode_bounds.h"
 #include "joint_rows.h"
 #include "registry_internal.h"
 #include "row_law.h"
@@ -19,6 +20,7 @@ ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, con
   ssSoftness softness;
   ssRowFallback fallback;
   ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, &fallback, &softness);
+  if (status == SS_OK) status = ssCheckSoftnessForOde("contact", softness.erp, softness.cfm);
   if (status != SS_OK) return status;
   contact->surface.mode |= dContactSoftERP | dContactSoftCFM;
   contact->surface.soft_erp = softness.erp;
@@ -32,8 +34,8 @@ ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpri
   if (contact == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "contact = NULL: a contact is required");
   if (ssMappingName(mapping) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "mapping = %d: unknown", (int)mapping);
   ssStatus status = ssValidateSpring(spring);
-  if (status == SS_OK) status = ssCheckPositive("step_s", "s", step_s);
-  if (status == SS_OK) status = ssCheckNonNegative("previous_step_s", "s", previous_step_s);
+  if (status == SS_OK) status = ssCheckStepLength("step_s", step_s);
+  if (status == SS_OK && previous_step_s != 0) status = ssCheckStepLength("previous_step_s", previous_step_s);
   if (status != SS_OK) return status;
   ssRowLaw law = ssRowLawOfSpring(spring);
   return ssContactSoftenLaw(contact, body1, body2, &law, mapping, step_s, previous_step_s, NULL);

@@ -7,6 +7,7 @@
 
 #include "array.h"
 #include "error.h"
+#include "ode_bounds.h"
 #include "joint_rows.h"
 #include "registry_internal.h"
 #include "row_law.h"
@@ -317,8 +318,8 @@ static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
 ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
                           ssApplyReport* report) {
   REQUIRE_REGISTRY(registry);
-  ssStatus status = ssCheckPositive("step_s", "s", step_s);
-  if (status == SS_OK) status = ssCheckNonNegative("previous_step_s", "s", previous_step_s);
+  ssStatus status = ssCheckStepLength("step_s", step_s);
+  if (status == SS_OK && previous_step_s != 0) status = ssCheckStepLength("previous_step_s", previous_step_s);
   if (status != SS_OK) return status;
   if (ssMappingName(mapping) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "mapping = %d: unknown", (int)mapping);
 
@@ -326,6 +327,8 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   if (registry->world_bound) {
     status = softnessFor(&registry->world_law, mapping, registry->world_mass, step_s, previous_step_s, &counts,
                          &registry->world_pending);
+    if (status == SS_OK)
+      status = ssCheckSoftnessForOde("softness", registry->world_pending.erp, registry->world_pending.cfm);
     if (status != SS_OK) return failBinding(status, NULL);
   }
   /* Programs bind many rows to a few springs: under the spring mapping each one's softness is computed once. */
@@ -350,6 +353,8 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
       continue;
     }
     status = softnessFor(&binding->law, mapping, mass, step_s, previous_step_s, &counts, &binding->pending);
+    /* the boundary with ODE: nothing outside limits.h's ranges is ever written */
+    if (status == SS_OK) status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
     if (status != SS_OK) return failBinding(status, binding);
     if (mapping == SS_MAPPING_SPRING || binding->law.hard) {
       int slot = cached < kCacheSize ? cached++ : i % kCacheSize;

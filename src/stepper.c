@@ -9,6 +9,7 @@
 
 #include "array.h"
 #include "error.h"
+#include "ode_bounds.h"
 #include "registry_internal.h"
 #include "steadystep/adopt.h"
 #include "steadystep/stepper.h"
@@ -87,12 +88,16 @@ ssStatus ssPolicyParse(const char* name, ssPolicy* out) {
 }
 
 static ssStatus checkStepLength(const char* name, double value, int allow_zero) {
-  ssStatus status = ssCheckFinite(name, "s", value);
-  if (status != SS_OK || (allow_zero && value == 0)) return status;
-  if (!(value >= SS_MIN_STEP_S && value <= SS_MAX_FRAME_S))
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = %g s: must be in [%g, %g] s%s", name, value, SS_MIN_STEP_S,
-                  SS_MAX_FRAME_S, allow_zero ? " or 0" : "");
-  return SS_OK;
+  if (allow_zero && value == 0) return SS_OK;
+  return ssCheckStepLength(name, value);
+}
+
+static ssStatus checkSpeed(const char* name, const char* unit, double value) {
+  ssStatus status = ssCheckNonNegative(name, unit, value);
+  if (status == SS_OK && value > SS_MAX_SAFE_SPEED)
+    status = ssFail(SS_ERROR_OUT_OF_RANGE, "%s = %g %s: must be at most SS_MAX_SAFE_SPEED = %g (0 = that bound)",
+                    name, value, unit, SS_MAX_SAFE_SPEED);
+  return status;
 }
 
 static ssStatus validateDef(const ssStepperDef* def) {
@@ -109,8 +114,8 @@ static ssStatus validateDef(const ssStepperDef* def) {
   ssStatus status = checkStepLength("max_step_s", def->max_step_s, 0);
   if (status == SS_OK) status = checkStepLength("reference_step_s", def->reference_step_s, 1);
   if (status == SS_OK) status = checkStepLength("fixed_step_s", def->fixed_step_s, 0);
-  if (status == SS_OK) status = ssCheckNonNegative("max_speed", "m/s", def->max_speed);
-  if (status == SS_OK) status = ssCheckNonNegative("max_angular_speed", "rad/s", def->max_angular_speed);
+  if (status == SS_OK) status = checkSpeed("max_speed", "m/s", def->max_speed);
+  if (status == SS_OK) status = checkSpeed("max_angular_speed", "rad/s", def->max_angular_speed);
   return status;
 }
 
@@ -143,6 +148,8 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   ssStepper* stepper = calloc(1, sizeof *stepper);
   if (stepper == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating a stepper");
   stepper->def = *def;
+  if (stepper->def.max_speed == 0) stepper->def.max_speed = SS_MAX_SAFE_SPEED;
+  if (stepper->def.max_angular_speed == 0) stepper->def.max_angular_speed = SS_MAX_SAFE_SPEED;
   stepper->contact_tuned = (ssSoftness){NAN, NAN};
   describeNextStep(stepper);
   *out = stepper;
@@ -381,12 +388,10 @@ static ssStatus checkBody(const ssStepper* stepper, dBodyID body) {
   double speed2 = velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2];
   double spin2 = spin[0] * spin[0] + spin[1] * spin[1] + spin[2] * spin[2];
   double max_speed = stepper->def.max_speed, max_spin = stepper->def.max_angular_speed;
-  if (isfinite(sum) && (max_speed == 0 || speed2 <= max_speed * max_speed) &&
-      (max_spin == 0 || spin2 <= max_spin * max_spin))
-    return SS_OK;
+  if (isfinite(sum) && speed2 <= max_speed * max_speed && spin2 <= max_spin * max_spin) return SS_OK;
   if (!isfinite(sum) || !isfinite(speed2) || !isfinite(spin2))
     return ssFail(SS_ERROR_BLOWUP, "body %p: position or velocity is not finite", (void*)body);
-  if (max_speed != 0 && speed2 > max_speed * max_speed)
+  if (speed2 > max_speed * max_speed)
     return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: speed %g m/s is above max_speed = %g m/s", (void*)body,
                   sqrt(speed2), max_speed);
   return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: angular speed %g rad/s is above max_angular_speed = %g rad/s",
@@ -472,7 +477,7 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
     cut.softness_step_s = referenceStep(stepper);
   } else {
     double count = ceil(total_s / stepper->def.max_step_s - kStepCountSlack);
-    if (count > (double)INT32_MAX)
+    if (count > (double)INT32_MAX) /* max_step_s >= SS_MIN_STEP_S and frame_s <= SS_MAX_FRAME_S: never */
       return ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: more than %d substeps of max_step_s = %g s", frame_s,
                     INT32_MAX, stepper->def.max_step_s);
     cut.steps = count < 1 ? 1 : (int)count;
@@ -523,7 +528,7 @@ ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* repor
   ssStatus status = ssCheckNonNegative("frame_s", "s", frame_s);
   if (status == SS_OK && frame_s > SS_MAX_FRAME_S)
     status = ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: must be at most SS_MAX_FRAME_S = %g s", frame_s,
-                    SS_MAX_FRAME_S);
+                    (double)SS_MAX_FRAME_S);
   if (status != SS_OK || frame_s == 0) return status;
   if ((status = refreshKnown(stepper)) != SS_OK) return status;
   captureForces(stepper);

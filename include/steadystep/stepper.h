@@ -24,6 +24,7 @@
 
 #include <ode/ode.h>
 
+#include "steadystep/limits.h"
 #include "steadystep/registry.h"
 
 #ifdef __cplusplus
@@ -77,9 +78,10 @@ typedef struct ssStepperDef {
   double reference_step_s;      /* NAIVE: the step its softness was tuned at (s), > 0; default 1/30 */
   double fixed_step_s;          /* FIXED: the constant step (s), > 0; default 1/60 */
   int max_steps_per_frame;      /* FIXED: cap against the spiral of death (later time is dropped), > 0; default 8 */
-  /* A known body faster than this after a step is a runaway (m/s, rad/s); 0 switches the check off. Default
-   * 1e4 m/s and 1e4 rad/s: far above anything a game moves, low enough to stop a blow-up before ODE 0.16 aborts
-   * the process (a non-finite rotation fails an assertion inside the next step). Raise them for faster bodies. */
+  /* A known body faster than this after a step is a runaway (m/s, rad/s), in [0, SS_MAX_SAFE_SPEED]. Default
+   * 1e4 m/s and 1e4 rad/s: far above anything a game moves, and a blow-up is stopped long before ODE 0.16 would
+   * abort the process (a non-finite rotation fails an assertion inside the next step). Raise them for faster
+   * bodies; 0 leaves only the guard ODE itself needs, SS_MAX_SAFE_SPEED. */
   double max_speed;
   double max_angular_speed;
   /* Before each step, after the frame's forces were put back and the registry applied: add forces that depend on
@@ -111,10 +113,9 @@ typedef struct ssFrameReport {
   dBodyID failed_body;        /* the body that blew up or ran too fast, else 0 */
 } ssFrameReport;
 
-/** The shortest physics step the stepper hands ODE (s). A frame shorter than this is carried over to the next one. */
-#define SS_MIN_STEP_S 1e-9
-/** The longest frame ssStepper_Step takes (s): longer is refused (a frame is never a day). */
-#define SS_MAX_FRAME_S 3600.0
+/** The longest frame ssStepper_Step takes (s): SS_MAX_STEP_S (limits.h), since SS_POLICY_NAIVE steps it whole.
+ *  A frame shorter than SS_MIN_STEP_S is carried over to the next one, never stepped. */
+#define SS_MAX_FRAME_S SS_MAX_STEP_S
 
 /** The defaults listed at each field. */
 ssStepperDef ssDefaultStepperDef(void);
