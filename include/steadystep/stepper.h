@@ -16,6 +16,17 @@
  *                                                                        ssStepper_Reset(stepper); }
  *     }
  *
+ * Threads. Each stepper's world may be stepped from its own thread, one thread per world, on ODE 0.16's terms:
+ * every world shares one process-wide default threading implementation, and stepping two worlds with it at once
+ * crashes the process. Before a world is stepped off the main thread, give it its own:
+ *     impl = dThreadingAllocateSelfThreadedImplementation();
+ *     dWorldSetStepThreadingImplementation(world, dThreadingImplementationGetFunctions(impl), impl);
+ * and when done: dWorldSetStepThreadingImplementation(world, NULL, NULL), dWorldDestroy, dThreadingFreeImplementation.
+ * Every thread that uses ODE calls dAllocateODEDataForThread(dAllocateMaskAll) first; dInitODE2 runs once, before
+ * the threads start. dWorldQuickStep shuffles rows with ODE's one global generator, so concurrent QuickSteps are
+ * not reproducible run to run; dWorldStep is. A stepper and its registry are used from one thread at a time.
+ * tests/c/test_threads.cpp shows two worlds on two threads.
+ *
  * Known bodies: the bodies of the registry (bound, adopted) and those given to ssStepper_WatchBody. They are the
  * ones whose forces are kept for the whole frame and whose state is checked after every step.
  */
