@@ -17,6 +17,7 @@
 
 #include "error.h"
 #include "ode_bounds.h"
+#include "matched_internal.h"
 #include "steadystep/spring.h"
 
 /* e^(-σt)·C(t) and e^(-σt)·S(t), and C(t)/S(t), computed without overflow for strongly over-damped springs and
@@ -68,17 +69,45 @@ static ssStatus finish(double a, double erp, double step_s, double mass, ssSoftn
   return SS_OK;
 }
 
+/* With d = e^(-σh), P = d², the numerator of erp, 1 + P - 2·d·C(h), is written as (1 - d)² + 2·d·(1 - C(h)): both
+ * terms are computed without cancellation, so erp keeps its digits at short steps (where it is O(h²)·k/c and the
+ * closed form subtracts numbers near 1), and 1 - P = (1 - d)(1 + d) needs no second exponential. */
+ssStatus ssMatchedSoftnessUnchecked(ssSpring spring, double mass, double step_s, ssSoftness* out) {
+  double sigma = spring.damping / (2.0 * mass);
+  double sigma_h = sigma * step_s;
+  double one_minus_d = -expm1(-sigma_h);
+  double d = sigma_h < 0.5 ? 1.0 - one_minus_d : exp(-sigma_h);
+  double one_minus_product = one_minus_d * (1.0 + d);
+  double product = d * d;
+  double twice_d_one_minus_c; /* 2·d·(1 - C(h)) */
+  if (spring.stiffness == 0) {
+    twice_d_one_minus_c = -one_minus_d * one_minus_d; /* a damper's poles are 1 and P: erp is 0 */
+  } else {
+    double q = spring.stiffness / mass - sigma * sigma;
+    double half_angle = 0.5 * sqrt(fabs(q)) * step_s;
+    if (fabs(q) * step_s * step_s < 1e-6) {
+      double qh2 = q * step_s * step_s;
+      twice_d_one_minus_c = d * (qh2 - qh2 * qh2 / 12.0);
+    } else if (q > 0) {
+      double s = sin(half_angle);
+      twice_d_one_minus_c = 4.0 * d * s * s;
+    } else if (half_angle < 0.5) {
+      double s = sinh(half_angle);
+      twice_d_one_minus_c = -4.0 * d * s * s;
+    } else { /* 2d - d(e^(μh) + e^(-μh)), in exponents that cannot overflow for a strongly over-damped spring */
+      double mu_h = 2.0 * half_angle;
+      twice_d_one_minus_c = 2.0 * d - exp(mu_h - sigma_h) - exp(-mu_h - sigma_h);
+    }
+  }
+  double a = product / one_minus_product;
+  double erp = (one_minus_d * one_minus_d + twice_d_one_minus_c) / one_minus_product;
+  return finish(a, erp, step_s, mass, out);
+}
+
 ssStatus ssMatchedSoftness(ssSpring spring, double mass, double step_s, ssSoftness* out) {
   ssStatus status = validate(spring, mass, step_s, out);
   if (status != SS_OK) return status;
-  double sigma = spring.damping / (2.0 * mass);
-  double q = spring.stiffness / mass - sigma * sigma;
-  Propagator p = propagate(sigma, q, step_s);
-  double one_minus_product = -expm1(-2.0 * sigma * step_s);
-  double product = 1.0 - one_minus_product;
-  double a = product / one_minus_product;
-  double erp = (one_minus_product + 2.0 * product - 2.0 * p.decayed_c) / one_minus_product;
-  return finish(a, erp, step_s, mass, out);
+  return ssMatchedSoftnessUnchecked(spring, mass, step_s, out);
 }
 
 ssStatus ssExactSoftness(ssSpring spring, double mass, double step_s, double previous_step_s, ssSoftness* out) {

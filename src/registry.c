@@ -25,6 +25,10 @@ typedef struct JointBinding {
   /* The spring mapping needs the mass only for the Nyquist report: it is refreshed every few Applies there. */
   double report_mass;
   int report_mass_age;
+  /* what pending was computed from: the mappings are pure functions of these, so equal inputs reuse it */
+  ssMapping computed_mapping;
+  double computed_mass, computed_step_s, computed_previous_s;
+  ssRowFallback computed_fallback;
 } JointBinding;
 
 struct ssRegistry {
@@ -103,7 +107,8 @@ int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam par
 
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass) {
-  JointBinding binding = {joint, param, axis, law, effective_mass, {0, 0}, {NAN, NAN}, 0, NAN, 0};
+  JointBinding binding = {joint, param, axis, law, effective_mass, {0, 0}, {NAN, NAN}, 0, NAN, 0,
+                          SS_MAPPING_SPRING, NAN, NAN, NAN, {0, 0}};
   JointBinding* existing = findJoint(registry, joint, param, axis);
   if (existing != NULL) {
     *existing = binding;
@@ -237,13 +242,19 @@ static ssStatus failBinding(ssStatus status, const JointBinding* binding) {
 enum { kReportMassRefresh = 16 };
 
 /* The softness of one row for this step, counting the fallbacks in the report. */
-static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass, double step_s,
-                            double previous_step_s, ssApplyReport* report, ssSoftness* out) {
-  ssRowFallback fallback;
-  ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, &fallback, out);
-  report->rows_exact_fallback += fallback.exact_to_matched;
-  report->rows_spring_fallback += fallback.to_spring;
+static void countRow(const ssRowLaw* law, double mass, double step_s, const ssRowFallback* fallback,
+                     ssApplyReport* report) {
+  report->rows_exact_fallback += fallback->exact_to_matched;
+  report->rows_spring_fallback += fallback->to_spring;
   if (!law->hard) report->rows_over_nyquist += ssOverNyquist(law->spring, mass, step_s);
+}
+
+/* The softness of one row for this step, counting in the report how it was obtained. */
+static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass, double step_s,
+                            double previous_step_s, ssApplyReport* report, ssRowFallback* fallback,
+                            ssSoftness* out) {
+  ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, fallback, out);
+  countRow(law, mass, step_s, fallback, report);
   return status;
 }
 
@@ -325,8 +336,9 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
 
   ssApplyReport counts = {0, 0, 0, 0};
   if (registry->world_bound) {
+    ssRowFallback fallback;
     status = softnessFor(&registry->world_law, mapping, registry->world_mass, step_s, previous_step_s, &counts,
-                         &registry->world_pending);
+                         &fallback, &registry->world_pending);
     if (status == SS_OK)
       status = ssCheckSoftnessForOde("softness", registry->world_pending.erp, registry->world_pending.cfm);
     if (status != SS_OK) return failBinding(status, NULL);
@@ -352,10 +364,26 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
       if (!binding->law.hard) counts.rows_over_nyquist += ssOverNyquist(binding->law.spring, mass, step_s);
       continue;
     }
-    status = softnessFor(&binding->law, mapping, mass, step_s, previous_step_s, &counts, &binding->pending);
+    /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
+     * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
+    double previous_s = mapping == SS_MAPPING_EXACT ? previous_step_s : 0;
+    if (mapping != SS_MAPPING_SPRING && binding->computed_mapping == mapping && binding->computed_mass == mass &&
+        binding->computed_step_s == step_s && binding->computed_previous_s == previous_s) {
+      countRow(&binding->law, mass, step_s, &binding->computed_fallback, &counts);
+      continue;
+    }
+    status = softnessFor(&binding->law, mapping, mass, step_s, previous_s, &counts, &binding->computed_fallback,
+                         &binding->pending);
     /* the boundary with ODE: nothing outside limits.h's ranges is ever written */
     if (status == SS_OK) status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
-    if (status != SS_OK) return failBinding(status, binding);
+    if (status != SS_OK) {
+      binding->computed_step_s = NAN;
+      return failBinding(status, binding);
+    }
+    binding->computed_mapping = mapping;
+    binding->computed_mass = mass;
+    binding->computed_step_s = step_s;
+    binding->computed_previous_s = previous_s;
     if (mapping == SS_MAPPING_SPRING || binding->law.hard) {
       int slot = cached < kCacheSize ? cached++ : i % kCacheSize;
       cached_law[slot] = binding->law;

@@ -5,6 +5,7 @@
 #include <stddef.h>
 
 #include "error.h"
+#include "matched_internal.h"
 
 ssRowLaw ssRowLawOfSpring(ssSpring spring) { return (ssRowLaw){.spring = spring, .hard = 0, .hard_rate_per_s = 0}; }
 
@@ -47,9 +48,12 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
      * step can sample: a near-rigid row above Nyquist has poles that no (erp, cfm) of this step reproduces. */
     int servable = mass > 0 && isfinite(mass) && law->spring.damping > 0 && !ssOverNyquist(law->spring, mass, step_s);
     if (servable) {
-      ssStatus status = ssSoftnessFor(mapping, law->spring, mass, step_s, previous_step_s, out);
+      /* the law, the mass and the step are valid here: the matched mapping needs no second check */
+      ssStatus status = mapping == SS_MAPPING_MATCHED
+                            ? ssMatchedSoftnessUnchecked(law->spring, mass, step_s, out)
+                            : ssExactSoftness(law->spring, mass, step_s, previous_step_s, out);
       if (status == SS_ERROR_NO_FINITE_MAPPING && mapping == SS_MAPPING_EXACT) {
-        status = ssMatchedSoftness(law->spring, mass, step_s, out);
+        status = ssMatchedSoftnessUnchecked(law->spring, mass, step_s, out);
         fallback->exact_to_matched = status == SS_OK;
       }
       if (status == SS_OK) return SS_OK;
