@@ -94,12 +94,27 @@ class SteadystepError(ValueError):
         return f"{self.message} ({self.status})" if self.message else self.status
 
 
+def _decode(raw: bytes) -> str:
+    # C messages are cut at 255 bytes, possibly inside a UTF-8 character, and may quote bytes from a file or an
+    # argument that are not UTF-8 at all: such bytes become U+FFFD instead of an exception.
+    return raw.decode("utf-8", errors="replace")
+
+
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
+
+
+def one_line(message: str) -> str:
+    """message as one printable line: control characters (a newline, an escape sequence quoted from a binary
+    file) as \\xNN escapes, so that a message can neither span lines nor drive the terminal."""
+    return _CONTROL.sub(lambda match: f"\\x{ord(match.group()):02x}", message)
+
+
 def status_name(code: int) -> str:
-    return ffi.string(lib.ssStatusName(code)).decode()
+    return _decode(ffi.string(lib.ssStatusName(code)))
 
 
 def last_error() -> str:
-    return ffi.string(lib.ssLastError()).decode()
+    return one_line(_decode(ffi.string(lib.ssLastError())))
 
 
 def check(code: int) -> None:
@@ -109,5 +124,72 @@ def check(code: int) -> None:
 
 
 def text(pointer) -> str | None:
-    """A C string as str; None for NULL."""
-    return None if pointer == ffi.NULL else ffi.string(pointer).decode()
+    """A C string as str (bytes that are not UTF-8 replaced by U+FFFD); None for NULL."""
+    return None if pointer == ffi.NULL else _decode(ffi.string(pointer))
+
+
+def printable(value: str) -> str:
+    """value as text that any UTF-8 stream or file takes: arguments that were not UTF-8 reach Python as lone
+    surrogates (surrogateescape), which print as U+FFFD here; any other lone surrogate as a backslash escape."""
+    try:
+        return value.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+    except UnicodeEncodeError:
+        return value.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
+def c_string(name: str, value) -> bytes:
+    """value as the bytes of a C string for the parameter called name.
+
+    Text that came from bytes that are not UTF-8 (surrogateescape, as in sys.argv and os.fsdecode) goes back to
+    those bytes, so that a file name reaches C as it is on disk. Raises SteadystepError naming the value for
+    anything that is not a str or bytes, for an embedded NUL (C would read only the text before it) and for text
+    that has no bytes (a lone surrogate from elsewhere)."""
+    if isinstance(value, str):
+        try:
+            raw = value.encode("utf-8", "surrogateescape")
+        except UnicodeEncodeError:
+            raise SteadystepError("out of range", f"{name} = {shown(value)}: has characters that are not text "
+                                  "(lone surrogates)") from None
+    elif isinstance(value, (bytes, bytearray)):
+        raw = bytes(value)
+    else:
+        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be a string")
+    if b"\0" in raw:
+        raise SteadystepError("out of range", f"{name} = {shown(value)}: contains a NUL character")
+    return raw
+
+
+def number(name: str, value, unit: str = "") -> float:
+    """value as a float for the parameter called name; SteadystepError naming it when it is not a number."""
+    if isinstance(value, (str, bytes, bytearray)):
+        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be a number{_unit(unit)}")
+    try:
+        return float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be a number{_unit(unit)}"
+                              ) from None
+
+
+def integer(name: str, value, low: int, high: int) -> int:
+    """value as an int in [low, high] for the parameter called name; SteadystepError naming it otherwise."""
+    if isinstance(value, bool) or not hasattr(value, "__index__"):
+        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be an integer")
+    value = value.__index__()
+    if not low <= value <= high:
+        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be in [{low}, {high}]")
+    return value
+
+
+def _unit(unit: str) -> str:
+    return f" ({unit})" if unit else ""
+
+
+def shown(value) -> str:
+    """value for a message: its repr, cut to 80 characters (a message is one line, whatever it quotes)."""
+    try:
+        quoted = repr(value)
+    except ValueError:  # an int too long to print in decimal
+        return f"<an integer of {value.bit_length()} bits>" if isinstance(value, int) else "<unprintable>"
+    except Exception:  # a foreign object whose repr fails: the message still has to be written
+        return f"<a {type(value).__name__}>"
+    return quoted if len(quoted) <= 80 else quoted[:77] + "..."

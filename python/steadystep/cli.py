@@ -1,7 +1,10 @@
 """The `steadystep` command: figure, compare, run, probe, convert. A thin layer over the package.
 
-Bad arguments and every SteadystepError end with one line on stderr and exit code 2, never a traceback. Output
-files are written whole (temporary name, then rename).
+Whatever the arguments' bytes, the command never shows a traceback. Exit codes: 0 done; 1 a run blew up (its
+records are still written); 2 a refusal: bad arguments, every SteadystepError, a file that cannot be read or
+written, a --json result that is not finite, with one line on stderr naming the value; 3 an internal error (a bug),
+with one line naming it; 130 interrupted; 141 stdout closed early (a pipe to `head`). Output files are written
+whole (temporary name, then rename). --json output is strict JSON (no NaN or Infinity).
 """
 
 from __future__ import annotations
@@ -11,14 +14,26 @@ import csv
 import io
 import json
 import math
+import os
 import shlex
 import sys
+import warnings
 from pathlib import Path
 
-from steadystep._native import SteadystepError
+import numpy as np
 
-EXIT_BAD_INPUT = 2
+from steadystep._native import SteadystepError, one_line, printable
+from steadystep.limits import MAX_RUN_STEPS, MIN_MEASURED_DURATION_S
+
 EXIT_BLOWUP = 1
+EXIT_BAD_INPUT = 2
+EXIT_INTERNAL = 3
+EXIT_INTERRUPTED = 130
+EXIT_BROKEN_PIPE = 141
+
+RUN_BOUND_HELP = (f"A run may take at most {MAX_RUN_STEPS:.0e} steps of the longest step allowed (--max-step, "
+                  f"default 1/60 s: {MAX_RUN_STEPS / 60:.0f} s) and at most {MAX_RUN_STEPS:.0e} frames of its "
+                  "profile; a run above that is refused before it starts.")
 
 
 class _UsageError(Exception):
@@ -33,19 +48,23 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    value = _float(text)
     if not math.isfinite(value) or value <= 0:
         raise argparse.ArgumentTypeError(f"{text!r} must be a finite number above 0")
+    return value
+
+
+def _measured_duration(text: str) -> float:
+    value = _positive_float(text)
+    if value < MIN_MEASURED_DURATION_S:
+        raise argparse.ArgumentTypeError(f"{text!r} s is too short to measure: at least {MIN_MEASURED_DURATION_S:g} s")
     return value
 
 
 def _float(text: str) -> float:
     try:
         return float(text)
-    except ValueError:
+    except (ValueError, OverflowError):
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
 
 
@@ -70,7 +89,9 @@ def build_parser() -> argparse.ArgumentParser:
     from steadystep.profiles import DEFAULT_PROFILES
 
     parser = _Parser(prog="steadystep", description="Frame-rate independent constraint softness for ODE: the "
-                     "article's figure, comparisons on real ODE scenes, single runs and conversions.")
+                     "article's figure, comparisons on real ODE scenes, single runs and conversions.",
+                     epilog="Exit codes: 0 done, 1 a run blew up, 2 refused (one line on stderr naming the value), "
+                     "3 internal error. " + RUN_BOUND_HELP)
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     figure = commands.add_parser("figure", help="reproduce the article's figure (PNG and SVG)",
@@ -78,13 +99,14 @@ def build_parser() -> argparse.ArgumentParser:
                                  "30 fps red, variable 15-45 fps green) and the same three curves from real ODE.")
     figure.add_argument("--out", type=_out_dir, default=Path("."), metavar="DIR",
                         help="directory for article_figure.png and .svg (default: the current one)")
-    figure.add_argument("--duration", type=_positive_float, default=5.0, metavar="S", help="seconds (default 5)")
+    figure.add_argument("--duration", type=_measured_duration, default=5.0, metavar="S",
+                        help=f"seconds, at least {MIN_MEASURED_DURATION_S:g} (default 5); bounded as every run")
     figure.add_argument("--seed", type=_seed, default=1, metavar="N", help="seed of the 15-45 fps frames")
 
     compare = commands.add_parser("compare", help="run scenes x profiles x policies and write the report",
                                   description="Runs every scene under every profile and policy, measures each run "
                                   "against a reference at 1/1000 s, and writes report.html, metrics.json, "
-                                  "metrics.csv and the figures to --out.")
+                                  "metrics.csv and the figures to --out. " + RUN_BOUND_HELP)
     compare.add_argument("--out", type=_out_dir, default=Path("report"), metavar="DIR",
                          help="output directory (default: ./report)")
     compare.add_argument("--scenes", nargs="+", metavar="SCENE", help="default: every scene")
@@ -92,44 +114,48 @@ def build_parser() -> argparse.ArgumentParser:
                          help=f"frame-time profiles (default: {' '.join(DEFAULT_PROFILES)})")
     compare.add_argument("--policies", nargs="+", metavar="POLICY",
                          help="default: naive spring fixed, and also matched exact for the oscillator")
-    compare.add_argument("--duration", type=_positive_float, default=5.0, metavar="S",
-                         help="simulated seconds per run (default 5)")
+    compare.add_argument("--duration", type=_measured_duration, default=5.0, metavar="S",
+                         help=f"simulated seconds per run, at least {MIN_MEASURED_DURATION_S:g} (default 5); the "
+                         f"reference's 1 ms steps bound it to {MAX_RUN_STEPS / 1000:.0f} s")
     compare.add_argument("--seed", type=_seed, default=1, metavar="N", help="profile seed (default 1)")
 
     run = commands.add_parser("run", help="one run of a scene; the trajectory as CSV or JSON",
                               description="Runs SCENE under a frame-time profile and a policy and prints one record "
-                              "per physics step: t and the scene's quantities (oscillator: t,x,v,erp,cfm).")
+                              "per physics step: t and the scene's quantities (oscillator: t,x,v,erp,cfm). "
+                              + RUN_BOUND_HELP)
     run.add_argument("scene", metavar="SCENE", help="oscillator, buggy, drop, chain or pile")
     run.add_argument("--profile", required=True, metavar="SPEC",
                      help="fixed:FPS, uniform:MIN:MAX, jitter:FPS:MS, hitch:FPS:EVERY:S, vsync:A:B or trace:FILE")
     run.add_argument("--policy", required=True, metavar="P", help="naive, spring, matched, exact or fixed")
-    run.add_argument("--duration", type=_positive_float, default=5.0, metavar="S", help="seconds (default 5)")
+    run.add_argument("--duration", type=_positive_float, default=5.0, metavar="S",
+                     help=f"seconds (default 5), at most {MAX_RUN_STEPS:.0e} steps of --max-step")
     run.add_argument("--seed", type=_seed, default=1, metavar="N", help="profile seed (default 1)")
     run.add_argument("--max-step", type=_positive_float, metavar="S", help="longest physics step (default 1/60 s)")
     output = run.add_mutually_exclusive_group()
     output.add_argument("--csv", type=Path, metavar="FILE", help="write CSV to FILE (default: CSV on stdout)")
-    output.add_argument("--json", action="store_true", help="JSON on stdout: columns and a summary")
+    output.add_argument("--json", action="store_true", help="strict JSON on stdout: columns and a summary")
 
     probe = commands.add_parser("probe", help="the largest step a scene survives under each policy",
                                 description="Bisects for the longest physics step (every frame one step of h) at "
                                 "which SCENE stays stable: no blow-up, and its motion within the reference run's "
-                                "range widened by that range on both sides.")
+                                "range widened by that range on both sides. A trial at --low may take at most "
+                                f"{MAX_RUN_STEPS:.0e} steps.")
     probe.add_argument("scene", metavar="SCENE", help="oscillator, buggy, drop, chain or pile")
     probe.add_argument("--policies", nargs="+", metavar="POLICY", default=["naive", "spring", "matched", "exact"],
                        help="default: naive spring matched exact")
-    probe.add_argument("--duration", type=_positive_float, default=3.0, metavar="S",
-                       help="seconds per trial (default 3)")
+    probe.add_argument("--duration", type=_measured_duration, default=3.0, metavar="S",
+                       help=f"seconds per trial, at least {MIN_MEASURED_DURATION_S:g} (default 3)")
     probe.add_argument("--low", type=_positive_float, default=0.001, metavar="S",
                        help="shortest step tried (default 0.001 s)")
     probe.add_argument("--high", type=_positive_float, default=0.25, metavar="S",
                        help="longest step tried (default 0.25 s)")
-    probe.add_argument("--json", action="store_true", help="JSON on stdout")
+    probe.add_argument("--json", action="store_true", help="strict JSON on stdout")
 
     convert = commands.add_parser("convert", help="springs <-> ERP/CFM <-> frequency and damping ratio",
                                   description="One of: --k K --c C --dt H (spring to ERP/CFM), --erp E --cfm F "
                                   "--dt H (tuned ERP/CFM to a spring), --frequency HZ --damping-ratio Z --mass M "
                                   "(to a spring; add --dt H for its ERP/CFM). With --mass, k/c also give the "
-                                  "matched mapping and the frequency.")
+                                  "matched mapping and the frequency. A result that is not finite is refused.")
     convert.add_argument("--k", type=_float, metavar="K", help="stiffness (N/m)")
     convert.add_argument("--c", type=_float, metavar="C", help="damping (N·s/m)")
     convert.add_argument("--erp", type=_float, metavar="E", help="error reduction parameter")
@@ -138,12 +164,51 @@ def build_parser() -> argparse.ArgumentParser:
     convert.add_argument("--frequency", type=_float, metavar="HZ", help="undamped natural frequency (Hz)")
     convert.add_argument("--damping-ratio", type=_float, metavar="Z", help="damping ratio (1 = critical)")
     convert.add_argument("--mass", type=_float, metavar="M", help="effective mass (kg)")
-    convert.add_argument("--json", action="store_true", help="JSON on stdout")
+    convert.add_argument("--json", action="store_true", help="strict JSON on stdout")
     return parser
 
 
 def _command_line(argv: list[str]) -> str:
-    return shlex.join(["steadystep", *argv])
+    return printable(shlex.join(["steadystep", *argv]))
+
+
+def _say(line: str) -> None:
+    """One line on stdout, whatever bytes the arguments it quotes were made of."""
+    print(one_line(printable(line)))
+
+
+def _strict_json(command: str, data, columns: dict[str, np.ndarray] | None = None) -> str:
+    """data as strict JSON, with columns (arrays by name), if given, as data["columns"]. Raises _UsageError naming
+    the first value that is not finite: JSON has no NaN or Infinity, and writing one anyway would hand the reader
+    something it cannot parse."""
+    for name, values in (columns or {}).items():
+        bad = np.flatnonzero(~np.isfinite(values))
+        if len(bad):
+            raise _UsageError(f"steadystep {command}: columns.{name}[{bad[0]}] = {values[bad[0]]}: not a finite "
+                              "number, which strict JSON cannot hold")
+    found = _first_non_finite(data)
+    if found is not None:
+        name, value = found
+        raise _UsageError(f"steadystep {command}: {name} = {value}: not a finite number, which strict JSON cannot hold")
+    if columns is not None:
+        data = {**data, "columns": {name: values.tolist() for name, values in columns.items()}}
+    return json.dumps(data, allow_nan=False)
+
+
+def _first_non_finite(data, name: str = ""):
+    if isinstance(data, dict):
+        items = ((f"{name}.{key}" if name else str(key), value) for key, value in data.items())
+    elif isinstance(data, (list, tuple)):
+        items = ((f"{name}[{index}]", value) for index, value in enumerate(data))
+    elif isinstance(data, float) and not math.isfinite(data):
+        return name, data
+    else:
+        return None
+    for item_name, value in items:
+        found = _first_non_finite(value, item_name)
+        if found is not None:
+            return found
+    return None
 
 
 def _figure(args, argv) -> int:
@@ -151,7 +216,7 @@ def _figure(args, argv) -> int:
 
     args.out.mkdir(parents=True, exist_ok=True)
     for path in article_figure(args.out, args.duration, args.seed):
-        print(path)
+        _say(str(path))
     return 0
 
 
@@ -159,13 +224,13 @@ def _compare(args, argv) -> int:
     from steadystep import report
     from steadystep.figures import article_figure
 
-    report.validate(args.scenes, args.profiles, args.policies)  # before the directory is made
+    report.validate(args.scenes, args.profiles, args.policies, args.duration, args.seed)  # before any directory
     args.out.mkdir(parents=True, exist_ok=True)
     result = report.compare(args.scenes, args.profiles, args.policies, args.duration, args.seed,
                             figure_dir=args.out)
     article_paths = article_figure(args.out, args.duration, args.seed)
     path = report.write(result, args.out, _command_line(argv), article_paths)
-    print(path)
+    _say(str(path))
     return 0
 
 
@@ -177,11 +242,11 @@ def _run(args, argv) -> int:
     result = runs.run(args.scene, args.profile, args.policy, args.duration, args.seed, stepping=stepping)
     columns = {"t": result.times, **result.quantities}
     if args.json:
-        print(json.dumps({"scene": result.scene, "profile": result.profile, "policy": result.policy,
-                          "seed": result.seed, "duration_s": result.duration_s, "status": result.status,
-                          "message": result.message, "steps": result.step_count, "frames": result.frame_count,
-                          "units": {"t": "s", **result.units},
-                          "columns": {name: values.tolist() for name, values in columns.items()}}))
+        summary = {"scene": result.scene, "profile": printable(result.profile), "policy": result.policy,
+                   "seed": result.seed, "duration_s": result.duration_s, "status": result.status,
+                   "message": result.message, "steps": result.step_count, "frames": result.frame_count,
+                   "units": {"t": "s", **result.units}}
+        print(_strict_json("run", summary, columns))
     else:
         buffer = io.StringIO()
         writer = csv.writer(buffer, lineterminator="\n")
@@ -193,7 +258,7 @@ def _run(args, argv) -> int:
         else:
             sys.stdout.write(buffer.getvalue())
     if result.blew_up:
-        print(f"steadystep run: {result.status}: {result.message}", file=sys.stderr)
+        _complain(f"steadystep run: {result.status}: {result.message}")
         return EXIT_BLOWUP
     return 0
 
@@ -207,14 +272,14 @@ def _probe(args, argv) -> int:
     results = [probe.largest_stable_step(args.scene, policy, args.duration, args.low, args.high)
                for policy in args.policies]
     if args.json:
-        print(json.dumps([{"scene": r.scene, "policy": r.policy, "stable_s": r.stable_s,
-                           "unstable_s": r.unstable_s if math.isfinite(r.unstable_s) else None, "reason": r.reason}
-                          for r in results]))
+        print(_strict_json("probe", [{"scene": r.scene, "policy": r.policy, "stable_s": r.stable_s,
+                                      "unstable_s": r.unstable_s if math.isfinite(r.unstable_s) else None,
+                                      "reason": r.reason} for r in results]))
     else:
         for r in results:
             unstable = f"unstable at {1000 * r.unstable_s:.4g} ms: {r.reason}" if math.isfinite(r.unstable_s) \
                 else "stable up to the longest step tried"
-            print(f"{r.scene} {r.policy}: stable up to {1000 * r.stable_s:.4g} ms; {unstable}")
+            _say(f"{r.scene} {r.policy}: stable up to {1000 * r.stable_s:.4g} ms; {unstable}")
     return 0
 
 
@@ -246,7 +311,7 @@ def _convert(args, argv) -> int:
         raise _UsageError("steadystep convert: give --k K --c C --dt H, or --erp E --cfm F --dt H, or "
                           "--frequency HZ --damping-ratio Z --mass M (see steadystep convert --help)")
     if args.json:
-        print(json.dumps(out))
+        print(_strict_json("convert", out))
     else:
         units = {"stiffness": "N/m", "damping": "N·s/m", "cfm": "m/(N·s)", "matched_cfm": "m/(N·s)",
                  "frequency_hz": "Hz"}
@@ -255,22 +320,56 @@ def _convert(args, argv) -> int:
     return 0
 
 
-def main(argv: list[str] | None = None) -> int:
-    argv = sys.argv[1:] if argv is None else list(argv)
+def _complain(line: str) -> None:
+    """One line on stderr: bytes that were not UTF-8 shown as U+FFFD, control characters escaped."""
+    print(one_line(printable(str(line))), file=sys.stderr)
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    _complain(f"steadystep: warning: {category.__name__}: {message}")
+
+
+def _dispatch(argv: list[str]) -> int:
     try:
         args = build_parser().parse_args(argv)
-        handler = {"figure": _figure, "compare": _compare, "run": _run, "probe": _probe,
-                   "convert": _convert}[args.command]
-        return handler(args, argv)
+    except SystemExit as done:  # --help: argparse has printed it
+        return done.code if isinstance(done.code, int) else 0
+    handler = {"figure": _figure, "compare": _compare, "run": _run, "probe": _probe,
+               "convert": _convert}[args.command]
+    return handler(args, argv)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Runs the command on argv (default: sys.argv[1:]) and returns its exit code (see the module's docstring)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning
+            return _dispatch(argv)
     except _UsageError as error:
-        print(error, file=sys.stderr)
+        _complain(str(error))
         return EXIT_BAD_INPUT
     except SteadystepError as error:
-        print(f"steadystep: {error}", file=sys.stderr)
+        _complain(f"steadystep: {error}")
         return EXIT_BAD_INPUT
+    except BrokenPipeError:
+        # The reader went away (`steadystep run ... | head`): nothing more to say, and nothing to flush at exit.
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError, io.UnsupportedOperation):
+            pass
+        return EXIT_BROKEN_PIPE
     except OSError as error:
-        print(f"steadystep: {error.strerror or error}: {error.filename or ''}".rstrip(": "), file=sys.stderr)
+        filename = error.filename if isinstance(error.filename, str) else ""
+        _complain(f"steadystep: {error.strerror or error}: {filename}".rstrip(": "))
         return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        _complain("steadystep: interrupted")
+        return EXIT_INTERRUPTED
+    except Exception as error:  # a bug: one line that names it, not a traceback
+        _complain(f"steadystep: internal error: {type(error).__name__}: {error} (please report this with the "
+                  "command that caused it)")
+        return EXIT_INTERNAL
 
 
 if __name__ == "__main__":

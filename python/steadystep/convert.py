@@ -1,14 +1,16 @@
 """Springs and softness: thin wrappers over the C conversions of spring.h (SI units throughout).
 
 A spring is (k N/m, c N·s/m); softness is ODE's (erp, cfm) for one step of h seconds. For angular rows read
-N·m/rad, N·m·s/rad and kg·m². Every bad input raises SteadystepError naming the value.
+N·m/rad, N·m·s/rad and kg·m². Every bad input raises SteadystepError naming the value, and so does a result that
+is not finite (whatever the library returned): every number returned here is finite.
 """
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
-from steadystep._native import SteadystepError, check, ffi, lib
+from steadystep._native import SteadystepError, check, ffi, lib, number, shown
 
 MAPPINGS = {"spring": lib.SS_MAPPING_SPRING, "matched": lib.SS_MAPPING_MATCHED, "exact": lib.SS_MAPPING_EXACT}
 
@@ -28,61 +30,97 @@ class Softness(NamedTuple):
 
 
 def _spring(spring: Spring | tuple[float, float]) -> dict:
-    k, c = spring
-    return {"stiffness": float(k), "damping": float(c)}
+    try:
+        k, c = spring
+    except (TypeError, ValueError):
+        raise SteadystepError("out of range", f"spring = {shown(spring)}: must be a pair (k N/m, c N·s/m)") from None
+    return {"stiffness": number("k", k, "N/m"), "damping": number("c", c, "N·s/m")}
+
+
+def _finite(what: str, inputs: dict, outputs: dict) -> None:
+    """Refuses a result that is not finite, naming it and the inputs that gave it."""
+    for name, value in outputs.items():
+        if not math.isfinite(value):
+            given = ", ".join(f"{key} = {number_in:g}" for key, number_in in inputs.items())
+            raise SteadystepError("not finite", f"{what}({given}): {name} = {value}: the result is not finite")
 
 
 def softness_from_spring(spring: Spring | tuple[float, float], step_s: float) -> Softness:
     """The article's mapping at step step_s (s): erp = hk/(hk+c), cfm = 1/(hk+c)."""
+    spring, step_s = _spring(spring), number("step_s", step_s, "s")
     out = ffi.new("ssSoftness*")
-    check(lib.ssSoftnessFromSpring(_spring(spring), float(step_s), out))
+    check(lib.ssSoftnessFromSpring(spring, step_s, out))
+    _finite("softness_from_spring", {"k": spring["stiffness"], "c": spring["damping"], "step_s": step_s},
+            {"erp": out.erp, "cfm": out.cfm})
     return Softness(out.erp, out.cfm)
 
 
 def spring_from_softness(softness: Softness | tuple[float, float], step_s: float) -> Spring:
     """The spring that erp, cfm tuned at a fixed step step_s (s) stand for: k = erp/(h·cfm), c = (1-erp)/cfm."""
-    erp, cfm = softness
+    try:
+        erp, cfm = softness
+    except (TypeError, ValueError):
+        raise SteadystepError("out of range", f"softness = {shown(softness)}: must be a pair (erp, cfm)") from None
+    erp, cfm, step_s = number("erp", erp), number("cfm", cfm, "m/(N·s)"), number("step_s", step_s, "s")
     out = ffi.new("ssSpring*")
-    check(lib.ssSpringFromSoftness({"erp": float(erp), "cfm": float(cfm)}, float(step_s), out))
+    check(lib.ssSpringFromSoftness({"erp": erp, "cfm": cfm}, step_s, out))
+    _finite("spring_from_softness", {"erp": erp, "cfm": cfm, "step_s": step_s},
+            {"stiffness": out.stiffness, "damping": out.damping})
     return Spring(out.stiffness, out.damping)
 
 
 def spring_from_frequency(frequency_hz: float, damping_ratio: float, mass: float) -> Spring:
     """k = m·w², c = 2·zeta·m·w with w = 2π·frequency_hz, for a row of effective mass `mass` (kg)."""
+    inputs = {"frequency_hz": number("frequency_hz", frequency_hz, "Hz"),
+              "damping_ratio": number("damping_ratio", damping_ratio), "mass": number("mass", mass, "kg")}
     out = ffi.new("ssSpring*")
-    check(lib.ssSpringFromFrequency(float(frequency_hz), float(damping_ratio), float(mass), out))
+    check(lib.ssSpringFromFrequency(*inputs.values(), out))
+    _finite("spring_from_frequency", inputs, {"stiffness": out.stiffness, "damping": out.damping})
     return Spring(out.stiffness, out.damping)
 
 
 def frequency_from_spring(spring: Spring | tuple[float, float], mass: float) -> tuple[float, float]:
     """The undamped natural frequency (Hz) and damping ratio of a spring on mass (kg)."""
+    spring, mass = _spring(spring), number("mass", mass, "kg")
     frequency = ffi.new("double*")
     ratio = ffi.new("double*")
-    check(lib.ssFrequencyFromSpring(_spring(spring), float(mass), frequency, ratio))
+    check(lib.ssFrequencyFromSpring(spring, mass, frequency, ratio))
+    _finite("frequency_from_spring", {"k": spring["stiffness"], "c": spring["damping"], "mass": mass},
+            {"frequency_hz": frequency[0], "damping_ratio": ratio[0]})
     return frequency[0], ratio[0]
 
 
 def matched_softness(spring: Spring | tuple[float, float], mass: float, step_s: float) -> Softness:
     """The matched mapping: erp, cfm whose discrete poles are exp(s·h) of the spring's exact poles (needs c > 0)."""
+    spring, mass, step_s = _spring(spring), number("mass", mass, "kg"), number("step_s", step_s, "s")
     out = ffi.new("ssSoftness*")
-    check(lib.ssMatchedSoftness(_spring(spring), float(mass), float(step_s), out))
+    check(lib.ssMatchedSoftness(spring, mass, step_s, out))
+    _finite("matched_softness", {"k": spring["stiffness"], "c": spring["damping"], "mass": mass, "step_s": step_s},
+            {"erp": out.erp, "cfm": out.cfm})
     return Softness(out.erp, out.cfm)
 
 
 def exact_softness(spring: Spring | tuple[float, float], mass: float, step_s: float,
                    previous_step_s: float = 0.0) -> Softness:
     """The exact mapping: ODE's step after one of previous_step_s (0 = no history) lands on the exact sample."""
-    out = ffi.new("ssSoftness*")
-    check(lib.ssExactSoftness(_spring(spring), float(mass), float(step_s), float(previous_step_s), out))
-    return Softness(out.erp, out.cfm)
+    return _mapped("exact_softness", lib.ssExactSoftness, spring, mass, step_s, previous_step_s)
 
 
 def softness_for(mapping: str, spring: Spring | tuple[float, float], mass: float, step_s: float,
                  previous_step_s: float = 0.0) -> Softness:
     """Any mapping by name ("spring", "matched", "exact")."""
-    if mapping not in MAPPINGS:
-        raise SteadystepError("unsupported", f"mapping = {mapping!r}: must be one of {', '.join(MAPPINGS)}")
+    if not isinstance(mapping, str) or mapping not in MAPPINGS:
+        raise SteadystepError("unsupported", f"mapping = {shown(mapping)}: must be one of {', '.join(MAPPINGS)}")
+    return _mapped(f"softness_for[{mapping}]", lambda *args: lib.ssSoftnessFor(MAPPINGS[mapping], *args), spring,
+                   mass, step_s, previous_step_s)
+
+
+def _mapped(what: str, function, spring, mass, step_s, previous_step_s) -> Softness:
+    spring = _spring(spring)
+    inputs = {"k": spring["stiffness"], "c": spring["damping"], "mass": number("mass", mass, "kg"),
+              "step_s": number("step_s", step_s, "s"), "previous_step_s": number("previous_step_s", previous_step_s,
+                                                                                 "s")}
     out = ffi.new("ssSoftness*")
-    check(lib.ssSoftnessFor(MAPPINGS[mapping], _spring(spring), float(mass), float(step_s),
-                            float(previous_step_s), out))
+    check(function(spring, inputs["mass"], inputs["step_s"], inputs["previous_step_s"], out))
+    _finite(what, inputs, {"erp": out.erp, "cfm": out.cfm})
     return Softness(out.erp, out.cfm)

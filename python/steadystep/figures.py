@@ -15,6 +15,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from steadystep import article, runs  # noqa: E402
+from steadystep._native import SteadystepError, number, printable  # noqa: E402
+from steadystep.limits import MIN_MEASURED_DURATION_S  # noqa: E402
+from steadystep.profiles import seed_value  # noqa: E402
 from steadystep.files import save_figure  # noqa: E402
 from steadystep.profiles import frame_times  # noqa: E402
 
@@ -36,6 +39,12 @@ plt.rcParams.update({
 })
 
 
+def _label(text: str) -> str:
+    """User text (a profile spec, a trace file's name) as matplotlib draws it literally: no lone surrogates from
+    bytes that were not UTF-8 (its fonts refuse them) and no $ that would start mathtext."""
+    return printable(text).replace("$", r"\$")
+
+
 def policy_color(policy: str) -> str:
     return POLICY_COLORS.get(policy, "#333333")
 
@@ -53,8 +62,17 @@ def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> lis
 
     Both panels use the oscillator scene's spring (its defaults: the article's kind of spring) released at rest from
     x0. Panel 2 runs ODE with policy spring and max_step_s = 1/15 s, so that every frame is one step, as in the
-    equations. The variable frames come from the C profile uniform:15:45 with the given seed.
+    equations. The variable frames come from the C profile uniform:15:45 with the given seed (in [0, 2^64)).
+    duration_s (s) is at least MIN_MEASURED_DURATION_S (0.1 s) and within the bound of limits.py for 15-45 fps
+    frames (about 22000 s). Raises SteadystepError naming the value, before anything is drawn.
     """
+    duration_s, seed = number("duration_s", duration_s, "s"), seed_value(seed)
+    if not duration_s >= MIN_MEASURED_DURATION_S:
+        raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: the figure needs at least "
+                              f"{MIN_MEASURED_DURATION_S:g} s")
+    one_step_per_frame = {"max_step_s": 1.0 / 15.0}
+    for profile in ("fixed:30", "uniform:15:45"):
+        runs.check_run_size(profile, duration_s, seed, runs.make_stepping("spring", **one_step_per_frame))
     params = runs.default_params("oscillator")
     osc = article.Oscillator(params["mass"], params["spring"]["stiffness"], params["spring"]["damping"])
     x0 = params["x0"]
@@ -83,7 +101,6 @@ def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> lis
     top.set_title("The article's approximation (equations 4 and 5); it gains energy for steps "
                   f"Δt > 2c/k = {1000 * unstable_above_s:.0f} ms", loc="left")
 
-    one_step_per_frame = {"max_step_s": 1.0 / 15.0}
     for profile, color, label in (("fixed:30", FIXED_30_COLOR, "fixed 30 fps"),
                                   ("uniform:15:45", VARIABLE_COLOR, "variable 15-45 fps, uniform")):
         result = runs.run("oscillator", profile, "spring", duration_s, seed=seed, stepping=one_step_per_frame)
@@ -130,7 +147,7 @@ def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_d
             on_top = policy == "spring"
             ax.plot(result.times, result.quantities[quantity], color=policy_color(policy), lw=1.5 if on_top else 1.1,
                     zorder=3 if on_top else 2, label=label)
-        ax.set_title(profile, loc="left", fontsize=10)
+        ax.set_title(_label(profile), loc="left", fontsize=10)
         ax.set_ylim(low, high)
         if index % columns == 0:
             ax.set_ylabel(f"{quantity} ({unit})" if unit else quantity)
@@ -190,7 +207,7 @@ def deviation_figure(scene: str, quantity: str, deviations: dict, out_dir: Path)
                 bar.set_edgecolor("white")
     ax.set_yscale("log")
     ax.set_ylim(bottom, top * 1.5)
-    ax.set_xticks(range(len(profiles)), profiles)
+    ax.set_xticks(range(len(profiles)), [_label(profile) for profile in profiles])
     ax.set_ylabel("RMS deviation / amplitude")
     ax.set_title(f"{scene}: deviation of {quantity} from the reference run, by profile and policy"
                  " (hatched: blew up)", loc="left", fontsize=10)

@@ -25,8 +25,10 @@ def atomic_write(path: str | Path, write: Callable[[Path], None]) -> Path:
 
 
 def atomic_write_text(path: str | Path, content: str) -> Path:
-    """Writes text (UTF-8) to path atomically."""
-    return atomic_write(path, lambda temporary: temporary.write_text(content, encoding="utf-8"))
+    """Writes text (UTF-8) to path atomically. A lone surrogate (an argument that was not UTF-8, quoted in a report)
+    is written as its backslash escape rather than failing the write."""
+    return atomic_write(path, lambda temporary: temporary.write_text(content, encoding="utf-8",
+                                                                       errors="backslashreplace"))
 
 
 def save_figure(figure, path: str | Path) -> Path:

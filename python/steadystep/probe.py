@@ -16,10 +16,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from steadystep import runs
-from steadystep._native import SteadystepError
+from steadystep._native import SteadystepError, number
+from steadystep.limits import MAX_RUN_STEPS, MIN_MEASURED_DURATION_S
 
 DEFAULT_LOW_S = 1.0 / 1000.0
 DEFAULT_HIGH_S = 0.25
+# Below this the bisection's midpoint would no longer move between its ends in double precision.
+MIN_TOLERANCE = 1e-9
 
 
 @dataclass
@@ -54,12 +57,25 @@ def largest_stable_step(scene: str, policy: str, duration_s: float = 3.0, low_s:
                         high_s: float = DEFAULT_HIGH_S, tolerance: float = 0.02, params: dict | None = None
                         ) -> ProbeResult:
     """Bisects for the longest step in [low_s, high_s] at which scene stays stable under policy, to a relative
-    tolerance. Raises SteadystepError for bad input (the scene, policy and parameters are checked by the library)."""
+    tolerance (at least 1e-9). duration_s (s) is at least MIN_MEASURED_DURATION_S (0.1 s), and a trial at low_s may
+    take at most MAX_RUN_STEPS steps (limits.py): duration_s / low_s <= 1e6. Raises SteadystepError naming the value
+    for bad input (the scene, policy and parameters are checked by the library)."""
+    values = {}
     for name, value in (("duration_s", duration_s), ("low_s", low_s), ("high_s", high_s), ("tolerance", tolerance)):
-        if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        value = values[name] = number(name, value)
+        if not math.isfinite(value) or value <= 0:
             raise SteadystepError("out of range", f"{name} = {value}: must be a positive finite number")
+    duration_s, low_s, high_s, tolerance = values.values()
+    if duration_s < MIN_MEASURED_DURATION_S:
+        raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: a trial needs at least "
+                              f"{MIN_MEASURED_DURATION_S:g} s to be measured")
+    if tolerance < MIN_TOLERANCE:
+        raise SteadystepError("out of range", f"tolerance = {tolerance:g}: must be at least {MIN_TOLERANCE:g}")
     if low_s >= high_s:
         raise SteadystepError("out of range", f"low_s = {low_s} s: must be shorter than high_s = {high_s} s")
+    if duration_s / low_s > MAX_RUN_STEPS:
+        raise SteadystepError("out of range", f"low_s = {low_s:g} s: a trial of duration_s = {duration_s:g} s "
+                              f"would take more than the bound of {MAX_RUN_STEPS} steps per run")
     reference = runs.reference_run(scene, duration_s, params)
     bounds = {}
     for name in runs.motion_quantities(scene):
@@ -77,7 +93,7 @@ def largest_stable_step(scene: str, policy: str, duration_s: float = 3.0, low_s:
         return ProbeResult(scene, policy, 0.0, low_s, trials, low_reason)
     stable, unstable = low_s, high_s
     while unstable / stable > 1.0 + tolerance:
-        middle = math.sqrt(stable * unstable)
+        middle = math.exp(0.5 * (math.log(stable) + math.log(unstable)))  # sqrt(stable·unstable), never inf
         trials += 1
         why = _trial(scene, policy, middle, duration_s, bounds, params)
         if why:

@@ -6,30 +6,42 @@ trace:FILE. Every random kind is seeded and reproducible.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from steadystep._native import check, ffi, lib
+from steadystep._native import SteadystepError, c_string, check, ffi, integer, lib, number, shown
+from steadystep.limits import MAX_RUN_STEPS
 
 DEFAULT_PROFILES = ("fixed:30", "uniform:15:45", "jitter:30:3", "hitch:60:30:0.1", "vsync:60:30")
+SEED_RANGE = (0, 2**64 - 1)
+
+
+def seed_value(seed) -> int:
+    """A profile seed as the C library takes it: an integer in [0, 2^64). SteadystepError naming it otherwise."""
+    return integer("seed", seed, *SEED_RANGE)
 
 
 class Profile:
     """A frame-time profile made by the C library. Raises SteadystepError for a bad spec or trace file."""
 
     def __init__(self, spec: str, seed: int = 1):
+        raw_spec = c_string("profile", spec)
+        seed = seed_value(seed)
         out = ffi.new("ssProfile**")
-        check(lib.ssProfile_Create(spec.encode(), int(seed), out))
+        check(lib.ssProfile_Create(raw_spec, seed, out))
         self._profile = ffi.gc(out[0], lib.ssProfile_Destroy)
         self.spec = spec
-        self.seed = int(seed)
+        self.seed = seed
 
     def next(self) -> float:
         """The next frame duration (s)."""
         return lib.ssProfile_Next(self._profile)
 
     def frames(self, count: int) -> np.ndarray:
-        """The next `count` frame durations (s)."""
-        return np.array([lib.ssProfile_Next(self._profile) for _ in range(int(count))])
+        """The next `count` frame durations (s); count in [0, MAX_RUN_STEPS] (limits.py)."""
+        count = integer("count", count, 0, MAX_RUN_STEPS)
+        return np.array([lib.ssProfile_Next(self._profile) for _ in range(count)], dtype=float)
 
     def reset(self) -> None:
         """Restarts the sequence from its seed."""
@@ -37,5 +49,24 @@ class Profile:
 
 
 def frame_times(spec: str, count: int, seed: int = 1) -> np.ndarray:
-    """`count` frame durations (s) of a profile from its start."""
+    """`count` frame durations (s) of a profile from its start; count in [0, MAX_RUN_STEPS] (limits.py)."""
+    count = integer("count", count, 0, MAX_RUN_STEPS)
     return Profile(spec, seed).frames(count)
+
+
+def frame_count(spec: str, duration_s: float, seed: int = 1, limit: int = MAX_RUN_STEPS) -> int:
+    """The frames the profile hands out within duration_s (s), as a run plays them (the last one shortened to end
+    at duration_s), counted up to limit + 1. Raises SteadystepError for a bad spec, and naming the frame when the
+    profile hands out one that is not a finite positive duration."""
+    duration_s = number("duration_s", duration_s, "s")
+    profile = Profile(spec, seed)
+    end_tolerance_s = 1e-9 * max(1.0, duration_s)  # as run.c: a rounding remainder is the end, not one more frame
+    elapsed_s, count = 0.0, 0
+    while duration_s - elapsed_s > end_tolerance_s and count <= limit:
+        frame_s = profile.next()
+        if not (math.isfinite(frame_s) and frame_s > 0):
+            raise SteadystepError("out of range", f"profile = {shown(spec)}: frame {count + 1} lasts {frame_s!r} s, "
+                                  "not a finite positive duration")
+        elapsed_s += frame_s
+        count += 1
+    return count

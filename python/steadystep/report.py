@@ -18,9 +18,10 @@ import numpy as np
 from tqdm import tqdm
 
 from steadystep import article, figures, metrics, probe, runs
-from steadystep._native import SteadystepError
+from steadystep._native import SteadystepError, number, printable, shown
 from steadystep.files import atomic_write_text
-from steadystep.profiles import DEFAULT_PROFILES, Profile
+from steadystep.limits import MIN_MEASURED_DURATION_S
+from steadystep.profiles import DEFAULT_PROFILES, Profile, seed_value
 
 DEFAULT_POLICIES = ("naive", "spring", "fixed")
 OSCILLATOR_POLICIES = ("naive", "spring", "matched", "exact", "fixed")
@@ -70,15 +71,29 @@ def policies_for(scene: str, policies) -> list[str]:
     return list(OSCILLATOR_POLICIES if scene == "oscillator" else DEFAULT_POLICIES)
 
 
-def validate(scenes, profiles, policies) -> list[str]:
-    """Checks every name and spec before anything runs or is written; returns the scenes (default: all)."""
+def validate(scenes, profiles, policies, duration_s: float = 5.0, seed: int = 1) -> list[str]:
+    """Checks every name, spec and number before anything runs or is written; returns the scenes (default: all).
+
+    duration_s (s) is at least MIN_MEASURED_DURATION_S (0.1 s), and every run within the bound of limits.py (the
+    reference's 1 ms steps: at most 1000 s). Raises SteadystepError naming the value."""
     scenes = list(scenes) if scenes else [info.name for info in runs.scenes()]
     for scene in scenes:
         runs.scene_info(scene)
+    profiles = list(profiles)
+    if not profiles:
+        raise SteadystepError("out of range", "profiles = []: name at least one frame-time profile")
     for profile in profiles:
-        Profile(profile)
+        Profile(profile, seed)
     for policy in policies or ():
         runs.policy_value(policy)
+    duration_s = number("duration_s", duration_s, "s")
+    if not duration_s >= MIN_MEASURED_DURATION_S or not math.isfinite(duration_s):
+        raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: must be finite and at least "
+                              f"{MIN_MEASURED_DURATION_S:g} s to be measured")
+    runs.check_run_size(runs.REFERENCE_PROFILE, duration_s, 1, runs.reference_stepping())
+    for policy in sorted({p for scene in scenes for p in policies_for(scene, policies)}):
+        for profile in profiles:
+            runs.check_run_size(profile, duration_s, seed, runs.make_stepping(policy))
     return scenes
 
 
@@ -89,7 +104,8 @@ def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: f
     params: per scene changes to its parameters (default REPORT_PARAMS). progress: a tqdm bar (None: only on a
     terminal). figure_dir: where to draw the figures (None: none drawn)."""
     started = time.perf_counter()
-    scenes = validate(scenes, profiles, policies)
+    scenes = validate(scenes, profiles, policies, duration_s, seed)
+    seed, duration_s, profiles = seed_value(seed), float(duration_s), list(profiles)
     params = REPORT_PARAMS if params is None else params
     report = Report(scenes, list(profiles), {s: policies_for(s, policies) for s in scenes}, duration_s, seed)
     total = sum(1 + len(profiles) * len(report.policies[s]) + (0 if s in NOT_PROBED else len(report.policies[s]))
@@ -200,7 +216,8 @@ def _side_by_side(report: Report, params: dict | None, bar) -> None:
 def write(report: Report, out_dir: Path, command: str, article_paths: list[Path] | None = None) -> Path:
     """Writes report.html (figures embedded), index.html (a link to it), metrics.json and metrics.csv."""
     out_dir = Path(out_dir)
-    atomic_write_text(out_dir / "metrics.json", json.dumps(_as_json(report, command), indent=1, default=_json_default))
+    metrics_json = json.dumps(_finite_json(_as_json(report, command)), indent=1, default=_json_default, allow_nan=False)
+    atomic_write_text(out_dir / "metrics.json", metrics_json)
     atomic_write_text(out_dir / "metrics.csv", _as_csv(report))
     path = atomic_write_text(out_dir / "report.html", _as_html(report, command, article_paths or []))
     atomic_write_text(out_dir / "index.html", '<!doctype html><meta charset="utf-8"><title>steadystep report</title>'
@@ -216,8 +233,16 @@ def _json_default(value):
     raise TypeError(type(value))
 
 
-def _finite_or_none(value):
-    return value if value is None or math.isfinite(value) else None
+def _finite_json(value):
+    """value with every float that is not finite (a blow-up's inf, a rate with no frames) as None: metrics.json is
+    strict JSON, which has no NaN or Infinity."""
+    if isinstance(value, dict):
+        return {key: _finite_json(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite_json(item) for item in value]
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
 
 
 def _as_json(report: Report, command: str) -> dict:
@@ -225,16 +250,14 @@ def _as_json(report: Report, command: str) -> dict:
         "command": command, "duration_s": report.duration_s, "seed": report.seed, "profiles": report.profiles,
         "policies": report.policies, "params": report.params, "elapsed_s": report.elapsed_s,
         "rows": [{"scene": r.scene, "profile": r.profile, "policy": r.policy, "status": r.status,
-                  "deviation": {q: _finite_or_none(v) for q, v in r.deviations.items()},
+                  "deviation": dict(r.deviations),
                   "steps_per_frame": r.steps_per_frame, "steps_per_second": r.steps_per_second,
-                  "wall_us_per_step": r.wall_us_per_step, "rms_vs_exact": _finite_or_none(r.rms_vs_exact)}
+                  "wall_us_per_step": r.wall_us_per_step, "rms_vs_exact": r.rms_vs_exact}
                  for r in report.rows],
-        "spread": {s: {p: {q: _finite_or_none(v) for q, v in qs.items()} for p, qs in ps.items()}
-                   for s, ps in report.spreads.items()},
-        "oscillator_side_by_side": [{k: _finite_or_none(v) if isinstance(v, float) else v for k, v in e.items()}
-                                    for e in report.side_by_side],
+        "spread": report.spreads,
+        "oscillator_side_by_side": report.side_by_side,
         "largest_stable_step": {s: [{"policy": r.policy, "stable_s": r.stable_s,
-                                     "unstable_s": _finite_or_none(r.unstable_s), "reason": r.reason}
+                                     "unstable_s": r.unstable_s, "reason": r.reason}
                                     for r in results] for s, results in report.probes.items()},
     }
 

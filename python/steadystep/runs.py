@@ -12,7 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from steadystep._native import SteadystepError, check, ffi, lib, text
+from steadystep._native import SteadystepError, c_string, check, ffi, lib, number, shown, text
+from steadystep.limits import MAX_RUN_STEPS
+from steadystep.profiles import frame_count, seed_value
 
 REFERENCE_STEP_S = 1.0 / 1000.0
 REFERENCE_PROFILE = "fixed:1000"
@@ -29,7 +31,7 @@ def policy_names() -> list[str]:
 def policy_value(name: str) -> int:
     """The ssPolicy value of a policy name. Raises SteadystepError ("parse error") naming it."""
     out = ffi.new("ssPolicy*")
-    check(lib.ssPolicyParse(name.encode(), out))
+    check(lib.ssPolicyParse(c_string("policy", name), out))
     return int(out[0])
 
 
@@ -57,10 +59,10 @@ def scenes() -> list[SceneInfo]:
 
 def scene_info(name: str) -> SceneInfo:
     """One scene's description. Raises SteadystepError ("not found") for an unknown name."""
-    info = lib.ssSceneFind(name.encode())
+    info = lib.ssSceneFind(c_string("scene", name))
     if info == ffi.NULL:
         known = ", ".join(s.name for s in scenes())
-        raise SteadystepError("not found", f"scene = {name!r}: unknown (known: {known})")
+        raise SteadystepError("not found", f"scene = {shown(name)}: unknown (known: {known})")
     return _scene_info(info)
 
 
@@ -85,7 +87,7 @@ def motion_quantities(scene: str) -> list[str]:
 def default_params(scene: str) -> dict:
     """The scene's default parameters (ssSceneParams as a dict: spring {stiffness, damping}, mass, x0, ...)."""
     out = ffi.new("ssSceneParams*")
-    check(lib.ssDefaultSceneParams(scene.encode(), out))
+    check(lib.ssDefaultSceneParams(c_string("scene", scene), out))
     return _as_dict(out[0])
 
 
@@ -95,12 +97,34 @@ def default_stepping() -> dict:
 
 
 def _merge(base: dict, changes: dict | None, what: str) -> dict:
+    """base with the fields in changes replaced (nested dicts field by field); SteadystepError naming a field that
+    does not exist or a value its C type cannot hold."""
+    if changes is None:
+        return dict(base)
+    if not isinstance(changes, dict):
+        raise SteadystepError("out of range", f"{what} = {shown(changes)}: must be a dict of fields")
     merged = dict(base)
-    for key, value in (changes or {}).items():
+    for key, value in changes.items():
         if key not in base:
-            raise SteadystepError("out of range", f"{what}: no field {key!r} (fields: {', '.join(base)})")
-        merged[key] = {**base[key], **value} if isinstance(base[key], dict) else value
+            raise SteadystepError("out of range", f"{what}: no field {shown(key)} (fields: {', '.join(base)})")
+        if isinstance(base[key], dict):
+            merged[key] = _merge(base[key], value, f"{what}.{key}")
+        else:
+            merged[key] = _field_value(f"{what}.{key}", base[key], value)
     return merged
+
+
+def _field_value(name: str, default, value):
+    """value for a struct field whose default is default: an int field takes integers within C's int, a double
+    field any real number."""
+    if isinstance(default, int):
+        if isinstance(value, bool) or not hasattr(value, "__index__"):
+            raise SteadystepError("out of range", f"{name} = {shown(value)}: must be an integer")
+        value = value.__index__()
+        if not -2**31 <= value < 2**31:
+            raise SteadystepError("out of range", f"{name} = {shown(value)}: outside C's int")
+        return value
+    return number(name, value)
 
 
 def make_stepping(policy: str, **changes) -> dict:
@@ -150,32 +174,59 @@ class RunResult:
         return float(self.times[-1]) if len(self.times) else 0.0
 
 
+def check_run_size(profile: str, duration_s: float, seed: int, stepping: dict) -> None:
+    """Refuses, before anything runs, a run larger than the bound of limits.py: duration_s (s) must be finite and
+    positive, duration_s / step_s at most MAX_RUN_STEPS (step_s: stepping's fixed_step_s under policy fixed, its
+    max_step_s otherwise), and the profile may hand out at most MAX_RUN_STEPS frames within duration_s.
+    Raises SteadystepError naming the value."""
+    duration_s = number("duration_s", duration_s, "s")
+    if not math.isfinite(duration_s):
+        raise SteadystepError("not finite", f"duration_s = {duration_s} s: must be a finite number of seconds")
+    if duration_s <= 0:
+        raise SteadystepError("out of range", f"duration_s = {duration_s} s: must be positive")
+    fixed = stepping.get("policy") == lib.SS_POLICY_FIXED
+    step_name = "fixed_step_s" if fixed else "max_step_s"
+    step_s = number(f"stepping.{step_name}", stepping.get(step_name, math.nan), "s")
+    if math.isfinite(step_s) and step_s > 0 and duration_s / step_s > MAX_RUN_STEPS:
+        raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: more than the bound of "
+                              f"{MAX_RUN_STEPS} steps of {step_name} = {step_s:g} s per run")
+    # A bad step length is left to the library, which names it; the frames are counted on the profile itself.
+    frames = frame_count(profile, duration_s, seed, MAX_RUN_STEPS)
+    if frames > MAX_RUN_STEPS:
+        raise SteadystepError("out of range", f"profile = {shown(profile)}: more than the bound of {MAX_RUN_STEPS} "
+                              f"frames per run within duration_s = {duration_s:g} s")
+
+
 def run(scene: str, profile: str, policy: str, duration_s: float = 5.0, seed: int = 1,
         params: dict | None = None, stepping: dict | None = None) -> RunResult:
     """Runs a scene under a profile and a policy for duration_s simulated seconds.
 
     params changes fields of the scene's defaults (e.g. {"spring": {"stiffness": 80}}); stepping changes fields of
-    make_stepping(policy). Raises SteadystepError for bad input; a blow-up is recorded in the result instead.
+    make_stepping(policy). seed is an integer in [0, 2^64). A run is bounded (limits.py): duration_s / step at most
+    MAX_RUN_STEPS = 1e6 steps of the longest step allowed (max_step_s, or fixed_step_s under policy fixed), and at
+    most 1e6 frames of the profile. Raises SteadystepError naming the value for bad input or a run above the bound,
+    before anything runs; a blow-up is recorded in the result instead.
     """
+    scene_c = ffi.new("char[]", c_string("scene", scene))
+    profile_c = ffi.new("char[]", c_string("profile", profile))
     full_params = _merge(default_params(scene), params, "params")
     full_stepping = _merge(make_stepping(policy), stepping, "stepping")
-    if not isinstance(duration_s, (int, float)) or not math.isfinite(duration_s):
-        raise SteadystepError("not finite", f"duration_s = {duration_s}: must be a finite number of seconds")
+    seed = seed_value(seed)
+    check_run_size(profile, duration_s, seed, full_stepping)
+    duration_s = float(duration_s)
     # The C strings must stay alive for the whole call: cffi frees them with these names.
-    scene_c = ffi.new("char[]", scene.encode())
-    profile_c = ffi.new("char[]", profile.encode())
     definition = ffi.new("ssRunDef*")
     definition.scene = scene_c
     definition.profile = profile_c
     definition.params = full_params
     definition.stepping = full_stepping
-    definition.seed = int(seed)
-    definition.duration_s = float(duration_s)
+    definition.seed = seed
+    definition.duration_s = duration_s
     out = ffi.new("ssRun**")
     check(lib.ssRun_Execute(definition, out))
     handle = out[0]
     try:
-        return _collect(handle, scene, profile, policy, int(seed), float(duration_s), full_params, full_stepping)
+        return _collect(handle, scene, profile, policy, seed, duration_s, full_params, full_stepping)
     finally:
         lib.ssRun_Destroy(handle)
 
@@ -189,7 +240,7 @@ def _copy(pointer, count: int) -> np.ndarray:
 
 def _collect(handle, scene, profile, policy, seed, duration_s, params, stepping) -> RunResult:
     info = scene_info(scene)
-    count = lib.ssRun_StepCount(handle)
+    count = max(0, int(lib.ssRun_StepCount(handle)))
     quantities = {name: _copy(lib.ssRun_Quantity(handle, i), count) for i, name in enumerate(info.quantities)}
     status = int(lib.ssRun_Status(handle))
     return RunResult(
@@ -215,24 +266,30 @@ class Scene:
         full_params = ffi.new("ssSceneParams*", _merge(default_params(name), params, "params"))
         full_stepping = ffi.new("ssStepping*", _merge(make_stepping(policy), stepping, "stepping"))
         out = ffi.new("ssScene**")
-        check(lib.ssScene_Create(name.encode(), full_params, full_stepping, out))
+        check(lib.ssScene_Create(c_string("scene", name), full_params, full_stepping, out))
         self._scene = ffi.gc(out[0], lib.ssScene_Destroy)
         self._steps = ffi.new("int*")
         self._sample = ffi.new("double[]", max(1, len(self.info.quantities)))
 
+    def _handle(self):
+        if self._scene is None:
+            raise SteadystepError("out of range", f"scene {self.info.name!r}: used after close()")
+        return self._scene
+
     def frame(self, frame_s: float) -> int:
-        """Advances one frame of frame_s seconds; returns the physics steps taken. Raises on a blow-up."""
-        check(lib.ssScene_Frame(self._scene, frame_s, self._steps))
+        """Advances one frame of frame_s seconds; returns the physics steps taken. Raises SteadystepError for a bad
+        frame time (named by the library) and on a blow-up."""
+        check(lib.ssScene_Frame(self._handle(), number("frame_s", frame_s, "s"), self._steps))
         return self._steps[0]
 
     def sample(self) -> dict[str, float]:
         """The followed quantities now, by name."""
-        lib.ssScene_Sample(self._scene, self._sample)
+        lib.ssScene_Sample(self._handle(), self._sample)
         return {name: self._sample[i] for i, name in enumerate(self.info.quantities)}
 
     @property
     def time_s(self) -> float:
-        return lib.ssScene_Time(self._scene)
+        return lib.ssScene_Time(self._handle())
 
     def close(self) -> None:
         """Destroys the scene and its ODE world now rather than at garbage collection."""
