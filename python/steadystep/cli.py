@@ -283,11 +283,9 @@ def _probe(args, argv) -> int:
     return 0
 
 
-def _convert(args, argv) -> int:
+def _conversions(args, given: set[str]) -> dict[str, float]:
     from steadystep import convert
 
-    given = {name for name in ("k", "c", "erp", "cfm", "dt", "frequency", "damping_ratio", "mass")
-             if getattr(args, name) is not None}
     out: dict[str, float] = {}
     if {"k", "c"} <= given and not given & {"erp", "cfm", "frequency", "damping_ratio"}:
         if "dt" not in given and "mass" not in given:
@@ -310,6 +308,19 @@ def _convert(args, argv) -> int:
     else:
         raise _UsageError("steadystep convert: give --k K --c C --dt H, or --erp E --cfm F --dt H, or "
                           "--frequency HZ --damping-ratio Z --mass M (see steadystep convert --help)")
+    return out
+
+
+def _convert(args, argv) -> int:
+    given = {name for name in ("k", "c", "erp", "cfm", "dt", "frequency", "damping_ratio", "mass")
+             if getattr(args, name) is not None}
+    try:
+        out = _conversions(args, given)
+    except SteadystepError as error:
+        # A chain of conversions can fail in a later link (a spring from a frequency, then its erp): name what the
+        # user typed, then the library's message.
+        typed = " ".join(f"--{name.replace('_', '-')} {getattr(args, name):g}" for name in sorted(given))
+        raise _UsageError(f"steadystep convert {typed}: {error}") from None
     if args.json:
         print(_strict_json("convert", out))
     else:

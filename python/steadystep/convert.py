@@ -37,21 +37,29 @@ def _spring(spring: Spring | tuple[float, float]) -> dict:
     return {"stiffness": number("k", k, "N/m"), "damping": number("c", c, "N·s/m")}
 
 
-def _finite(what: str, inputs: dict, outputs: dict) -> None:
-    """Refuses a result that is not finite, naming it and the inputs that gave it."""
-    for name, value in outputs.items():
+def _given(what: str, inputs: dict) -> str:
+    return f"{what}(" + ", ".join(f"{name} = {value:g}" for name, value in inputs.items()) + ")"
+
+
+def _checked(what: str, inputs: dict, status: int, outputs) -> None:
+    """Raises SteadystepError for a failure of the library, and for a result that is not finite; the message starts
+    with the call and every input, since the library's message names the value it checked last, which is not
+    always the one at fault (a mass that makes the matched step's numbers overflow)."""
+    try:
+        check(status)
+    except SteadystepError as error:
+        raise SteadystepError(error.status, f"{_given(what, inputs)}: {error.message}", error.code) from None
+    for name, value in outputs().items():
         if not math.isfinite(value):
-            given = ", ".join(f"{key} = {number_in:g}" for key, number_in in inputs.items())
-            raise SteadystepError("not finite", f"{what}({given}): {name} = {value}: the result is not finite")
+            raise SteadystepError("not finite", f"{_given(what, inputs)}: {name} = {value}: the result is not finite")
 
 
 def softness_from_spring(spring: Spring | tuple[float, float], step_s: float) -> Softness:
     """The article's mapping at step step_s (s): erp = hk/(hk+c), cfm = 1/(hk+c)."""
     spring, step_s = _spring(spring), number("step_s", step_s, "s")
     out = ffi.new("ssSoftness*")
-    check(lib.ssSoftnessFromSpring(spring, step_s, out))
-    _finite("softness_from_spring", {"k": spring["stiffness"], "c": spring["damping"], "step_s": step_s},
-            {"erp": out.erp, "cfm": out.cfm})
+    _checked("softness_from_spring", {"k": spring["stiffness"], "c": spring["damping"], "step_s": step_s},
+             lib.ssSoftnessFromSpring(spring, step_s, out), lambda: {"erp": out.erp, "cfm": out.cfm})
     return Softness(out.erp, out.cfm)
 
 
@@ -63,9 +71,9 @@ def spring_from_softness(softness: Softness | tuple[float, float], step_s: float
         raise SteadystepError("out of range", f"softness = {shown(softness)}: must be a pair (erp, cfm)") from None
     erp, cfm, step_s = number("erp", erp), number("cfm", cfm, "m/(N·s)"), number("step_s", step_s, "s")
     out = ffi.new("ssSpring*")
-    check(lib.ssSpringFromSoftness({"erp": erp, "cfm": cfm}, step_s, out))
-    _finite("spring_from_softness", {"erp": erp, "cfm": cfm, "step_s": step_s},
-            {"stiffness": out.stiffness, "damping": out.damping})
+    _checked("spring_from_softness", {"erp": erp, "cfm": cfm, "step_s": step_s},
+             lib.ssSpringFromSoftness({"erp": erp, "cfm": cfm}, step_s, out),
+             lambda: {"stiffness": out.stiffness, "damping": out.damping})
     return Spring(out.stiffness, out.damping)
 
 
@@ -74,8 +82,8 @@ def spring_from_frequency(frequency_hz: float, damping_ratio: float, mass: float
     inputs = {"frequency_hz": number("frequency_hz", frequency_hz, "Hz"),
               "damping_ratio": number("damping_ratio", damping_ratio), "mass": number("mass", mass, "kg")}
     out = ffi.new("ssSpring*")
-    check(lib.ssSpringFromFrequency(*inputs.values(), out))
-    _finite("spring_from_frequency", inputs, {"stiffness": out.stiffness, "damping": out.damping})
+    _checked("spring_from_frequency", inputs, lib.ssSpringFromFrequency(*inputs.values(), out),
+             lambda: {"stiffness": out.stiffness, "damping": out.damping})
     return Spring(out.stiffness, out.damping)
 
 
@@ -84,9 +92,9 @@ def frequency_from_spring(spring: Spring | tuple[float, float], mass: float) -> 
     spring, mass = _spring(spring), number("mass", mass, "kg")
     frequency = ffi.new("double*")
     ratio = ffi.new("double*")
-    check(lib.ssFrequencyFromSpring(spring, mass, frequency, ratio))
-    _finite("frequency_from_spring", {"k": spring["stiffness"], "c": spring["damping"], "mass": mass},
-            {"frequency_hz": frequency[0], "damping_ratio": ratio[0]})
+    _checked("frequency_from_spring", {"k": spring["stiffness"], "c": spring["damping"], "mass": mass},
+             lib.ssFrequencyFromSpring(spring, mass, frequency, ratio),
+             lambda: {"frequency_hz": frequency[0], "damping_ratio": ratio[0]})
     return frequency[0], ratio[0]
 
 
@@ -94,9 +102,8 @@ def matched_softness(spring: Spring | tuple[float, float], mass: float, step_s: 
     """The matched mapping: erp, cfm whose discrete poles are exp(s·h) of the spring's exact poles (needs c > 0)."""
     spring, mass, step_s = _spring(spring), number("mass", mass, "kg"), number("step_s", step_s, "s")
     out = ffi.new("ssSoftness*")
-    check(lib.ssMatchedSoftness(spring, mass, step_s, out))
-    _finite("matched_softness", {"k": spring["stiffness"], "c": spring["damping"], "mass": mass, "step_s": step_s},
-            {"erp": out.erp, "cfm": out.cfm})
+    _checked("matched_softness", {"k": spring["stiffness"], "c": spring["damping"], "mass": mass, "step_s": step_s},
+             lib.ssMatchedSoftness(spring, mass, step_s, out), lambda: {"erp": out.erp, "cfm": out.cfm})
     return Softness(out.erp, out.cfm)
 
 
@@ -121,6 +128,6 @@ def _mapped(what: str, function, spring, mass, step_s, previous_step_s) -> Softn
               "step_s": number("step_s", step_s, "s"), "previous_step_s": number("previous_step_s", previous_step_s,
                                                                                  "s")}
     out = ffi.new("ssSoftness*")
-    check(function(spring, inputs["mass"], inputs["step_s"], inputs["previous_step_s"], out))
-    _finite(what, inputs, {"erp": out.erp, "cfm": out.cfm})
+    _checked(what, inputs, function(spring, inputs["mass"], inputs["step_s"], inputs["previous_step_s"], out),
+             lambda: {"erp": out.erp, "cfm": out.cfm})
     return Softness(out.erp, out.cfm)
