@@ -248,15 +248,15 @@ def _run(args, argv) -> int:
                    "units": {"t": "s", **result.units}}
         print(_strict_json("run", summary, columns))
     else:
-        buffer = io.StringIO()
+        # To a file whole (written aside, then renamed); to stdout row by row, so that a reader that stops early
+        # (`| head`) stops the command at once.
+        buffer = io.StringIO() if args.csv else sys.stdout
         writer = csv.writer(buffer, lineterminator="\n")
         writer.writerow(columns)
         for row in zip(*columns.values()):
             writer.writerow(f"{value:.17g}" for value in row)
         if args.csv:
             atomic_write_text(args.csv, buffer.getvalue())
-        else:
-            sys.stdout.write(buffer.getvalue())
     if result.blew_up:
         _complain(f"steadystep run: {result.status}: {result.message}")
         return EXIT_BLOWUP

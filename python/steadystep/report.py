@@ -215,7 +215,7 @@ def _side_by_side(report: Report, params: dict | None, bar) -> None:
 
 def write(report: Report, out_dir: Path, command: str, article_paths: list[Path] | None = None) -> Path:
     """Writes report.html (figures embedded), index.html (a link to it), metrics.json and metrics.csv."""
-    out_dir = Path(out_dir)
+    out_dir, command = Path(out_dir), printable(command)
     metrics_json = json.dumps(_finite_json(_as_json(report, command)), indent=1, default=_json_default, allow_nan=False)
     atomic_write_text(out_dir / "metrics.json", metrics_json)
     atomic_write_text(out_dir / "metrics.csv", _as_csv(report))
