@@ -20,7 +20,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from steadystep._native import SteadystepError
+from steadystep._native import SteadystepError, number, shown
 
 
 class Oscillator(NamedTuple):
@@ -32,18 +32,26 @@ class Oscillator(NamedTuple):
 
     @property
     def decay_rate(self) -> float:
-        """c / 2m (1/s): the envelope e^{-rate·t}."""
+        """c / 2m (1/s): the envelope e^{-rate·t}. Every property raises SteadystepError for an oscillator that
+        _validate refuses (a mass that is not positive, a number that is not finite)."""
+        _validate(self)
         return self.damping / (2.0 * self.mass)
 
     @property
     def angular_frequency(self) -> float:
-        """ω = √(k/m - (c/2m)²) (rad/s), the damped angular frequency."""
-        return math.sqrt(self.stiffness / self.mass - self.decay_rate**2)
+        """ω = √(k/m - (c/2m)²) (rad/s), the damped angular frequency. SteadystepError when damping is critical
+        or stronger (nothing oscillates)."""
+        rate = self.decay_rate
+        square = self.stiffness / self.mass - rate * rate  # inf rather than OverflowError when huge
+        if not square > 0:
+            raise SteadystepError("out of range", f"k/m - (c/2m)^2 = {square:g} 1/s^2: no damped oscillation")
+        return math.sqrt(square)
 
     @property
     def damping_ratio(self) -> float:
         """c / 2√(mk), non-dimensional."""
-        return self.damping / (2.0 * math.sqrt(self.mass * self.stiffness))
+        _validate(self)
+        return self.damping / (2.0 * math.sqrt(self.mass) * math.sqrt(self.stiffness))  # √m√k: m·k may underflow
 
 
 # The article's kind of spring (issue 4): 1 kg, 40 N/m, 1 N·s/m, released at rest from 0.5 m.
@@ -86,7 +94,11 @@ def integrate(osc: Oscillator, x0: float, v0: float, steps_s, method: str = "art
     step = {"article": article_step, "implicit": implicit_euler_step}.get(method)
     if step is None:
         raise SteadystepError("unsupported", f"method = {method!r}: must be 'article' or 'implicit'")
-    steps = np.asarray(steps_s, dtype=float)
+    x0, v0 = number("x0", x0, "m"), number("v0", v0, "m/s")
+    try:
+        steps = np.asarray(steps_s, dtype=float)
+    except (TypeError, ValueError):
+        raise SteadystepError("out of range", f"steps_s = {shown(steps_s)}: must be step lengths in s") from None
     if steps.ndim != 1 or not np.all(np.isfinite(steps)) or np.any(steps <= 0):
         raise SteadystepError("out of range", "steps_s: every step length must be finite and positive (s)")
     t = np.concatenate(([0.0], np.cumsum(steps)))
@@ -101,6 +113,7 @@ def integrate(osc: Oscillator, x0: float, v0: float, steps_s, method: str = "art
 def exact_parameters(osc: Oscillator, x0: float, v0: float) -> tuple[float, float]:
     """C (m) and α (rad) of the exact solution through x(0) = x0, ẋ(0) = v0."""
     _validate(osc)
+    x0, v0 = number("x0", x0, "m"), number("v0", v0, "m/s")
     if osc.damping_ratio >= 1.0:
         raise SteadystepError("out of range", f"damping ratio = {osc.damping_ratio:g}: the exact solution here "
                                               "is for weak damping (< 1)")
@@ -113,7 +126,10 @@ def exact_parameters(osc: Oscillator, x0: float, v0: float) -> tuple[float, floa
 def exact(osc: Oscillator, x0: float, v0: float, t) -> tuple[np.ndarray, np.ndarray]:
     """The exact extension (m) and velocity (m/s) at times t (s)."""
     amplitude, alpha = exact_parameters(osc, x0, v0)
-    t = np.asarray(t, dtype=float)
+    try:
+        t = np.asarray(t, dtype=float)
+    except (TypeError, ValueError):
+        raise SteadystepError("out of range", f"t = {shown(t)}: must be times in s") from None
     w, gamma = osc.angular_frequency, osc.decay_rate
     envelope = amplitude * np.exp(-gamma * t)
     phase = w * t + alpha

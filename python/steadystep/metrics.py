@@ -9,7 +9,18 @@ import math
 
 import numpy as np
 
-from steadystep._native import SteadystepError
+from steadystep._native import SteadystepError, number, shown
+
+
+def _samples(name: str, values) -> np.ndarray:
+    """values as a 1-D float array; SteadystepError naming it when it is not one."""
+    try:
+        array = np.asarray(values, float)
+    except (TypeError, ValueError):
+        raise SteadystepError("out of range", f"{name} = {shown(values)}: must be an array of numbers") from None
+    if array.ndim != 1:
+        raise SteadystepError("out of range", f"{name}: must be one-dimensional, not of shape {array.shape}")
+    return array
 
 
 def rms_deviation(t, y, reference_t, reference_y) -> float:
@@ -17,8 +28,10 @@ def rms_deviation(t, y, reference_t, reference_y) -> float:
 
     Only times inside the reference's span count. A trajectory with a NaN or an infinity (a blow-up) gives inf.
     """
-    t, y = np.asarray(t, float), np.asarray(y, float)
-    reference_t, reference_y = np.asarray(reference_t, float), np.asarray(reference_y, float)
+    t, y = _samples("t", t), _samples("y", y)
+    reference_t, reference_y = _samples("reference_t", reference_t), _samples("reference_y", reference_y)
+    if len(t) != len(y) or len(reference_t) != len(reference_y):
+        raise SteadystepError("out of range", "rms_deviation: t and y, and the reference's t and y, must match")
     if len(t) == 0 or len(reference_t) < 2:
         raise SteadystepError("out of range", "rms_deviation: needs samples and a reference of two or more")
     if not np.all(np.isfinite(y)):
@@ -36,7 +49,9 @@ def rms_deviation(t, y, reference_t, reference_y) -> float:
 
 def rms_vs_exact(x, exact_x, x0: float) -> float:
     """RMS of x minus the exact solution at the same times, relative to |x0| (m/m). inf after a blow-up."""
-    x, exact_x = np.asarray(x, float), np.asarray(exact_x, float)
+    x, exact_x, x0 = _samples("x", x), _samples("exact_x", exact_x), number("x0", x0, "m")
+    if len(x) != len(exact_x):
+        raise SteadystepError("out of range", f"rms_vs_exact: {len(x)} samples against {len(exact_x)} exact ones")
     if x0 == 0 or not math.isfinite(x0):
         raise SteadystepError("out of range", f"x0 = {x0} m: must be finite and non-zero")
     if not np.all(np.isfinite(x)):
@@ -46,7 +61,7 @@ def rms_vs_exact(x, exact_x, x0: float) -> float:
 
 def spread(deviations) -> float:
     """The spread of a policy across profiles: the RMS over profiles of each profile's deviation."""
-    values = np.asarray(list(deviations), float)
+    values = _samples("deviations", list(deviations))
     if len(values) == 0:
         raise SteadystepError("out of range", "spread: needs at least one profile's deviation")
     return float(np.sqrt(np.mean(values**2)))
@@ -62,6 +77,14 @@ def steps_per_second(step_count: int, simulated_s: float) -> float:
     return step_count / simulated_s if simulated_s > 0 else math.nan
 
 
+def _least_squares(a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """The least-squares solution of a·z = b, or None when a or b holds an infinity or a NaN: LAPACK's solver
+    (gelsd) can loop for ever on such input instead of failing."""
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        return None
+    return np.linalg.lstsq(a, b, rcond=None)[0]
+
+
 def _prony(t: np.ndarray, x: np.ndarray) -> tuple[float, float]:
     """A first estimate of (decay rate 1/s, angular frequency rad/s) from the samples on a uniform grid.
 
@@ -74,7 +97,10 @@ def _prony(t: np.ndarray, x: np.ndarray) -> tuple[float, float]:
     if len(u) < 8:
         raise SteadystepError("out of range", "fit_oscillation: needs at least 8 samples")
     design = np.column_stack((u[1:-1], u[:-2], np.ones(len(u) - 2)))
-    (a1, a2, _), *_ = np.linalg.lstsq(design, u[2:], rcond=None)
+    solution = _least_squares(design, u[2:])
+    if solution is None or not np.all(np.isfinite(solution)) or not math.isfinite(spacing) or spacing <= 0:
+        raise SteadystepError("out of range", "fit_oscillation: the samples do not fit in double precision")
+    a1, a2, _ = solution
     if a2 >= 0:
         raise SteadystepError("out of range", "fit_oscillation: the trajectory does not oscillate")
     r = math.sqrt(-a2)
@@ -89,7 +115,9 @@ def _residual(params: np.ndarray, t: np.ndarray, x: np.ndarray) -> np.ndarray:
     gamma, omega = params
     envelope = np.exp(-gamma * t)
     basis = np.column_stack((envelope * np.cos(omega * t), envelope * np.sin(omega * t), np.ones_like(t)))
-    coefficients, *_ = np.linalg.lstsq(basis, x, rcond=None)
+    coefficients = _least_squares(basis, x)
+    if coefficients is None:  # the envelope overflowed at these (γ, ω): as bad a trial as can be
+        return np.full_like(x, np.inf)
     return basis @ coefficients - x
 
 
@@ -99,10 +127,15 @@ def fit_oscillation(t, x) -> tuple[float, float]:
     Starts from a Prony estimate and refines (γ, ω) by Levenberg-Marquardt on the samples as they are (steps of
     any length), with A, B, D solved linearly at each trial. Raises SteadystepError when nothing oscillates.
     """
-    t, x = np.asarray(t, float), np.asarray(x, float)
-    if len(t) != len(x) or len(t) < 8 or not np.all(np.isfinite(x)) or np.any(np.diff(t) <= 0):
+    t, x = _samples("t", t), _samples("x", x)
+    if (t.shape != x.shape or len(t) < 8 or not np.all(np.isfinite(x)) or not np.all(np.isfinite(t))
+            or np.any(np.diff(t) <= 0)):
         raise SteadystepError("out of range", "fit_oscillation: needs 8 or more finite samples at rising times")
-    t = t - t[0]
+    # γ and ω do not depend on the amplitude: fitting x / max|x| keeps every product far from overflow.
+    scale = float(np.max(np.abs(x)))
+    if scale == 0:
+        raise SteadystepError("out of range", "fit_oscillation: the trajectory does not oscillate")
+    t, x = t - t[0], x / scale
     params = np.array(_prony(t, x))
     damping = 1e-3
     cost = float(np.sum(_residual(params, t, x) ** 2))
@@ -117,7 +150,11 @@ def fit_oscillation(t, x) -> tuple[float, float]:
         gradient = jacobian.T @ residual
         improved = False
         while damping < 1e12:
-            trial = params - np.linalg.solve(normal + damping * np.diag(np.diag(normal)), gradient)
+            try:
+                trial = params - np.linalg.solve(normal + damping * np.diag(np.diag(normal)), gradient)
+            except np.linalg.LinAlgError:  # a flat direction: more damping makes the system regular
+                damping *= 10.0
+                continue
             trial_cost = float(np.sum(_residual(trial, t, x) ** 2))
             if trial_cost < cost:
                 change = np.max(np.abs(trial - params) / np.maximum(np.abs(params), 1e-12))
@@ -126,4 +163,6 @@ def fit_oscillation(t, x) -> tuple[float, float]:
             damping *= 10.0
         if not improved or change < 1e-13:
             break
+    if not np.all(np.isfinite(params)):
+        raise SteadystepError("out of range", "fit_oscillation: the fit does not converge to finite values")
     return float(params[0]), float(params[1])

@@ -18,7 +18,7 @@ import numpy as np
 from tqdm import tqdm
 
 from steadystep import article, figures, metrics, probe, runs
-from steadystep._native import SteadystepError, number, printable, shown
+from steadystep._native import SteadystepError, number, printable
 from steadystep.files import atomic_write_text
 from steadystep.limits import MIN_MEASURED_DURATION_S
 from steadystep.profiles import DEFAULT_PROFILES, Profile, seed_value
@@ -199,9 +199,13 @@ def _side_by_side(report: Report, params: dict | None, bar) -> None:
             result = runs.run("oscillator", profile, policy, report.duration_s, report.seed, params=params)
             bar.update()
             osc = _oscillator(result.params)
+            try:
+                true_omega = osc.angular_frequency
+            except SteadystepError:
+                true_omega = math.nan  # damped too strongly to oscillate: the table shows "-"
             entry = {"profile": profile, "policy": policy, "rms_vs_exact": _rms_vs_exact(result),
                      "decay_rate_per_s": math.nan, "angular_frequency_rad_s": math.nan,
-                     "true_decay_rate_per_s": osc.decay_rate, "true_angular_frequency_rad_s": osc.angular_frequency,
+                     "true_decay_rate_per_s": osc.decay_rate, "true_angular_frequency_rad_s": true_omega,
                      "status": result.status}
             try:
                 entry["decay_rate_per_s"], entry["angular_frequency_rad_s"] = metrics.fit_oscillation(

@@ -217,3 +217,40 @@ def test_a_profile_that_hands_out_a_frame_that_is_not_finite_is_refused():
     # 1/1e-320 overflows: the library's profile hands out infinite frames today; the run refuses them by name.
     with pytest.raises(SteadystepError, match="fixed:1e-320"):
         runs.run("oscillator", "fixed:1e-320", "spring", 1.0)
+
+
+# ---- the pure-Python model and metrics ------------------------------------------------------------------------
+
+def test_the_model_and_the_metrics_raise_only_steadystep_error_whatever_the_numbers():
+    import itertools
+    import warnings
+
+    import numpy as np
+
+    from steadystep import article, metrics
+
+    values = [math.nan, math.inf, -math.inf, 1e308, 0.0, 1e-320, -1.0, 40.0, 1e300]
+    t = np.linspace(0.0, 1.0, 50)
+    calls = []
+    for m, k, c in itertools.product(values, repeat=3):
+        osc = article.Oscillator(m, k, c)
+        calls += [lambda osc=osc: (osc.decay_rate, osc.angular_frequency, osc.damping_ratio),
+                  lambda osc=osc: article.integrate(osc, 0.5, 0.0, [0.01, 0.02], method="implicit"),
+                  lambda osc=osc: article.exact(osc, 0.5, 1e308, [0.0, 1e308])]
+    for a, b in itertools.product(values, repeat=2):
+        calls += [lambda a=a, b=b: metrics.fit_oscillation(t, a * np.sin(b * t)),  # 1e308·sin(1e300 t) hung LAPACK
+                  lambda a=a, b=b: metrics.fit_oscillation(t * a, np.sin(20 * t) * np.exp(-b * t)),
+                  lambda a=a, b=b: metrics.rms_deviation([0.0, 1.0], [a, b], [0.0, 1.0], [b, a]),
+                  lambda a=a, b=b: metrics.rms_vs_exact([1.0, 2.0], [a, b], a)]
+    calls += [lambda: metrics.fit_oscillation("abc", "def"), lambda: metrics.spread("ab"),
+              lambda: article.integrate(article.ARTICLE_OSCILLATOR, "a", 0.0, [0.1]),
+              lambda: article.integrate(article.ARTICLE_OSCILLATOR, 0.5, 0.0, "x")]
+    refused = 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # overflow in numpy is what the values are for
+        for call in calls:
+            try:
+                call()
+            except SteadystepError:
+                refused += 1
+    assert refused > len(calls) // 2
