@@ -35,14 +35,16 @@ class ProbeResult:
     reason: str          # why unstable_s failed ("blow-up: ...", "x left its range", ""), for the report
 
 
-def _trial(scene: str, policy: str, step_s: float, duration_s: float, bounds: dict, params) -> str:
-    """'' when the scene is stable at step_s, else why not."""
+def _trial(scene: str, policy: str, step_s: float, duration_s: float, bounds: dict, params,
+           name: str = "step_s") -> str:
+    """'' when the scene is stable at step_s, else why not. A step the library refuses is refused naming it as
+    name (low_s, high_s: what the caller gave)."""
     try:
         result = runs.run(scene, f"fixed:{1.0 / step_s!r}", policy, duration_s, params=params,
                           stepping={"max_step_s": step_s, "fixed_step_s": step_s})
     except SteadystepError as error:
         if error.status != "no finite mapping":  # a mapping with nothing to offer at this step is a failure of it
-            raise
+            raise SteadystepError(error.status, f"{name} = {step_s:g} s: {error.message}", error.code) from None
         return f"{error.status}: {error.message}"
     if result.blew_up:
         return f"{result.status}: {result.message}"
@@ -84,11 +86,11 @@ def largest_stable_step(scene: str, policy: str, duration_s: float = 3.0, low_s:
         bounds[name] = (float(values.min()) - width, float(values.max()) + width)
 
     trials = 1
-    reason = _trial(scene, policy, high_s, duration_s, bounds, params)
+    reason = _trial(scene, policy, high_s, duration_s, bounds, params, "high_s")
     if not reason:
         return ProbeResult(scene, policy, high_s, math.inf, trials, "")
     trials += 1
-    low_reason = _trial(scene, policy, low_s, duration_s, bounds, params)
+    low_reason = _trial(scene, policy, low_s, duration_s, bounds, params, "low_s")
     if low_reason:
         return ProbeResult(scene, policy, 0.0, low_s, trials, low_reason)
     stable, unstable = low_s, high_s

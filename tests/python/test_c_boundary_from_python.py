@@ -2,9 +2,7 @@
 whole process (SIGABRT) on some of them, and a test must see that as a failure rather than die with it.
 
 Every case must end with exit code 0, 1 or 2 and no traceback. Python cannot make ODE take a frame it aborts on:
-that boundary is the library's (issue 8, point 1). Until it is merged, the cases that still kill the process are
-marked xfail(strict=True), so that each one reports XPASS, and fails, the day the library handles it: then drop
-its mark.
+that boundary is the library's (limits.h); these cases check it from the outside, where a user meets it.
 """
 
 import subprocess
@@ -15,8 +13,6 @@ import pytest
 
 SCRIPT = Path(sys.executable).parent / "steadystep"
 COMMAND = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "steadystep.cli"]
-NEEDS_C_BOUNDARY = pytest.mark.xfail(strict=True, reason="ODE aborts or the trace reader never returns: the "
-                                     "library's boundary (issue 8 points 1 and 7) is not merged yet")
 
 
 def finishes_cleanly(args, timeout_s=20.0):
@@ -34,12 +30,12 @@ def python_call(code: str):
 
 
 @pytest.mark.parametrize("profile", [
-    "fixed:1e200",          # refused by Python: more frames than a run may take
-    "fixed:1e-320",         # infinite frames: refused by Python
+    "fixed:1e200",          # frames of 1e-200 s
+    "fixed:1e-320",         # 1/FPS overflows: infinite frames
     "uniform:1e-320:30",
-    "hitch:60:1e19:1",      # EVERY beyond long: refused by the library
-    pytest.param("hitch:60:2:1e-320", marks=NEEDS_C_BOUNDARY),
-    pytest.param("vsync:1e308:1e-308", marks=NEEDS_C_BOUNDARY),
+    "hitch:60:1e19:1",      # EVERY beyond a long
+    "hitch:60:2:1e-320",    # every other frame a denormal
+    "vsync:1e308:1e-308",
     "hitch:60:2:1e308",
 ])
 @pytest.mark.parametrize("policy", ["naive", "spring"])
@@ -49,7 +45,7 @@ def test_profiles_with_absurd_frames(profile, policy):
 
 
 @pytest.mark.parametrize("lines", [
-    pytest.param(b"0.02\n1e-310\n", marks=NEEDS_C_BOUNDARY),
+    b"0.02\n1e-310\n",
     b"0.02\n1.8e308\n",
 ])
 def test_trace_lines_with_absurd_frames(tmp_path, lines):
@@ -59,16 +55,15 @@ def test_trace_lines_with_absurd_frames(tmp_path, lines):
                       "--duration", "0.5"])
 
 
-@NEEDS_C_BOUNDARY
 def test_a_trace_that_never_ends():
     finishes_cleanly([*COMMAND, "run", "oscillator", "--profile", "trace:/dev/zero", "--policy", "spring"],
                      timeout_s=5.0)
 
 
 @pytest.mark.parametrize("code", [
-    pytest.param("runs.Scene('oscillator').frame(1e-310)", marks=NEEDS_C_BOUNDARY),
-    pytest.param("runs.run('oscillator', 'fixed:30', 'spring', 0.5, params={'mass': 1e300})", marks=NEEDS_C_BOUNDARY),
-    pytest.param("runs.run('oscillator', 'fixed:30', 'spring', 0.5, params={'mass': 1e-320})", marks=NEEDS_C_BOUNDARY),
+    "runs.Scene('oscillator').frame(1e-310)",
+    "runs.run('oscillator', 'fixed:30', 'spring', 0.5, params={'mass': 1e300})",
+    "runs.run('oscillator', 'fixed:30', 'spring', 0.5, params={'mass': 1e-320})",
 ])
 def test_python_calls_that_reach_ode(code):
     python_call(f"""
