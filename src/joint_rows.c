@@ -281,6 +281,9 @@ ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, doub
   if (!ssJointSupports(joint, param, axis))
     return ssFail(SS_ERROR_UNSUPPORTED, "a %s joint has no %s parameters on axis %d", ssJointTypeName(joint),
                   ssJointParamName(param) ? ssJointParamName(param) : "such", axis);
+  /* ODE's axis getters need the joint's first body (some assert on it): a detached joint has no row to measure */
+  if (dJointGetBody(joint, 0) == 0)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "the %s joint has no dynamic body attached", ssJointTypeName(joint));
   dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
   int angular, has_point;
   if (!rowGeometry(joint, param, axis, direction, point, &angular, &has_point))
@@ -300,6 +303,7 @@ int ssJointRowHasDirection(dJointID joint, ssJointParam param, int axis) {
 }
 
 void ssJointAddRowForce(dJointID joint, ssJointParam param, int axis, double force_or_torque) {
+  if (dJointGetBody(joint, 0) == 0) return; /* detached: no row, and ODE's getters would assert */
   dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
   int angular, has_point;
   if (!rowGeometry(joint, param, axis, direction, point, &angular, &has_point)) return;

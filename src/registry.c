@@ -22,6 +22,7 @@ typedef struct JointBinding {
   ssSoftness pending;    /* computed in Apply's first pass */
   ssSoftness written;    /* last written: the registry owns the row, so an unchanged value is not written again */
   double load; /* the steady force or torque the row carries (ssRegistry_SetJointLoad); 0 = none declared */
+  double load_correction; /* the force this Apply adds along the row for the load (N or N·m) */
   /* The spring mapping needs the mass only for the Nyquist report: it is refreshed every few Applies there. */
   double report_mass;
   int report_mass_age;
@@ -107,7 +108,7 @@ int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam par
 
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass) {
-  JointBinding binding = {joint, param, axis, law, effective_mass, {0, 0}, {NAN, NAN}, 0, NAN, 0,
+  JointBinding binding = {joint, param, axis, law, effective_mass, {0, 0}, {NAN, NAN}, 0, 0, NAN, 0,
                           SS_MAPPING_SPRING, NAN, NAN, NAN, {0, 0}};
   JointBinding* existing = findJoint(registry, joint, param, axis);
   if (existing != NULL) {
@@ -138,6 +139,9 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
 ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, double load) {
   REQUIRE_REGISTRY(registry);
   ssStatus status = ssCheckFinite("load", "N or N·m", load);
+  if (status == SS_OK && fabs(load) > SS_MAX_FORCE_N)
+    status = ssFail(SS_ERROR_OUT_OF_RANGE, "load = %g N or N·m: must be at most SS_MAX_FORCE_N = %g in size", load,
+                    SS_MAX_FORCE_N);
   if (status != SS_OK) return status;
   JointBinding* binding = findJoint(registry, joint, param, axis);
   if (binding == NULL)
@@ -391,6 +395,24 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     }
   }
 
+  /* The load corrections, computed and bounded before anything is written. */
+  if (mapping != SS_MAPPING_SPRING) {
+    for (int i = 0; i < registry->joint_count; ++i) {
+      JointBinding* binding = &registry->joints[i];
+      binding->load_correction = 0;
+      const ssSpring* spring = &binding->law.spring;
+      if (binding->load == 0 || binding->law.hard || spring->stiffness == 0) continue;
+      /* the step's static stiffness is k' = erp/(h·cfm): this force puts the rest position back at load/k */
+      double static_stiffness = binding->pending.erp / (step_s * binding->pending.cfm);
+      double correction = binding->load * (static_stiffness / spring->stiffness - 1);
+      if (!(fabs(correction) <= SS_MAX_FORCE_N))
+        return failBinding(ssFail(SS_ERROR_OUT_OF_RANGE, "load correction %g N or N·m: beyond SS_MAX_FORCE_N = %g",
+                                  correction, SS_MAX_FORCE_N),
+                           binding);
+      binding->load_correction = correction;
+    }
+  }
+
   /* Second pass: nothing below can fail. */
   if (registry->world_bound) {
     dWorldSetERP(registry->world, registry->world_pending.erp);
@@ -407,12 +429,8 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   if (mapping != SS_MAPPING_SPRING) {
     for (int i = 0; i < registry->joint_count; ++i) {
       const JointBinding* binding = &registry->joints[i];
-      const ssSpring* spring = &binding->law.spring;
-      if (binding->load == 0 || binding->law.hard || spring->stiffness == 0) continue;
-      /* the step's static stiffness is k' = erp/(h·cfm): this force puts the rest position back at load/k */
-      double static_stiffness = binding->pending.erp / (step_s * binding->pending.cfm);
-      ssJointAddRowForce(binding->joint, binding->param, binding->axis,
-                         binding->load * (static_stiffness / spring->stiffness - 1));
+      if (binding->load_correction != 0)
+        ssJointAddRowForce(binding->joint, binding->param, binding->axis, binding->load_correction);
     }
   }
   counts.rows_written += registry->joint_count;

@@ -197,7 +197,14 @@ ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body) {
   for (int i = 0; i < stepper->watched_count; ++i)
     if (stepper->watched[i] == body) ssStepper_UnwatchBody(stepper, body);
   ssRegistry* registry = stepper->def.registry;
-  if (registry != NULL && ssRegistryHasBody(registry, body)) ssRegistry_UnbindBody(registry, body);
+  if (registry != NULL) {
+    if (ssRegistryHasBody(registry, body)) ssRegistry_UnbindBody(registry, body);
+    /* ODE leaves the body's joints detached on one side, where some of its getters assert: they are unbound */
+    for (int i = dBodyGetNumJoints(body) - 1; i >= 0; --i) {
+      dJointID joint = dBodyGetJoint(body, i);
+      if (ssRegistryHasJoint(registry, joint)) ssRegistry_UnbindJoint(registry, joint);
+    }
+  }
   stepper->watched_generation += 1; /* the known list is rebuilt without it before it is read again */
   dBodyDestroy(body);
   return SS_OK;
@@ -334,8 +341,9 @@ static int anyNonZero(const double* values) {
   return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
 }
 
-/* Reads the forces the program added for this frame, and lists the bodies that have one or carried momentum. */
-static void captureForces(ssStepper* stepper) {
+/* Reads the forces the program added for this frame, and lists the bodies that have one or carried momentum. A
+ * force ODE cannot step (non-finite, or beyond SS_MAX_FORCE_N) refuses the frame before anything is touched. */
+static ssStatus captureForces(ssStepper* stepper) {
   stepper->pushed_count = 0;
   for (int i = 0; i < stepper->known_count; ++i) {
     KnownBody* known = &stepper->known[i];
@@ -343,8 +351,15 @@ static void captureForces(ssStepper* stepper) {
     const dReal* torque = dBodyGetTorque(known->body);
     double* f = known->frame_force;
     f[0] = force[0], f[1] = force[1], f[2] = force[2], f[3] = torque[0], f[4] = torque[1], f[5] = torque[2];
-    if (anyNonZero(f) || anyNonZero(known->carried)) stepper->pushed[stepper->pushed_count++] = i;
+    if (!anyNonZero(f) && !anyNonZero(known->carried)) continue;
+    for (int j = 0; j < 6; ++j)
+      if (!(fabs(f[j]) <= SS_MAX_FORCE_N))
+        return ssFail(isfinite(f[j]) ? SS_ERROR_OUT_OF_RANGE : SS_ERROR_NOT_FINITE,
+                      "body %p: %s %g N or N·m added for the frame: must be finite and at most SS_MAX_FORCE_N = %g",
+                      (void*)known->body, j < 3 ? "force" : "torque", f[j], SS_MAX_FORCE_N);
+    stepper->pushed[stepper->pushed_count++] = i;
   }
+  return SS_OK;
 }
 
 /* Before each of a frame's `steps` steps of step_s: each pushed body gets the force that delivers its frame's
@@ -531,7 +546,7 @@ ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* repor
                     (double)SS_MAX_FRAME_S);
   if (status != SS_OK || frame_s == 0) return status;
   if ((status = refreshKnown(stepper)) != SS_OK) return status;
-  captureForces(stepper);
+  if ((status = captureForces(stepper)) != SS_OK) return status;
   stepper->report = report;
   status = stepper->def.policy == SS_POLICY_FIXED ? stepFixed(stepper, frame_s, report)
                                                    : stepFrame(stepper, frame_s, report);

@@ -63,6 +63,12 @@
  *  finite at all 64 corners (both solvers, h, erp, cfm and mass at their bounds); from 1e90, 16 of them abort. */
 #define SS_MAX_SAFE_SPEED 1e50
 
+/** The largest force (N) or torque (N·m) the library hands to ODE: 1e30, the program's frame forces that the
+ *  stepper puts back before each substep and the load corrections of ssRegistry_SetJointLoad alike. With masses of
+ *  at least SS_MIN_MASS_KG and steps of at most SS_MAX_STEP_S, one step changes a speed by at most 3.6e45, inside
+ *  SS_MAX_SAFE_SPEED. */
+#define SS_MAX_FORCE_N 1e30
+
 /** The shortest and longest frame (s) a lab profile hands out (profile.h): 1e-12 s to SS_MAX_STEP_S. Frames
  *  shorter than SS_MIN_STEP_S are allowed on purpose, to exercise carrying a frame over. */
 #define SS_MIN_PROFILE_FRAME_S 1e-12

@@ -81,8 +81,9 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
  *  body) for the coming step, which puts the rest position back at load/k; for a lone spring under a constant load
  *  the exact mapping's samples are then exact again. The spring mapping needs nothing (its k' is k). Call Apply
  *  once per step (the stepper does), since the force is added each time. Binding the row again clears the load.
- *  Errors: SS_ERROR_NOT_FINITE; SS_ERROR_NOT_FOUND when that row is not bound; SS_ERROR_UNSUPPORTED for
- *  SS_PARAM_JOINT rows, which have no single direction. */
+ *  Errors: SS_ERROR_NOT_FINITE; SS_ERROR_OUT_OF_RANGE for |load| > SS_MAX_FORCE_N (limits.h), or a NULL registry;
+ *  SS_ERROR_NOT_FOUND when that row is not bound; SS_ERROR_UNSUPPORTED for SS_PARAM_JOINT rows, which have no
+ *  single direction. Apply refuses a step whose correction would exceed SS_MAX_FORCE_N. */
 ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, double load);
 
 /** Removes every binding of joint. Call it before dJointDestroy. Errors: SS_ERROR_NOT_FOUND. */

@@ -144,8 +144,9 @@ void ssStepper_Destroy(ssStepper* stepper);
  *  Forces and torques that the program added to known bodies before this call act for the whole frame: they are
  *  put back before every substep (ODE clears them after each step), and under SS_POLICY_FIXED they are scaled so
  *  that the frame's steps deliver the momentum F·frame_s (carried to the next frame when this one takes no step).
- *  Errors, with the world left as it was: SS_ERROR_OUT_OF_RANGE (stepper NULL, frame_s out of range),
- *  SS_ERROR_NOT_FINITE; errors of ssRegistry_Apply (checked before the first step touches the world);
+ *  Errors, with the world left as it was: SS_ERROR_OUT_OF_RANGE (stepper NULL, frame_s out of range, a force or
+ *  torque on a known body beyond SS_MAX_FORCE_N, named with its body), SS_ERROR_NOT_FINITE (frame_s, a force);
+ *  errors of ssRegistry_Apply (checked before the first step touches the world);
  *  SS_ERROR_FAILED when an earlier frame failed and ssStepper_Reset has not been called.
  *  Errors after stepping: SS_ERROR_BLOWUP (a known body's position or velocity is not finite) and
  *  SS_ERROR_SPEED_LIMIT (faster than max_speed or max_angular_speed): the frame stops at that step,
@@ -181,7 +182,8 @@ ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body);
 /** Destroys a body safely: stops watching it, removes its damping and auto-disable bindings from the registry,
  *  then calls dBodyDestroy. Use it instead of dBodyDestroy for any body the stepper knows: ODE gives no way to tell
  *  a destroyed body from a live one, so the stepper and the registry would read freed memory (a sanitizer build
- *  stops there with a report). Joints attached to it stay bound; ODE detaches them.
+ *  stops there with a report). The registry's bindings of the joints attached to it are removed too: ODE leaves
+ *  those joints detached on one side, where some of its getters assert.
  *  Errors, with nothing destroyed: SS_ERROR_OUT_OF_RANGE (stepper or body NULL). */
 ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body);
 

@@ -245,6 +245,60 @@ TEST_F(DestroyTest, BoundAndWatchedObjectsAreDestroyedThroughTheStepper) {
   dSpaceDestroy(space);
 }
 
+TEST_F(DestroyTest, DestroyingABodyUnbindsTheJointsODELeavesDetached) {
+  // A hinge-2 whose chassis goes: ODE asserts in the hinge-2 axis getters of a joint without its first body.
+  dBodyID chassis = MakeBody(4.0, 0, 0, 1), wheel = MakeBody(0.5, 0.3, 0, 0.8);
+  dJointID hinge2 = dJointCreateHinge2(world, 0);
+  dJointAttach(hinge2, chassis, wheel);
+  const dReal up[3] = {0, 0, 1}, spin[3] = {0, 1, 0};
+  dJointSetHinge2Axes(hinge2, up, spin);
+  ssRegistry* registry = ssRegistry_Create(world);
+  ASSERT_EQ(ssRegistry_BindJoint(registry, hinge2, SS_PARAM_SUSPENSION, 1, ssSpring{400, 20}, 0), SS_OK);
+  ASSERT_EQ(ssRegistry_SetJointLoad(registry, hinge2, SS_PARAM_SUSPENSION, 1, -9.81), SS_OK);
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = world;
+  def.registry = registry;
+  def.policy = SS_POLICY_MATCHED;
+  ssStepper* stepper = nullptr;
+  ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
+  ASSERT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK) << ssLastError();
+  ASSERT_EQ(ssStepper_DestroyBody(stepper, chassis), SS_OK);
+  EXPECT_EQ(ssRegistry_JointBindingCount(registry), 0);
+  for (int frame = 0; frame < 3; ++frame) ASSERT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK) << ssLastError();
+  ssStepper_Destroy(stepper);
+  ssRegistry_Destroy(registry);
+}
+
+TEST_F(ProgramTest, ForcesAndLoadsODECannotStepAreRefusedByNameBeforeAnythingMoves) {
+  dBodyID body = MakeBody(1.0, 0, 0, 1);
+  dJointID slider = dJointCreateSlider(world, 0);
+  dJointAttach(slider, body, 0);
+  ssRegistry* registry = ssRegistry_Create(world);
+  ASSERT_EQ(ssRegistry_BindJoint(registry, slider, SS_PARAM_STOP, 1, ssSpring{40, 1}, 0), SS_OK);
+  EXPECT_EQ(ssRegistry_SetJointLoad(registry, slider, SS_PARAM_STOP, 1, 1.7976931348623157e308),
+            SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("SS_MAX_FORCE_N"), std::string::npos) << ssLastError();
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = world;
+  def.registry = registry;
+  ssStepper* stepper = nullptr;
+  ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
+  for (double force : {1e300, double(NAN), double(INFINITY)}) {
+    dBodySetForce(body, 0, 0, 0);
+    dBodyAddTorque(body, force, 0, 0);
+    const double z = dBodyGetPosition(body)[2];
+    ssFrameReport report;
+    EXPECT_NE(ssStepper_Step(stepper, 0.05, &report), SS_OK) << force;
+    EXPECT_NE(std::string(ssLastError()).find("torque"), std::string::npos) << ssLastError();
+    EXPECT_EQ(report.steps, 0);
+    EXPECT_EQ(dBodyGetPosition(body)[2], z);
+    dBodySetTorque(body, 0, 0, 0);
+  }
+  EXPECT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK) << ssLastError();
+  ssStepper_Destroy(stepper);
+  ssRegistry_Destroy(registry);
+}
+
 #if STEADYSTEP_TESTS_SANITIZED
 // Forgetting it cannot be detected by the library (ODE has no way to tell a freed joint from a live one); a
 // sanitizer build stops at the next step with a report that points at the registry's read of the freed joint
