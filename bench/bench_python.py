@@ -20,7 +20,7 @@ REPEATS = 3
 
 
 def python_loop(bodies: int, duration_s: float) -> tuple[float, int]:
-    scene = runs.Scene("pile", "spring", params={"body_count": bodies})
+    scene = runs.Scene("pile", "implicit-euler", params={"body_count": bodies})
     profile = Profile(PROFILE, SEED)
     steps = 0
     elapsed_s = 0.0
@@ -36,7 +36,7 @@ def python_loop(bodies: int, duration_s: float) -> tuple[float, int]:
 
 
 def c_run(bodies: int, duration_s: float) -> tuple[float, int]:
-    result = runs.run("pile", PROFILE, "spring", duration_s, SEED, params={"body_count": bodies})
+    result = runs.run("pile", PROFILE, "implicit-euler", duration_s, SEED, params={"body_count": bodies})
     return result.wall_s, result.step_count
 
 

@@ -3,7 +3,7 @@
  * is ODE's default, bodies are damped per step, and the links collide with the ground. This is chain_ode.c
  * adopted with steadystep: the lines marked "steadystep" take over what it tuned, and the stepper steps each frame.
  *
- *   chain_steadystep --policy spring --profile uniform:15:45 --seconds 10 > run.csv      (t_s,end_x_m,end_z_m)
+ *   chain_steadystep --policy implicit-euler --profile uniform:15:45 --seconds 10 > run.csv      (t_s,end_x_m,end_z_m)
  *
  * Followed: the free end of the last link, its x (the push's direction) and its height z. */
 #include <math.h>
@@ -88,8 +88,10 @@ int main(int argc, char** argv) {
   ExampleFlags flags;
   int parsed = exampleParseFlags(PROGRAM, argc, argv, EXAMPLE_FLAGS_STEPPER, &flags);
   if (parsed != 0) return parsed < 0 ? 0 : parsed;
-  ssPolicy policy;
-  if (ssPolicyParse(flags.policy, &policy) != SS_OK)
+  /* naive freezes the softness at the step the numbers were tuned for: the program's own stepping */
+  ssStepping stepping = ssDefaultStepping();
+  stepping.max_step_s = flags.max_step_s;
+  if (ssSteppingForPolicy(flags.policy, 1.0 / 60, &stepping) != SS_OK)
     return exampleRefuse(&flags, PROGRAM, "--policy", flags.policy, ssLastError());
   dInitODE2(0);
   build();
@@ -98,9 +100,7 @@ int main(int argc, char** argv) {
   ssStepperDef def = ssDefaultStepperDef();
   def.world = world;
   def.registry = registry;
-  def.policy = policy;
-  def.max_step_s = flags.max_step_s;
-  def.reference_step_s = 1.0 / 60; /* naive: the tuned numbers as they are, one step a frame */
+  def.stepping = stepping;
   def.collide = collide;
   def.contact_group = contacts;
   ssStepper* stepper = NULL;

@@ -8,7 +8,8 @@
  *   --seed N         the profile's seed (whole number >= 0), default 1
  *   --quiet          no CSV; print the stepping loop's wall seconds and process CPU seconds to stderr, one line
  *                    "WALL CPU" (for benchmarks: CPU time is what a busy shared machine disturbs least)
- * Adopted programs (EXAMPLE_FLAGS_STEPPER) also take --policy naive|spring|matched|exact|fixed (default spring) and
+ * Adopted programs (EXAMPLE_FLAGS_STEPPER) also take --policy NAME (a preset of stepping.h: naive, implicit-euler, matched, exact, fixed, ...; default
+ * implicit-euler) and
  * --max-step S (the longest substep, s, > 0, default 1/60); the stack also takes --boxes N (EXAMPLE_FLAGS_BOXES).
  * Exit codes: 0 every frame stepped, 1 a frame failed, 2 a bad flag. */
 #ifndef EXAMPLE_CLI_H
@@ -51,7 +52,7 @@ static inline int exampleNumber(const char* text, double* out) {
 static inline int exampleParseFlags(const char* program, int argc, char** argv, int accepts, ExampleFlags* flags) {
   const char* profile = "uniform:15:45";
   double seed = 1;
-  *flags = (ExampleFlags){NULL, 10.0, 0, "spring", 1.0 / 60.0, 8};
+  *flags = (ExampleFlags){NULL, 10.0, 0, "implicit-euler", 1.0 / 60.0, 8};
   for (int i = 1; i < argc; ++i) {
     const char* flag = argv[i];
     if (strcmp(flag, "--help") == 0 || strcmp(flag, "-h") == 0) {
@@ -59,9 +60,9 @@ static inline int exampleParseFlags(const char* program, int argc, char** argv, 
              "Defaults: uniform:15:45, 10 s, seed 1%s%s. CSV on stdout; --quiet prints the stepping loop's wall\n"
              "and CPU seconds to stderr instead.\n",
              program,
-             accepts & EXAMPLE_FLAGS_STEPPER ? " [--policy naive|spring|matched|exact|fixed] [--max-step S]" : "",
+             accepts & EXAMPLE_FLAGS_STEPPER ? " [--policy naive|implicit-euler|matched|exact|fixed|fixed-matched|fixed-exact] [--max-step S]" : "",
              accepts & EXAMPLE_FLAGS_BOXES ? " [--boxes N]" : "",
-             accepts & EXAMPLE_FLAGS_STEPPER ? ", policy spring, max step 1/60 s" : "",
+             accepts & EXAMPLE_FLAGS_STEPPER ? ", policy implicit-euler, max step 1/60 s" : "",
              accepts & EXAMPLE_FLAGS_BOXES ? ", 8 boxes" : "");
       return -1;
     }

@@ -1,7 +1,7 @@
 /* The article's case with steadystep: one body on a slider whose stop (lo = hi = 0) is a spring-damper, stepped
  * frame by frame under a frame-time profile. Prints CSV, one row per physics step: t,x,v,erp,cfm.
  *
- *   oscillator --policy spring --profile uniform:15:45 --seed 3 > run.csv
+ *   oscillator --policy implicit-euler --profile uniform:15:45 --seed 3 > run.csv
  *
  * Read it as a template: make the world, bind the spring once, call ssStepper_Step once per frame. */
 #include <errno.h>
@@ -35,7 +35,7 @@ static void printStep(void* context, double step_s) {
 
 static void usage(FILE* out) {
   fprintf(out,
-          "usage: oscillator [--policy naive|spring|matched|exact|fixed] [--profile SPEC] [--seed N]\n"
+          "usage: oscillator [--policy naive|implicit-euler|matched|exact|fixed|...] [--profile SPEC] [--seed N]\n"
           "                  [--seconds T] [--k N/m] [--c N*s/m] [--mass KG] [--x0 M] [--gravity M/S2]\n"
           "                  [--stepper step|quick] [--reference-fps R] [--max-step S]\n"
           "Profiles: fixed:FPS, uniform:MINFPS:MAXFPS, jitter:FPS:SPREAD_MS, hitch:FPS:EVERY:SECONDS,\n"
@@ -107,15 +107,15 @@ static int fail(const char* what, ssStatus status) {
 }
 
 int main(int argc, char** argv) {
-  Options o = {"spring", "uniform:15:45", 0, 5.0, 40.0, 1.0, 1.0, 0.5, 0.0, 30.0, 1.0 / 60.0, 0};
+  Options o = {"implicit-euler", "uniform:15:45", 0, 5.0, 40.0, 1.0, 1.0, 0.5, 0.0, 30.0, 1.0 / 60.0, 0};
   int parsed = parseOptions(argc, argv, &o);
   if (parsed == 1) {
     usage(stdout);
     return 0;
   }
   if (parsed != 0) return parsed;
-  ssPolicy policy;
-  ssStatus status = ssPolicyParse(o.policy, &policy);
+  ssStepping stepping = ssDefaultStepping();
+  ssStatus status = ssSteppingForPolicy(o.policy, 1.0 / o.reference_fps, &stepping);
   if (status != SS_OK) return fail("--policy", status);
   ssProfile* profile;
   status = ssProfile_Create(o.profile, o.seed, &profile);
@@ -144,11 +144,10 @@ int main(int argc, char** argv) {
   ssStepperDef def = ssDefaultStepperDef();
   def.world = world;
   def.registry = registry;
-  def.policy = policy;
-  def.solver = o.use_step ? SS_SOLVER_STEP : SS_SOLVER_QUICK;
-  def.max_step_s = o.max_step_s;
-  def.reference_step_s = 1.0 / o.reference_fps;
-  def.max_speed = 1e6;
+  def.stepping = stepping;
+  def.stepping.solver = o.use_step ? SS_SOLVER_STEP : SS_SOLVER_QUICK;
+  def.stepping.max_step_s = o.max_step_s;
+  def.stepping.max_speed = 1e6;
   def.step_done = printStep;
   def.step_done_context = &recorder;
   ssStepper* stepper;

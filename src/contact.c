@@ -16,7 +16,7 @@ static double contactMass(const dContact* contact, dBodyID body1, dBodyID body2)
 
 ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
                             double step_s, double previous_step_s, int* spring_fallback) {
-  double mass = mapping == SS_MAPPING_SPRING || law->hard ? NAN : contactMass(contact, body1, body2);
+  double mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard ? NAN : contactMass(contact, body1, body2);
   ssSoftness softness;
   ssRowFallback fallback;
   ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, &fallback, &softness);

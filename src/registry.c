@@ -109,7 +109,7 @@ int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam par
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass) {
   JointBinding binding = {joint, param, axis, law, effective_mass, {0, 0}, {NAN, NAN}, 0, 0, NAN, 0,
-                          SS_MAPPING_SPRING, NAN, NAN, NAN, {0, 0}};
+                          SS_MAPPING_IMPLICIT_EULER, NAN, NAN, NAN, {0, 0}};
   JointBinding* existing = findJoint(registry, joint, param, axis);
   if (existing != NULL) {
     *existing = binding;
@@ -268,7 +268,7 @@ static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass,
 static double bindingMass(JointBinding* binding, ssMapping mapping) {
   if (binding->effective_mass > 0) return binding->effective_mass;
   if (binding->law.hard) return NAN;
-  if (mapping == SS_MAPPING_SPRING && binding->report_mass_age > 0) {
+  if (mapping == SS_MAPPING_IMPLICIT_EULER && binding->report_mass_age > 0) {
     binding->report_mass_age -= 1;
     return binding->report_mass;
   }
@@ -371,7 +371,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
     double previous_s = mapping == SS_MAPPING_EXACT ? previous_step_s : 0;
-    if (mapping != SS_MAPPING_SPRING && binding->computed_mapping == mapping && binding->computed_mass == mass &&
+    if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_mapping == mapping && binding->computed_mass == mass &&
         binding->computed_step_s == step_s && binding->computed_previous_s == previous_s) {
       countRow(&binding->law, mass, step_s, &binding->computed_fallback, &counts);
       continue;
@@ -388,7 +388,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     binding->computed_mass = mass;
     binding->computed_step_s = step_s;
     binding->computed_previous_s = previous_s;
-    if (mapping == SS_MAPPING_SPRING || binding->law.hard) {
+    if (mapping == SS_MAPPING_IMPLICIT_EULER || binding->law.hard) {
       int slot = cached < kCacheSize ? cached++ : i % kCacheSize;
       cached_law[slot] = binding->law;
       cached_softness[slot] = binding->pending;
@@ -396,7 +396,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   }
 
   /* The load corrections, computed and bounded before anything is written. */
-  if (mapping != SS_MAPPING_SPRING) {
+  if (mapping != SS_MAPPING_IMPLICIT_EULER) {
     for (int i = 0; i < registry->joint_count; ++i) {
       JointBinding* binding = &registry->joints[i];
       binding->load_correction = 0;
@@ -426,7 +426,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     ssJointWriteSoftness(binding->joint, binding->param, binding->axis, binding->pending.erp, binding->pending.cfm);
     binding->written = binding->pending;
   }
-  if (mapping != SS_MAPPING_SPRING) {
+  if (mapping != SS_MAPPING_IMPLICIT_EULER) {
     for (int i = 0; i < registry->joint_count; ++i) {
       const JointBinding* binding = &registry->joints[i];
       if (binding->load_correction != 0)

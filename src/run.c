@@ -112,10 +112,9 @@ static ssStatus play(ssRun* run, ssScene* scene, ssProfile* profile, double dura
 /* The physics steps a run of frames of mean_frame_s will take, roughly: one per frame, more when a policy cuts
  * frames into substeps, duration / fixed_step_s under the accumulator. */
 static double expected_steps(const ssStepping* stepping, double duration_s, double frames, double mean_frame_s) {
-  if (stepping->policy == SS_POLICY_FIXED) return duration_s / stepping->fixed_step_s;
-  if (stepping->policy == SS_POLICY_NAIVE) return frames;
-  double per_frame = fmin(ceil(mean_frame_s / stepping->max_step_s), (double)stepping->max_steps_per_frame);
-  return frames * fmax(per_frame, 1.0);
+  if (stepping->cut == SS_CUT_FIXED) return duration_s / stepping->fixed_step_s;
+  if (stepping->cut == SS_CUT_WHOLE_FRAME) return frames;
+  return frames * fmax(ceil(mean_frame_s / stepping->max_step_s), 1.0);
 }
 
 /* Refuses, before anything runs, a run that would take more frames or steps than limits.h allows. */
@@ -129,9 +128,9 @@ static ssStatus check_size(const ssRunDef* def, const ssProfile* profile) {
   double steps = expected_steps(&def->stepping, def->duration_s, frames, mean_frame_s);
   if (steps > SS_MAX_RUN_STEPS)
     return ssFail(SS_ERROR_OUT_OF_RANGE,
-                  "duration_s = %g s: policy %s with max_step_s = %g s, fixed_step_s = %g s needs about %.3g steps, "
+                  "duration_s = %g s: cut %s with max_step_s = %g s, fixed_step_s = %g s needs about %.3g steps, "
                   "a run takes at most %d",
-                  def->duration_s, ssPolicyName((ssPolicy)def->stepping.policy), def->stepping.max_step_s,
+                  def->duration_s, ssFrameCutName(def->stepping.cut), def->stepping.max_step_s,
                   def->stepping.fixed_step_s, steps, SS_MAX_RUN_STEPS);
   return SS_OK;
 }

@@ -77,22 +77,16 @@ ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out) {
   return SS_OK;
 }
 
-ssStepping ssDefaultStepping(void) {
-  ssStepperDef def = ssDefaultStepperDef();
-  return (ssStepping){
-      .policy = (int)def.policy,
-      .solver = (int)def.solver,
-      .quick_iterations = 20, /* ODE's own default, written so that a scene never depends on it */
-      .max_step_s = def.max_step_s,
-      .reference_step_s = 1.0 / 30.0, /* the scenes' springs are stated for all steps; naive freezes them here */
-      .fixed_step_s = def.fixed_step_s,
-      .max_steps_per_frame = def.max_steps_per_frame,
-  };
+ssStatus ssLabStepping(const char* policy, ssStepping* out) {
+  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the stepping");
+  ssStepping stepping = ssDefaultStepping();
+  ssStatus status = ssSteppingForPolicy(policy, SS_LAB_NAIVE_REFERENCE_STEP_S, &stepping);
+  if (status == SS_OK) *out = stepping;
+  return status;
 }
 
 ssStepping ssReferenceStepping(double step_s) {
   ssStepping stepping = ssDefaultStepping();
-  stepping.policy = SS_POLICY_SPRING;
   stepping.max_step_s = step_s;
   stepping.fixed_step_s = step_s;
   return stepping;
@@ -119,30 +113,6 @@ static ssStatus validate_params(const ssSceneDesc* desc, const ssSceneParams* pa
   return SS_OK;
 }
 
-static ssStatus validate_stepping(const ssStepping* stepping, const ssSpring* spring) {
-  if (ssPolicyName((ssPolicy)stepping->policy) == NULL)
-    return ssFail(SS_ERROR_UNSUPPORTED, "stepping.policy = %d: unknown (0 naive, 1 spring, 2 matched, 3 exact, 4 fixed)",
-                  stepping->policy);
-  if (stepping->solver != SS_SOLVER_QUICK && stepping->solver != SS_SOLVER_STEP)
-    return ssFail(SS_ERROR_UNSUPPORTED, "stepping.solver = %d: unknown (0 quick, 1 step)", stepping->solver);
-  if (stepping->quick_iterations <= 0)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.quick_iterations = %d: must be positive",
-                  stepping->quick_iterations);
-  if (stepping->max_steps_per_frame <= 0)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.max_steps_per_frame = %d: must be positive",
-                  stepping->max_steps_per_frame);
-  ssStatus status = ssCheckStepLength("stepping.max_step_s", stepping->max_step_s);
-  if (status == SS_OK) status = ssCheckStepLength("stepping.reference_step_s", stepping->reference_step_s);
-  if (status == SS_OK) status = ssCheckStepLength("stepping.fixed_step_s", stepping->fixed_step_s);
-  if (status != SS_OK) return status;
-  /* Found here rather than at the first frame, where it would stop a run that could never have worked. */
-  int exact_poles = stepping->policy == SS_POLICY_MATCHED || stepping->policy == SS_POLICY_EXACT;
-  if (exact_poles && spring->damping == 0)
-    return ssFail(SS_ERROR_NO_FINITE_MAPPING, "c = 0 N*s/m: policy %s needs a damped spring",
-                  ssPolicyName((ssPolicy)stepping->policy));
-  return SS_OK;
-}
-
 static void scene_step_done(void* context, double step_s) {
   ssScene* scene = context;
   scene->time_s += step_s;
@@ -161,14 +131,9 @@ static ssStatus make_stepper(ssScene* scene, const ssStepping* stepping) {
   ssStepperDef def = ssDefaultStepperDef();
   def.world = scene->parts.world;
   def.registry = scene->parts.registry;
-  def.policy = (ssPolicy)stepping->policy;
-  def.solver = (ssSolver)stepping->solver;
-  def.quick_iterations = stepping->quick_iterations;
-  def.max_step_s = stepping->max_step_s;
-  def.reference_step_s = stepping->reference_step_s;
-  def.fixed_step_s = stepping->fixed_step_s;
-  def.max_steps_per_frame = stepping->max_steps_per_frame;
-  def.max_speed = SS_SCENE_MAX_SPEED_M_PER_S;
+  def.stepping = *stepping;
+  def.stepping.max_speed = fmin(stepping->max_speed > 0 ? stepping->max_speed : SS_MAX_SAFE_SPEED,
+                                SS_SCENE_MAX_SPEED_M_PER_S);
   def.collide = scene->desc->collide;
   def.collide_context = scene->state;
   def.step_done = scene_step_done;
@@ -188,7 +153,7 @@ ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssS
     return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_Create needs params, stepping and out",
                   params == NULL ? "params" : stepping == NULL ? "stepping" : "out");
   status = validate_params(desc, params);
-  if (status == SS_OK) status = validate_stepping(stepping, &params->spring);
+  if (status == SS_OK) status = ssValidateStepping(stepping);
   if (status != SS_OK) return status;
 
   ssSceneParams resolved = *params;

@@ -138,7 +138,7 @@ ssStatus ssFrequencyFromSpring(ssSpring spring, double mass, double* frequency_h
 
 const char* ssMappingName(ssMapping mapping) {
   switch (mapping) {
-    case SS_MAPPING_SPRING: return "spring";
+    case SS_MAPPING_IMPLICIT_EULER: return "implicit-euler";
     case SS_MAPPING_MATCHED: return "matched";
     case SS_MAPPING_EXACT: return "exact";
   }
@@ -149,9 +149,9 @@ ssStatus ssSoftnessFor(ssMapping mapping, ssSpring spring, double mass, double s
                        ssSoftness* out) {
   if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: ssSoftnessFor needs somewhere to write");
   switch (mapping) {
-    case SS_MAPPING_SPRING: return ssSoftnessFromSpring(spring, step_s, out);
+    case SS_MAPPING_IMPLICIT_EULER: return ssSoftnessFromSpring(spring, step_s, out);
     case SS_MAPPING_MATCHED: return ssMatchedSoftness(spring, mass, step_s, out);
     case SS_MAPPING_EXACT: return ssExactSoftness(spring, mass, step_s, previous_step_s, out);
   }
-  return ssFail(SS_ERROR_UNSUPPORTED, "mapping = %d: unknown (0 spring, 1 matched, 2 exact)", (int)mapping);
+  return ssFail(SS_ERROR_UNSUPPORTED, "mapping = %d: unknown (0 implicit-euler, 1 matched, 2 exact)", (int)mapping);
 }

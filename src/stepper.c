@@ -16,8 +16,6 @@
 
 /* Frame times are sums of floating-point parts: a frame of exactly 2·max_step_s must not become 3 substeps. */
 static const double kStepCountSlack = 1e-9;
-/* Naive's softness step when neither the program nor an adoption gave one (the lab's oscillator was tuned there). */
-static const double kDefaultReferenceStepS = 1.0 / 30.0;
 
 /* A body whose forces the stepper keeps over a frame and whose state it checks. */
 typedef struct KnownBody {
@@ -54,91 +52,27 @@ struct ssStepper {
 ssStepperDef ssDefaultStepperDef(void) {
   ssStepperDef def;
   memset(&def, 0, sizeof def);
-  def.policy = SS_POLICY_SPRING;
-  def.solver = SS_SOLVER_QUICK;
-  def.max_step_s = 1.0 / 60.0;
-  def.fixed_step_s = 1.0 / 60.0;
-  def.max_steps_per_frame = 8;
-  def.max_speed = 1e4;
-  def.max_angular_speed = 1e4;
+  def.stepping = ssDefaultStepping();
   return def;
-}
-
-const char* ssPolicyName(ssPolicy policy) {
-  switch (policy) {
-    case SS_POLICY_NAIVE: return "naive";
-    case SS_POLICY_SPRING: return "spring";
-    case SS_POLICY_MATCHED: return "matched";
-    case SS_POLICY_EXACT: return "exact";
-    case SS_POLICY_FIXED: return "fixed";
-  }
-  return NULL;
-}
-
-ssStatus ssPolicyParse(const char* name, ssPolicy* out) {
-  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the policy");
-  for (int policy = SS_POLICY_NAIVE; policy <= SS_POLICY_FIXED; ++policy) {
-    if (name != NULL && strcmp(name, ssPolicyName((ssPolicy)policy)) == 0) {
-      *out = (ssPolicy)policy;
-      return SS_OK;
-    }
-  }
-  return ssFail(SS_ERROR_PARSE, "policy \"%.64s\": unknown (naive, spring, matched, exact, fixed)",
-                name ? name : "(null)");
-}
-
-static ssStatus checkStepLength(const char* name, double value, int allow_zero) {
-  if (allow_zero && value == 0) return SS_OK;
-  return ssCheckStepLength(name, value);
-}
-
-static ssStatus checkSpeed(const char* name, const char* unit, double value) {
-  ssStatus status = ssCheckNonNegative(name, unit, value);
-  if (status == SS_OK && value > SS_MAX_SAFE_SPEED)
-    status = ssFail(SS_ERROR_OUT_OF_RANGE, "%s = %g %s: must be at most SS_MAX_SAFE_SPEED = %g (0 = that bound)",
-                    name, value, unit, SS_MAX_SAFE_SPEED);
-  return status;
 }
 
 static ssStatus validateDef(const ssStepperDef* def) {
   if (def == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "def = NULL: a definition is required");
   if (def->world == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "world = NULL: a world is required");
-  if (ssPolicyName(def->policy) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "policy = %d: unknown", (int)def->policy);
-  if (def->solver != SS_SOLVER_QUICK && def->solver != SS_SOLVER_STEP)
-    return ssFail(SS_ERROR_UNSUPPORTED, "solver = %d: unknown", (int)def->solver);
-  if (def->quick_iterations < 0)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "quick_iterations = %d: must not be negative (0 = the world's own)",
-                  def->quick_iterations);
-  if (def->max_steps_per_frame <= 0)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "max_steps_per_frame = %d: must be positive", def->max_steps_per_frame);
-  ssStatus status = checkStepLength("max_step_s", def->max_step_s, 0);
-  if (status == SS_OK) status = checkStepLength("reference_step_s", def->reference_step_s, 1);
-  if (status == SS_OK) status = checkStepLength("fixed_step_s", def->fixed_step_s, 0);
-  if (status == SS_OK) status = checkSpeed("max_speed", "m/s", def->max_speed);
-  if (status == SS_OK) status = checkSpeed("max_angular_speed", "rad/s", def->max_angular_speed);
-  return status;
-}
-
-static ssMapping policyMapping(ssPolicy policy) {
-  switch (policy) {
-    case SS_POLICY_MATCHED: return SS_MAPPING_MATCHED;
-    case SS_POLICY_EXACT: return SS_MAPPING_EXACT;
-    default: return SS_MAPPING_SPRING;
-  }
-}
-
-/* NAIVE's softness step: the program's, else the adoption's tuned step, else the lab's default. */
-static double referenceStep(const ssStepper* stepper) {
-  if (stepper->def.reference_step_s > 0) return stepper->def.reference_step_s;
-  double tuned_s = ssRegistry_TunedStep(stepper->def.registry);
-  return tuned_s > 0 ? tuned_s : kDefaultReferenceStepS;
+  return ssValidateStepping(&def->stepping);
 }
 
 static void describeNextStep(ssStepper* stepper) {
-  ssPolicy policy = stepper->def.policy;
-  double step_s = policy == SS_POLICY_FIXED ? stepper->def.fixed_step_s : stepper->def.max_step_s;
-  double softness_step_s = policy == SS_POLICY_NAIVE ? referenceStep(stepper) : step_s;
-  stepper->current = (ssStepInfo){policyMapping(policy), step_s, softness_step_s, stepper->previous_step_s, 0, 1};
+  const ssStepping* stepping = &stepper->def.stepping;
+  double step_s = stepping->cut == SS_CUT_FIXED ? stepping->fixed_step_s : stepping->max_step_s;
+  double softness_step_s = stepping->frozen_step_s > 0 ? stepping->frozen_step_s : step_s;
+  stepper->current = (ssStepInfo){stepping->mapping, step_s, softness_step_s, stepper->previous_step_s, 0, 1};
+}
+
+/* The speed guard: 0 stands for the bound ODE itself needs. */
+static void resolveSpeeds(ssStepping* stepping) {
+  if (stepping->max_speed == 0) stepping->max_speed = SS_MAX_SAFE_SPEED;
+  if (stepping->max_angular_speed == 0) stepping->max_angular_speed = SS_MAX_SAFE_SPEED;
 }
 
 ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
@@ -148,8 +82,7 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   ssStepper* stepper = calloc(1, sizeof *stepper);
   if (stepper == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating a stepper");
   stepper->def = *def;
-  if (stepper->def.max_speed == 0) stepper->def.max_speed = SS_MAX_SAFE_SPEED;
-  if (stepper->def.max_angular_speed == 0) stepper->def.max_angular_speed = SS_MAX_SAFE_SPEED;
+  resolveSpeeds(&stepper->def.stepping);
   stepper->contact_tuned = (ssSoftness){NAN, NAN};
   describeNextStep(stepper);
   *out = stepper;
@@ -239,15 +172,20 @@ void ssStepper_Reset(ssStepper* stepper) {
   describeNextStep(stepper);
 }
 
-ssStatus ssStepper_SetPolicy(ssStepper* stepper, ssPolicy policy) {
+ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping) {
   REQUIRE_STEPPER(stepper);
-  if (ssPolicyName(policy) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "policy = %d: unknown", (int)policy);
-  stepper->def.policy = policy;
+  ssStatus status = ssValidateStepping(stepping);
+  if (status != SS_OK) return status;
+  stepper->def.stepping = *stepping;
+  resolveSpeeds(&stepper->def.stepping);
   stepper->previous_step_s = 0;
   stepper->accumulator_s = 0;
+  stepper->short_frame_s = 0;
   describeNextStep(stepper);
   return SS_OK;
 }
+
+ssStepping ssStepper_Stepping(const ssStepper* stepper) { return stepper->def.stepping; }
 
 ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper) { return stepper->current; }
 
@@ -402,7 +340,7 @@ static ssStatus checkBody(const ssStepper* stepper, dBodyID body) {
                spin[2];
   double speed2 = velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2];
   double spin2 = spin[0] * spin[0] + spin[1] * spin[1] + spin[2] * spin[2];
-  double max_speed = stepper->def.max_speed, max_spin = stepper->def.max_angular_speed;
+  double max_speed = stepper->def.stepping.max_speed, max_spin = stepper->def.stepping.max_angular_speed;
   if (isfinite(sum) && speed2 <= max_speed * max_speed && spin2 <= max_spin * max_spin) return SS_OK;
   if (!isfinite(sum) || !isfinite(speed2) || !isfinite(spin2))
     return ssFail(SS_ERROR_BLOWUP, "body %p: position or velocity is not finite", (void*)body);
@@ -446,7 +384,8 @@ typedef struct FrameCut {
 /* Takes the frame's steps. Errors of Apply leave the world as the previous step left it; a failed check latches. */
 static ssStatus takeSteps(ssStepper* stepper, const FrameCut* cut, double frame_s, ssFrameReport* report) {
   const ssStepperDef* def = &stepper->def;
-  if (def->quick_iterations > 0) dWorldSetQuickStepNumIterations(def->world, def->quick_iterations);
+  const ssStepping* stepping = &def->stepping;
+  if (stepping->quick_iterations > 0) dWorldSetQuickStepNumIterations(def->world, stepping->quick_iterations);
   for (int i = 0; i < cut->steps; ++i) {
     double previous_step_s = cut->use_history ? stepper->previous_step_s : 0;
     putForces(stepper, frame_s, cut->steps, cut->step_s);
@@ -457,7 +396,7 @@ static ssStatus takeSteps(ssStepper* stepper, const FrameCut* cut, double frame_
     stepper->current = (ssStepInfo){cut->mapping, cut->step_s, cut->softness_step_s, previous_step_s, i, cut->steps};
     if (def->before_step) def->before_step(def->before_step_context, stepper);
     if (def->collide) def->collide(def->collide_context, stepper);
-    int stepped = def->solver == SS_SOLVER_STEP ? dWorldStep(def->world, cut->step_s)
+    int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, cut->step_s)
                                                 : dWorldQuickStep(def->world, cut->step_s);
     if (def->contact_group) dJointGroupEmpty(def->contact_group);
     if (!stepped) return latch(stepper, ssFail(SS_ERROR_OUT_OF_MEMORY, "ODE ran out of memory in its step"));
@@ -477,9 +416,16 @@ static ssStatus takeSteps(ssStepper* stepper, const FrameCut* cut, double frame_
   return SS_OK;
 }
 
-/* NAIVE: one step of the whole frame, softness frozen at the reference step. Others: n equal substeps no longer
- * than max_step_s. A frame too short to step waits for the next one. */
+/* The softness step of a cut: the step's own length, or the frozen one. */
+static double softnessStep(const ssStepper* stepper, double step_s) {
+  double frozen_s = stepper->def.stepping.frozen_step_s;
+  return frozen_s > 0 ? frozen_s : step_s;
+}
+
+/* WHOLE_FRAME: one step of the frame. SUBSTEPS: n equal substeps no longer than max_step_s. A frame too short to
+ * step waits for the next one. */
 static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* report) {
+  const ssStepping* stepping = &stepper->def.stepping;
   double total_s = frame_s + stepper->short_frame_s;
   if (total_s < SS_MIN_STEP_S) {
     stepper->short_frame_s = total_s;
@@ -487,19 +433,19 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
     carryForces(stepper, frame_s);
     return SS_OK;
   }
-  FrameCut cut = {1, total_s, total_s, policyMapping(stepper->def.policy), 0, 0};
-  if (stepper->def.policy == SS_POLICY_NAIVE) {
-    cut.softness_step_s = referenceStep(stepper);
-  } else {
-    double count = ceil(total_s / stepper->def.max_step_s - kStepCountSlack);
+  FrameCut cut = {1, total_s, 0, stepping->mapping, 0, 0};
+  if (stepping->cut == SS_CUT_SUBSTEPS) {
+    double count = ceil(total_s / stepping->max_step_s - kStepCountSlack);
     if (count > (double)INT32_MAX) /* max_step_s >= SS_MIN_STEP_S and frame_s <= SS_MAX_FRAME_S: never */
       return ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: more than %d substeps of max_step_s = %g s", frame_s,
-                    INT32_MAX, stepper->def.max_step_s);
+                    INT32_MAX, stepping->max_step_s);
     cut.steps = count < 1 ? 1 : (int)count;
-    cut.step_s = cut.softness_step_s = total_s / cut.steps;
-    cut.apply_every_step = cut.mapping != SS_MAPPING_SPRING;
-    cut.use_history = cut.mapping == SS_MAPPING_EXACT;
+    cut.step_s = total_s / cut.steps;
   }
+  cut.softness_step_s = softnessStep(stepper, cut.step_s);
+  /* implicit Euler depends on h alone, equal for all the frame's steps; the accurate mappings on the bodies too */
+  cut.apply_every_step = cut.mapping != SS_MAPPING_IMPLICIT_EULER;
+  cut.use_history = cut.mapping == SS_MAPPING_EXACT && stepping->frozen_step_s == 0;
   stepper->short_frame_s = 0;
   ssStatus status = takeSteps(stepper, &cut, frame_s, report);
   clearCarried(stepper);
@@ -508,16 +454,19 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
 
 /* FIXED: constant steps from an accumulator, capped against the spiral of death. */
 static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* report) {
-  double step_s = stepper->def.fixed_step_s;
+  const ssStepping* stepping = &stepper->def.stepping;
+  double step_s = stepping->fixed_step_s;
   double accumulator_s = stepper->accumulator_s + frame_s;
   double due = floor(accumulator_s / step_s + kStepCountSlack);
-  int cap = stepper->def.max_steps_per_frame;
+  int cap = stepping->max_steps_per_frame;
   if (due > cap) {
     report->dropped_s = (due - cap) * step_s;
     accumulator_s -= report->dropped_s;
     due = cap;
   }
-  FrameCut cut = {(int)due, step_s, step_s, SS_MAPPING_SPRING, 0, 0};
+  FrameCut cut = {(int)due, step_s, softnessStep(stepper, step_s), stepping->mapping,
+                  stepping->mapping != SS_MAPPING_IMPLICIT_EULER,
+                  stepping->mapping == SS_MAPPING_EXACT && stepping->frozen_step_s == 0};
   ssStatus status = SS_OK;
   if (cut.steps == 0) {
     carryForces(stepper, frame_s);
@@ -548,8 +497,8 @@ ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* repor
   if ((status = refreshKnown(stepper)) != SS_OK) return status;
   if ((status = captureForces(stepper)) != SS_OK) return status;
   stepper->report = report;
-  status = stepper->def.policy == SS_POLICY_FIXED ? stepFixed(stepper, frame_s, report)
-                                                   : stepFrame(stepper, frame_s, report);
+  status = stepper->def.stepping.cut == SS_CUT_FIXED ? stepFixed(stepper, frame_s, report)
+                                                      : stepFrame(stepper, frame_s, report);
   stepper->report = NULL;
   return status;
 }

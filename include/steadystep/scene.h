@@ -22,6 +22,7 @@
 #include "steadystep/limits.h"
 #include "steadystep/spring.h"
 #include "steadystep/status.h"
+#include "steadystep/stepping.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -55,17 +56,6 @@ typedef struct ssSceneInfo {
   const char* quantity_units[SS_MAX_QUANTITIES];
 } ssSceneInfo;
 
-/** How scene steps are taken: the stepper's policy and limits (see stepper.h for each). */
-typedef struct ssStepping {
-  int policy;              /* an ssPolicy value */
-  int solver;              /* an ssSolver value */
-  int quick_iterations;    /* default 20 */
-  double max_step_s;       /* default 1/60; the three step lengths in [SS_MIN_STEP_S, SS_MAX_STEP_S] (limits.h) */
-  double reference_step_s; /* default 1/30 */
-  double fixed_step_s;     /* default 1/60 */
-  int max_steps_per_frame; /* default 8 */
-} ssStepping;
-
 /** The number of scenes, and each scene's description (NULL past the end). */
 int ssSceneCount(void);
 const ssSceneInfo* ssSceneInfoAt(int index);
@@ -76,12 +66,17 @@ const ssSceneInfo* ssSceneFind(const char* name);
  *  SS_ERROR_OUT_OF_RANGE for name = NULL or out = NULL. */
 ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
 
-/** The stepper's defaults as an ssStepping. */
-ssStepping ssDefaultStepping(void);
+/** The naive policy's reference step in the lab (s): the scenes' softness frozen as if tuned at 30 fps. */
+#define SS_LAB_NAIVE_REFERENCE_STEP_S (1.0 / 30.0)
 
-/** The stepping of a reference run: policy spring with substeps of at most step_s (s, > 0; e.g. 1/1000), fixed_step_s
- *  also step_s, the other fields as ssDefaultStepping. Run it under the profile "fixed:N" with N = 1/step_s (e.g.
- *  "fixed:1000") so that every frame is one step. step_s is not checked here: ssScene_Create refuses a bad one. */
+/** The stepping of a policy in the lab: ssDefaultStepping() with the policy's cut and mapping (stepping.h), naive
+ *  frozen at SS_LAB_NAIVE_REFERENCE_STEP_S. Errors: those of ssSteppingForPolicy. */
+ssStatus ssLabStepping(const char* policy, ssStepping* out);
+
+/** The stepping of a reference run: implicit Euler with substeps of at most step_s (s, in the step range; e.g.
+ *  1/1000), fixed_step_s also step_s, the other fields as ssDefaultStepping. Run it under the profile "fixed:N"
+ *  with N = 1/step_s (e.g. "fixed:1000") so that every frame is one step. step_s is not checked here:
+ *  ssScene_Create refuses a bad one. */
 ssStepping ssReferenceStepping(double step_s);
 
 typedef struct ssScene ssScene;

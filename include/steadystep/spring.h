@@ -6,7 +6,7 @@
  * N·m·s/rad for N·s/m and kg·m² for kg.
  *
  * Three mappings from a spring to softness at step h:
- *  - SS_MAPPING_SPRING, the article's: erp = hk/(hk+c), cfm = 1/(hk+c). ODE's step then solves exactly the
+ *  - SS_MAPPING_IMPLICIT_EULER, the article's: erp = hk/(hk+c), cfm = 1/(hk+c). ODE's step then solves exactly the
  *    implicit-Euler step of the spring, m(v'-v)/h = -k(x + h v') - c v', x' = x + h v', at any h: consistent
  *    stiffness and damping at every frame rate. Implicit Euler adds numerical damping of about h·k/2 per unit mass.
  *  - SS_MAPPING_MATCHED: for a row of effective mass m, the erp and cfm whose discrete poles equal exp(s·h) of the
@@ -42,7 +42,7 @@ typedef struct ssSoftness {
 
 /** How a spring becomes softness at a step. */
 typedef enum ssMapping {
-  SS_MAPPING_SPRING = 0,  /* the article's mapping: implicit Euler of the spring */
+  SS_MAPPING_IMPLICIT_EULER = 0,  /* the article's mapping: implicit Euler of the spring */
   SS_MAPPING_MATCHED = 1, /* exact poles at a constant step; needs the row's effective mass and c > 0 */
   SS_MAPPING_EXACT = 2,   /* exact samples under varying steps; also needs the previous step length */
 } ssMapping;
@@ -94,13 +94,13 @@ ssStatus ssMatchedSoftness(ssSpring spring, double mass, double step_s, ssSoftne
  *  long one on a lightly damped spring): the caller may fall back to the matched mapping for that step. */
 ssStatus ssExactSoftness(ssSpring spring, double mass, double step_s, double previous_step_s, ssSoftness* out);
 
-/** One entry point for all mappings: mass is ignored by SS_MAPPING_SPRING, previous_step_s by all but EXACT.
+/** One entry point for all mappings: mass is ignored by SS_MAPPING_IMPLICIT_EULER, previous_step_s by all but EXACT.
  *  Errors (out untouched): those of the chosen mapping, SS_ERROR_UNSUPPORTED for an unknown mapping value,
  *  SS_ERROR_OUT_OF_RANGE for out = NULL. */
 ssStatus ssSoftnessFor(ssMapping mapping, ssSpring spring, double mass, double step_s, double previous_step_s,
                        ssSoftness* out);
 
-/** The mapping's name: "spring", "matched", "exact"; NULL for an unknown value. */
+/** The mapping's name: "implicit-euler", "matched", "exact"; NULL for an unknown value. */
 const char* ssMappingName(ssMapping mapping);
 
 /** Checks a spring: finite, k >= 0, c >= 0, not both 0. Errors as ssSoftnessFromSpring. */

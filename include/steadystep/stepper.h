@@ -6,7 +6,7 @@
  * steps with the program's own solver settings, the contact group is emptied and the known bodies are checked.
  *
  *     ssStepperDef def = ssDefaultStepperDef();
- *     def.world = world; def.registry = registry; def.max_step_s = 1.0 / 60.0;
+ *     def.world = world; def.registry = registry; def.stepping.max_step_s = 1.0 / 60.0;
  *     def.collide = collide; def.contact_group = contacts;   // collide calls dSpaceCollide(space, stepper, near)
  *     ssStepper* stepper; ssStepper_Create(&def, &stepper);
  *     for (;;) {
@@ -37,26 +37,11 @@
 
 #include "steadystep/limits.h"
 #include "steadystep/registry.h"
+#include "steadystep/stepping.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/** What a frame does with its time. */
-typedef enum ssPolicy {
-  SS_POLICY_NAIVE = 0,   /* one step of dt; softness frozen at its value for reference_step_s: the problem itself */
-  SS_POLICY_SPRING = 1,  /* substeps <= max_step_s, the article's mapping at each substep's h */
-  SS_POLICY_MATCHED = 2, /* substeps <= max_step_s, the matched mapping: exact poles at each h */
-  SS_POLICY_EXACT = 3,   /* substeps <= max_step_s, the exact mapping: exact samples under varying h */
-  SS_POLICY_FIXED = 4,   /* constant steps of fixed_step_s from an accumulator ("fix your timestep"), spring
-                          * mapping at that step, at most max_steps_per_frame a frame, with an interpolation factor */
-} ssPolicy;
-
-/** Which ODE solver a step calls. */
-typedef enum ssSolver {
-  SS_SOLVER_QUICK = 0, /* dWorldQuickStep, iterative: the world's own iteration count and SOR w */
-  SS_SOLVER_STEP = 1,  /* dWorldStep, the direct (big matrix) solver */
-} ssSolver;
 
 typedef struct ssStepper ssStepper;
 
@@ -64,7 +49,7 @@ typedef struct ssStepper ssStepper;
 typedef struct ssStepInfo {
   ssMapping mapping;      /* the mapping this step's softness is written with */
   double step_s;          /* the length of the physics step about to be taken (s) */
-  double softness_step_s; /* the step length the softness is for (s): step_s, except SS_POLICY_NAIVE's reference */
+  double softness_step_s; /* the step length the softness is for (s): step_s, or stepping.frozen_step_s */
   double previous_step_s; /* the step before, for SS_MAPPING_EXACT (s); 0 when there is no usable history */
   int index;              /* 0-based index of this step within the frame */
   int count;              /* steps this frame takes */
@@ -80,21 +65,7 @@ typedef void ssStepDoneFn(void* context, double step_s);
 typedef struct ssStepperDef {
   dWorldID world;               /* required */
   ssRegistry* registry;         /* may be NULL: nothing soft is rewritten, only watched bodies are known */
-  ssPolicy policy;              /* default SS_POLICY_SPRING */
-  ssSolver solver;              /* default SS_SOLVER_QUICK */
-  /* dWorldQuickStep iterations written into the world before each frame, > 0; default 0: the world's own setting
-   * (dWorldSetQuickStepNumIterations) is left as the program set it. The stepper writes no other solver setting. */
-  int quick_iterations;
-  double max_step_s;            /* the longest substep (s), > 0; default 1/60 */
-  double reference_step_s;      /* NAIVE: the step its softness was tuned at (s), > 0; default 1/30 */
-  double fixed_step_s;          /* FIXED: the constant step (s), > 0; default 1/60 */
-  int max_steps_per_frame;      /* FIXED: cap against the spiral of death (later time is dropped), > 0; default 8 */
-  /* A known body faster than this after a step is a runaway (m/s, rad/s), in [0, SS_MAX_SAFE_SPEED]. Default
-   * 1e4 m/s and 1e4 rad/s: far above anything a game moves, and a blow-up is stopped long before ODE 0.16 would
-   * abort the process (a non-finite rotation fails an assertion inside the next step). Raise them for faster
-   * bodies; 0 leaves only the guard ODE itself needs, SS_MAX_SAFE_SPEED. */
-  double max_speed;
-  double max_angular_speed;
+  ssStepping stepping;          /* how frames become steps (stepping.h); default ssDefaultStepping() */
   /* Before each step, after the frame's forces were put back and the registry applied: add forces that depend on
    * the state (PD controllers, drag, buoyancy). Forces that are constant over a frame can simply be added before
    * ssStepper_Step. May be NULL. */
@@ -124,7 +95,7 @@ typedef struct ssFrameReport {
   dBodyID failed_body;        /* the body that blew up or ran too fast, else 0 */
 } ssFrameReport;
 
-/** The longest frame ssStepper_Step takes (s): SS_MAX_STEP_S (limits.h), since SS_POLICY_NAIVE steps it whole.
+/** The longest frame ssStepper_Step takes (s): SS_MAX_STEP_S (limits.h), since SS_CUT_WHOLE_FRAME steps it whole.
  *  A frame shorter than SS_MIN_STEP_S is carried over to the next one, never stepped. */
 #define SS_MAX_FRAME_S SS_MAX_STEP_S
 
@@ -133,7 +104,7 @@ ssStepperDef ssDefaultStepperDef(void);
 
 /** Makes a stepper. The registry and the world are borrowed: they must outlive it.
  *  Errors: SS_ERROR_OUT_OF_RANGE (def or out NULL, no world, or a field outside its range, named),
- *  SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED (unknown policy or solver), SS_ERROR_OUT_OF_MEMORY. */
+ *  SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED (those of ssValidateStepping), SS_ERROR_OUT_OF_MEMORY. */
 ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out);
 
 /** Destroys the stepper. NULL is a no-op. */
@@ -142,7 +113,7 @@ void ssStepper_Destroy(ssStepper* stepper);
 /** Advances the world by one frame of frame_s seconds (0 <= frame_s <= SS_MAX_FRAME_S; 0 does nothing). report may
  *  be NULL.
  *  Forces and torques that the program added to known bodies before this call act for the whole frame: they are
- *  put back before every substep (ODE clears them after each step), and under SS_POLICY_FIXED they are scaled so
+ *  put back before every substep (ODE clears them after each step), and under SS_CUT_FIXED they are scaled so
  *  that the frame's steps deliver the momentum F·frame_s (carried to the next frame when this one takes no step).
  *  Errors, with the world left as it was: SS_ERROR_OUT_OF_RANGE (stepper NULL, frame_s out of range, a force or
  *  torque on a known body beyond SS_MAX_FORCE_N, named with its body), SS_ERROR_NOT_FINITE (frame_s, a force);
@@ -192,20 +163,16 @@ ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body);
  *  Errors, with nothing destroyed: SS_ERROR_OUT_OF_RANGE (stepper or joint NULL). */
 ssStatus ssStepper_DestroyJoint(ssStepper* stepper, dJointID joint);
 
-/** Forgets the previous step length, so the next step of SS_POLICY_EXACT maps the bodies' true velocities. Call it
+/** Forgets the previous step length, so the next step of SS_MAPPING_EXACT maps the bodies' true velocities. Call it
  *  after teleporting a body or setting its velocity. NULL is a no-op. */
 void ssStepper_ResetHistory(ssStepper* stepper);
 
-/** Changes the policy between frames (resets the history and the FIXED accumulator).
- *  Errors: SS_ERROR_OUT_OF_RANGE for a NULL stepper, SS_ERROR_UNSUPPORTED for an unknown policy. */
-ssStatus ssStepper_SetPolicy(ssStepper* stepper, ssPolicy policy);
+/** Changes how frames become steps, between frames (resets the history and the FIXED accumulator).
+ *  Errors, with nothing changed: those of ssValidateStepping; SS_ERROR_OUT_OF_RANGE for a NULL stepper. */
+ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping);
 
-/** The policy's name: "naive", "spring", "matched", "exact", "fixed"; NULL for an unknown value. */
-const char* ssPolicyName(ssPolicy policy);
-
-/** Parses a policy name as ssPolicyName gives it. Errors: SS_ERROR_PARSE naming the text; SS_ERROR_OUT_OF_RANGE
- *  for a NULL out. */
-ssStatus ssPolicyParse(const char* name, ssPolicy* out);
+/** The stepper's stepping. stepper must not be NULL. */
+ssStepping ssStepper_Stepping(const ssStepper* stepper);
 
 #ifdef __cplusplus
 }

@@ -3,8 +3,8 @@
 The headers are the one source of truth for every struct and function: they are read from the wheel's
 ``_native/include`` directory at import time, stripped of what cffi's parser does not take (preprocessor lines,
 ``extern "C"`` braces) and handed to ``ffi.cdef``. Nothing is re-typed here, so a field added in C reaches Python
-with the next build. ``registry.h`` and ``stepper.h`` need ODE's types and are not read whole; only the two enums
-(policy, solver) and the policy name functions are taken from ``stepper.h``, again verbatim.
+with the next build. The headers read here (up to ``scene.h``) use no ODE types; ``stepping.h`` holds the stepper's
+settings, so the lab and Python share the one struct and its validator.
 """
 
 from __future__ import annotations
@@ -19,10 +19,7 @@ INCLUDE_DIR = _HERE / "include" / "steadystep"
 LIBRARY_PATH = _HERE / "libsteadystep.so"
 
 # The headers cffi reads whole, in dependency order.
-_WHOLE_HEADERS = ("status.h", "spring.h", "profile.h", "scene.h")
-# Declarations taken verbatim from stepper.h (the rest of it needs ODE's types).
-_STEPPER_ENUMS = ("ssPolicy", "ssSolver")
-_STEPPER_FUNCTIONS = ("ssPolicyName", "ssPolicyParse")
+_WHOLE_HEADERS = ("status.h", "spring.h", "stepping.h", "profile.h", "scene.h")
 
 _INTEGER_DEFINE = re.compile(r"^\s*#\s*define\s+(\w+)\s+(\d+)\s*$")
 
@@ -49,30 +46,8 @@ def _declarations(text: str) -> str:
     return "\n".join(kept)
 
 
-def _stepper_declarations(text: str) -> str:
-    text = _strip_comments(text)
-    parts = []
-    for name in _STEPPER_ENUMS:
-        match = re.search(r"typedef\s+enum\s+" + name + r"\s*\{.*?\}\s*" + name + r"\s*;", text, flags=re.S)
-        if not match:
-            raise ImportError(f"stepper.h: enum {name} not found in {INCLUDE_DIR}")
-        parts.append(match.group(0))
-    for name in _STEPPER_FUNCTIONS:
-        match = re.search(r"[^;{}]*\b" + name + r"\s*\([^;]*\)\s*;", text, flags=re.S)
-        if not match:
-            raise ImportError(f"stepper.h: function {name} not found in {INCLUDE_DIR}")
-        parts.append(match.group(0).strip())
-    return "\n".join(parts)
-
-
 def _cdef_source() -> str:
-    sources = []
-    for header in _WHOLE_HEADERS:
-        sources.append(_declarations((INCLUDE_DIR / header).read_text()))
-        if header == "spring.h":
-            # scene.h's ssStepping holds policy and solver as ints; the enums come right after spring.h.
-            sources.append(_stepper_declarations((INCLUDE_DIR / "stepper.h").read_text()))
-    return "\n".join(sources)
+    return "\n".join(_declarations((INCLUDE_DIR / header).read_text()) for header in _WHOLE_HEADERS)
 
 
 ffi = cffi.FFI()

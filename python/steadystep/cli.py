@@ -126,7 +126,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("scene", metavar="SCENE", help="oscillator, buggy, drop, chain or pile")
     run.add_argument("--profile", required=True, metavar="SPEC",
                      help="fixed:FPS, uniform:MIN:MAX, jitter:FPS:MS, hitch:FPS:EVERY:S, vsync:A:B or trace:FILE")
-    run.add_argument("--policy", required=True, metavar="P", help="naive, spring, matched, exact or fixed")
+    from steadystep.runs import policy_names  # the library's names: no second list here
+    run.add_argument("--policy", required=True, metavar="P", help=", ".join(policy_names()))
     run.add_argument("--duration", type=_positive_float, default=5.0, metavar="S",
                      help=f"seconds (default 5), at most {MAX_RUN_STEPS:.0e} steps of --max-step")
     run.add_argument("--seed", type=_seed, default=1, metavar="N", help="profile seed (default 1)")
@@ -141,7 +142,7 @@ def build_parser() -> argparse.ArgumentParser:
                                 "range widened by that range on both sides. A trial at --low may take at most "
                                 f"{MAX_RUN_STEPS:.0e} steps.")
     probe.add_argument("scene", metavar="SCENE", help="oscillator, buggy, drop, chain or pile")
-    probe.add_argument("--policies", nargs="+", metavar="POLICY", default=["naive", "spring", "matched", "exact"],
+    probe.add_argument("--policies", nargs="+", metavar="POLICY", default=["naive", "implicit-euler", "matched", "exact"],
                        help="default: naive spring matched exact")
     probe.add_argument("--duration", type=_measured_duration, default=3.0, metavar="S",
                        help=f"seconds per trial, at least {MIN_MEASURED_DURATION_S:g} (default 3)")
@@ -268,7 +269,7 @@ def _probe(args, argv) -> int:
 
     runs.scene_info(args.scene)
     for policy in args.policies:
-        runs.policy_value(policy)
+        runs.make_stepping(policy)
     results = [probe.largest_stable_step(args.scene, policy, args.duration, args.low, args.high)
                for policy in args.policies]
     if args.json:

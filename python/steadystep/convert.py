@@ -12,7 +12,7 @@ from typing import NamedTuple
 
 from steadystep._native import SteadystepError, check, ffi, lib, number, shown
 
-MAPPINGS = {"spring": lib.SS_MAPPING_SPRING, "matched": lib.SS_MAPPING_MATCHED, "exact": lib.SS_MAPPING_EXACT}
+MAPPINGS = {"implicit-euler": lib.SS_MAPPING_IMPLICIT_EULER, "matched": lib.SS_MAPPING_MATCHED, "exact": lib.SS_MAPPING_EXACT}
 
 
 class Spring(NamedTuple):
@@ -115,7 +115,7 @@ def exact_softness(spring: Spring | tuple[float, float], mass: float, step_s: fl
 
 def softness_for(mapping: str, spring: Spring | tuple[float, float], mass: float, step_s: float,
                  previous_step_s: float = 0.0) -> Softness:
-    """Any mapping by name ("spring", "matched", "exact")."""
+    """Any mapping by name ("implicit-euler", "matched", "exact")."""
     if not isinstance(mapping, str) or mapping not in MAPPINGS:
         raise SteadystepError("unsupported", f"mapping = {shown(mapping)}: must be one of {', '.join(MAPPINGS)}")
     return _mapped(f"softness_for[{mapping}]", lambda *args: lib.ssSoftnessFor(MAPPINGS[mapping], *args), spring,

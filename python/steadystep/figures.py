@@ -23,7 +23,7 @@ from steadystep.profiles import frame_times  # noqa: E402
 
 POLICY_COLORS = {
     "naive": "#e6550d",    # orange
-    "spring": "#756bb1",   # purple
+    "implicit-euler": "#756bb1",   # purple
     "matched": "#8c6d31",  # brown
     "exact": "#17becf",    # cyan
     "fixed": "#636363",    # grey
@@ -61,7 +61,7 @@ def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> lis
     """The article's figure, twice: from its equations 4 and 5, and from real ODE with the article's method.
 
     Both panels use the oscillator scene's spring (its defaults: the article's kind of spring) released at rest from
-    x0. Panel 2 runs ODE with policy spring and max_step_s = 1/15 s, so that every frame is one step, as in the
+    x0. Panel 2 runs ODE with policy implicit-euler and max_step_s = 1/15 s, so that every frame is one step, as in the
     equations. The variable frames come from the C profile uniform:15:45 with the given seed (in [0, 2^64)).
     duration_s (s) is at least MIN_MEASURED_DURATION_S (0.1 s) and within the bound of limits.py for 15-45 fps
     frames (about 22000 s). Raises SteadystepError naming the value, before anything is drawn.
@@ -72,7 +72,7 @@ def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> lis
                               f"{MIN_MEASURED_DURATION_S:g} s")
     one_step_per_frame = {"max_step_s": 1.0 / 15.0}
     for profile in ("fixed:30", "uniform:15:45"):
-        runs.check_run_size(profile, duration_s, seed, runs.make_stepping("spring", **one_step_per_frame))
+        runs.check_run_size(profile, duration_s, seed, runs.make_stepping("implicit-euler", **one_step_per_frame))
     params = runs.default_params("oscillator")
     osc = article.Oscillator(params["mass"], params["spring"]["stiffness"], params["spring"]["damping"])
     x0 = params["x0"]
@@ -103,7 +103,7 @@ def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> lis
 
     for profile, color, label in (("fixed:30", FIXED_30_COLOR, "fixed 30 fps"),
                                   ("uniform:15:45", VARIABLE_COLOR, "variable 15-45 fps, uniform")):
-        result = runs.run("oscillator", profile, "spring", duration_s, seed=seed, stepping=one_step_per_frame)
+        result = runs.run("oscillator", profile, "implicit-euler", duration_s, seed=seed, stepping=one_step_per_frame)
         t = np.concatenate(([0.0], result.times))
         x = np.concatenate(([x0], result.quantities["x"]))
         bottom.plot(t, x, color=color, lw=1.4, marker="o", ms=2.2, label=f"ODE,\n{label}")
@@ -144,7 +144,7 @@ def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_d
                 continue
             label = policy + (" (blew up)" if result.blew_up else "")
             # The article's method drawn on top: it is what the figure is about.
-            on_top = policy == "spring"
+            on_top = policy == "implicit-euler"
             ax.plot(result.times, result.quantities[quantity], color=policy_color(policy), lw=1.5 if on_top else 1.1,
                     zorder=3 if on_top else 2, label=label)
         ax.set_title(_label(profile), loc="left", fontsize=10)

@@ -23,8 +23,8 @@ from steadystep.files import atomic_write_text
 from steadystep.limits import MIN_MEASURED_DURATION_S
 from steadystep.profiles import DEFAULT_PROFILES, Profile, seed_value
 
-DEFAULT_POLICIES = ("naive", "spring", "fixed")
-OSCILLATOR_POLICIES = ("naive", "spring", "matched", "exact", "fixed")
+DEFAULT_POLICIES = ("naive", "implicit-euler", "fixed")
+OSCILLATOR_POLICIES = ("naive", "implicit-euler", "matched", "exact", "fixed")
 SIDE_BY_SIDE_PROFILES = ("fixed:30", "uniform:15:45")
 # Quantities that are settings, not motion: they are plotted by `run`, never measured against a reference.
 # The pile is there for timing; the report keeps it small so that the whole report takes a few minutes.
@@ -85,7 +85,7 @@ def validate(scenes, profiles, policies, duration_s: float = 5.0, seed: int = 1)
     for profile in profiles:
         Profile(profile, seed)
     for policy in policies or ():
-        runs.policy_value(policy)
+        runs.make_stepping(policy)
     duration_s = number("duration_s", duration_s, "s")
     if not duration_s >= MIN_MEASURED_DURATION_S or not math.isfinite(duration_s):
         raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: must be finite and at least "
@@ -313,7 +313,7 @@ def _as_html(report: Report, command: str, article_paths: list[Path]) -> str:
     if pngs:
         parts += ["<h2>The article's figure</h2>",
                   "<p>Top: the article's equations 4 and 5. Bottom: real ODE with the article's mapping, one step per "
-                  "frame (policy spring, max_step_s = 1/15 s).</p>", _embed(pngs[0])]
+                  "frame (policy implicit-euler, max_step_s = 1/15 s).</p>", _embed(pngs[0])]
     if report.side_by_side:
         parts += ["<h2>Oscillator against the exact solution</h2>", _side_by_side_table(report)]
     for scene in report.scenes:
@@ -331,13 +331,13 @@ def _summary(report: Report) -> str:
         quantity = runs.motion_quantities(scene)[0]
         spreads = report.spreads[scene]
         cells = [html.escape(scene), html.escape(quantity)]
-        for policy in ("naive", "spring", "fixed"):
+        for policy in ("naive", "implicit-euler", "fixed"):
             cells.append(_number(spreads[policy][quantity]) if policy in spreads else "-")
-        naive, spring = spreads.get("naive", {}).get(quantity), spreads.get("spring", {}).get(quantity)
+        naive, spring = spreads.get("naive", {}).get(quantity), spreads.get("implicit-euler", {}).get(quantity)
         cells.append(_number(spring / naive) if naive and spring is not None and math.isfinite(naive) else "-")
         rows.append(cells)
     return "<h2>Summary: spread across profiles</h2>" + _table(
-        ["scene", "quantity", "naive", "spring", "fixed", "spring / naive"], rows)
+        ["scene", "quantity", "naive", "implicit-euler", "fixed", "implicit-euler / naive"], rows)
 
 
 def _side_by_side_table(report: Report) -> str:

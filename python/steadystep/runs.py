@@ -21,18 +21,9 @@ REFERENCE_PROFILE = "fixed:1000"
 
 
 def policy_names() -> list[str]:
-    """The stepper's policies by name, in enum order: naive, spring, matched, exact, fixed."""
-    names = []
-    while (name := text(lib.ssPolicyName(len(names)))) is not None:
-        names.append(name)
-    return names
-
-
-def policy_value(name: str) -> int:
-    """The ssPolicy value of a policy name. Raises SteadystepError ("parse error") naming it."""
-    out = ffi.new("ssPolicy*")
-    check(lib.ssPolicyParse(c_string("policy", name), out))
-    return int(out[0])
+    """The lab's policies by name, as the library lists them (stepping.h): naive, implicit-euler, matched, exact,
+    fixed, fixed-matched, fixed-exact."""
+    return [text(lib.ssPolicyNameAt(i)) for i in range(lib.ssPolicyCount())]
 
 
 @dataclass(frozen=True)
@@ -92,7 +83,7 @@ def default_params(scene: str) -> dict:
 
 
 def default_stepping() -> dict:
-    """The stepper's defaults (ssStepping as a dict: policy, solver, max_step_s, ...)."""
+    """The stepper's defaults (ssStepping as a dict: cut, mapping, frozen_step_s, solver, max_step_s, ...)."""
     return _as_dict(lib.ssDefaultStepping())
 
 
@@ -128,16 +119,16 @@ def _field_value(name: str, default, value):
 
 
 def make_stepping(policy: str, **changes) -> dict:
-    """The default stepping with the named policy and any field changed (max_step_s=..., solver=...)."""
-    return _merge(default_stepping(), {"policy": policy_value(policy), **changes}, "stepping")
+    """The lab's stepping of the named policy (ssLabStepping: its cut and mapping, naive frozen at 1/30 s) with any
+    field changed (max_step_s=..., solver=...). Raises SteadystepError ("parse error") naming an unknown policy."""
+    out = ffi.new("ssStepping*")
+    check(lib.ssLabStepping(c_string("policy", policy), out))
+    return _merge(_as_dict(out[0]), changes, "stepping")
 
 
 def reference_stepping() -> dict:
-    """How the reference run steps: the article's mapping at a fixed 1/1000 s, one step a frame."""
-    try:
-        return _as_dict(lib.ssReferenceStepping(REFERENCE_STEP_S))
-    except AttributeError:  # a library built before scene.h had ssReferenceStepping
-        return make_stepping("spring", max_step_s=REFERENCE_STEP_S, fixed_step_s=REFERENCE_STEP_S)
+    """How the reference run steps: implicit Euler at a fixed 1/1000 s, one step a frame."""
+    return _as_dict(lib.ssReferenceStepping(REFERENCE_STEP_S))
 
 
 @dataclass
@@ -177,14 +168,14 @@ class RunResult:
 def check_run_size(profile: str, duration_s: float, seed: int, stepping: dict) -> None:
     """Refuses, before anything runs, a run larger than the bound of limits.py: duration_s (s) must be finite and
     positive, duration_s / step_s at most MAX_RUN_STEPS (step_s: stepping's fixed_step_s under policy fixed, its
-    max_step_s otherwise), and the profile may hand out at most MAX_RUN_STEPS frames within duration_s.
+    max_step_s otherwise; under the fixed cut, its fixed_step_s), and the profile may hand out at most MAX_RUN_STEPS frames within duration_s.
     Raises SteadystepError naming the value."""
     duration_s = number("duration_s", duration_s, "s")
     if not math.isfinite(duration_s):
         raise SteadystepError("not finite", f"duration_s = {duration_s} s: must be a finite number of seconds")
     if duration_s <= 0:
         raise SteadystepError("out of range", f"duration_s = {duration_s} s: must be positive")
-    fixed = stepping.get("policy") == lib.SS_POLICY_FIXED
+    fixed = stepping.get("cut") == lib.SS_CUT_FIXED
     step_name = "fixed_step_s" if fixed else "max_step_s"
     step_s = number(f"stepping.{step_name}", stepping.get(step_name, math.nan), "s")
     if math.isfinite(step_s) and step_s > 0 and duration_s / step_s > MAX_RUN_STEPS:
@@ -254,13 +245,13 @@ def _collect(handle, scene, profile, policy, seed, duration_s, params, stepping)
 
 def reference_run(scene: str, duration_s: float = 5.0, params: dict | None = None) -> RunResult:
     """The scene at a fine fixed step (1/1000 s, the article's mapping): what the other runs are measured against."""
-    return run(scene, REFERENCE_PROFILE, "spring", duration_s, seed=1, params=params, stepping=reference_stepping())
+    return run(scene, REFERENCE_PROFILE, "implicit-euler", duration_s, seed=1, params=params, stepping=reference_stepping())
 
 
 class Scene:
     """A scene driven frame by frame from Python (ssScene_Frame), for programs and for the binding benchmark."""
 
-    def __init__(self, name: str, policy: str = "spring", params: dict | None = None,
+    def __init__(self, name: str, policy: str = "implicit-euler", params: dict | None = None,
                  stepping: dict | None = None):
         self.info = scene_info(name)
         full_params = ffi.new("ssSceneParams*", _merge(default_params(name), params, "params"))

@@ -7,7 +7,7 @@
 #    and solver settings.
 #  - Bad flags exit with 2 and name the flag.
 set(STEADYSTEP_EXAMPLE_PROGRAMS vehicle chain stack)
-set(STEADYSTEP_EXAMPLE_POLICIES naive spring matched exact fixed)
+set(STEADYSTEP_EXAMPLE_POLICIES naive implicit-euler matched exact fixed fixed-matched fixed-exact)
 
 foreach(program ${STEADYSTEP_EXAMPLE_PROGRAMS})
   add_test(NAME example_${program}_ode_uniform

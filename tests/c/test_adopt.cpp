@@ -161,13 +161,13 @@ TEST_F(AdoptTest, EveryJointTypeKeepsItsTunedValuesAtTheTunedStep) {
   EXPECT_EQ(report.skipped_joints, 0);
 
   // Other step lengths change the softness of every row (all but motors, which are dampers)...
-  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 1.0 / 25.0, 0, nullptr), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 1.0 / 25.0, 0, nullptr), SS_OK);
   int changed = 0;
   for (const Tuned& t : tuned) changed += GetParam(t.joint, t.param, t.axis) != t.value;
   EXPECT_GE(changed, (int)tuned.size() - report.motor_rows);
   EXPECT_NE(dWorldGetERP(world), 0.35);
   // ...and the tuned step gives back exactly what the program tuned.
-  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, kTunedStep, 0, nullptr), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, kTunedStep, 0, nullptr), SS_OK);
   ExpectTunedValues("at the tuned step");
   EXPECT_NEAR(dWorldGetERP(world), 0.35, 1e-12);
   EXPECT_NEAR(dWorldGetCFM(world), 2e-5, 1e-12 * 2e-5);
@@ -179,13 +179,13 @@ TEST_F(AdoptTest, OdeDefaultsAreAdoptedLikeTunedValues) {
   dJointAttach(ball, Body(0, 0, 1), 0);
   const double erp = dWorldGetERP(world), cfm = dWorldGetCFM(world);
   ASSERT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, nullptr), SS_OK) << ssLastError();
-  for (ssMapping mapping : {SS_MAPPING_SPRING, SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
+  for (ssMapping mapping : {SS_MAPPING_IMPLICIT_EULER, SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
     ssApplyReport applied;
     ASSERT_EQ(ssRegistry_Apply(registry, mapping, kTunedStep, kTunedStep, &applied), SS_OK) << ssLastError();
     EXPECT_NEAR(dJointGetBallParam(ball, dParamCFM), cfm, 1e-12 * cfm);
     EXPECT_NEAR(dJointGetBallParam(ball, dParamERP), erp, 1e-12);
     // near-rigid: far above the step's Nyquist frequency, so the accurate mappings hand the rows to spring
-    if (mapping != SS_MAPPING_SPRING) {
+    if (mapping != SS_MAPPING_IMPLICIT_EULER) {
       EXPECT_GE(applied.rows_spring_fallback, 2) << ssMappingName(mapping);
     }
   }
@@ -204,7 +204,7 @@ TEST_F(AdoptTest, HardRowsAndDampersAreCarriedAsTheyAre) {
   ASSERT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, &report), SS_OK) << ssLastError();
   EXPECT_EQ(report.hard_rows, 1);
   for (double h : {kTunedStep, 1.0 / 20.0, 1.0 / 240.0}) {
-    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, h, 0, nullptr), SS_OK);
+    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, h, 0, nullptr), SS_OK);
     // hard: cfm stays 0, and the error is corrected at the same rate per second r = erp/(h0 (1 - erp))
     const double rate = 0.4 / (kTunedStep * 0.6);
     EXPECT_EQ(dJointGetHingeParam(hard, dParamStopCFM), 0.0);
@@ -228,7 +228,7 @@ TEST_F(AdoptTest, DampingAndAutoDisableBecomeSecondsAndReachBodiesMadeLater) {
   ASSERT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, nullptr), SS_OK) << ssLastError();
 
   const double h = kTunedStep / 2;
-  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, h, 0, nullptr), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, h, 0, nullptr), SS_OK);
   // half the step: the velocity kept per step is the square root, so the same fraction is kept per second
   EXPECT_NEAR(1 - dBodyGetLinearDamping(early), std::sqrt(1 - 0.01), 1e-12);
   EXPECT_NEAR(1 - dBodyGetAngularDamping(early), std::sqrt(1 - 0.02), 1e-12);
@@ -243,7 +243,7 @@ TEST_F(AdoptTest, DampingAndAutoDisableBecomeSecondsAndReachBodiesMadeLater) {
   ssAdoptReport report = {};
   ASSERT_EQ(ssRegistry_AdoptBody(registry, late, &report), SS_OK) << ssLastError();
   EXPECT_EQ(report.bodies, 1);
-  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, kTunedStep, 0, nullptr), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, kTunedStep, 0, nullptr), SS_OK);
   for (dBodyID body : {early, late}) {
     EXPECT_NEAR(dBodyGetLinearDamping(body), 0.01, 1e-12);
     EXPECT_EQ(dBodyGetAutoDisableSteps(body), 12);
@@ -258,13 +258,13 @@ TEST_F(AdoptTest, JointsMadeLaterAdoptTheWorldsSpringAndAdoptingAgainChangesNoth
   dWorldSetCFM(world, 1e-4);
   dBodyID body = Body(0, 0, 1);
   ASSERT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, nullptr), SS_OK) << ssLastError();
-  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 1.0 / 20.0, 0, nullptr), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 1.0 / 20.0, 0, nullptr), SS_OK);
   dJointID ball = dJointCreateBall(world, 0);  // copies the world's ERP/CFM written for 1/20 s
   dJointAttach(ball, body, 0);
   ssAdoptReport report = {};
   ASSERT_EQ(ssRegistry_AdoptJoint(registry, ball, &report), SS_OK) << ssLastError();
   EXPECT_EQ(report.joint_rows, 1);
-  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, kTunedStep, 0, nullptr), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, kTunedStep, 0, nullptr), SS_OK);
   EXPECT_NEAR(dJointGetBallParam(ball, dParamERP), 0.3, 1e-12);
   EXPECT_NEAR(dJointGetBallParam(ball, dParamCFM), 1e-4, 1e-16);
 
@@ -298,7 +298,7 @@ TEST_F(AdoptTest, BadInputIsRefusedByNameAndNothingIsBound) {
   EXPECT_EQ(ssRegistry_JointBindingCount(registry), 0);
   EXPECT_EQ(ssRegistry_TunedStep(registry), 0.0);
   const double world_erp = dWorldGetERP(world);
-  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 0.1, 0, nullptr), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 0.1, 0, nullptr), SS_OK);
   EXPECT_EQ(dWorldGetERP(world), world_erp);
 
   // Plane-2D cannot be read back in ODE 0.16: skipped and counted, not guessed.

@@ -17,10 +17,10 @@ class Oscillator : public ::testing::Test {
 };
 
 // The article's setting: one physics step per frame (max_step_s no shorter than the longest frame).
-void OneStepPerFrame(OscillatorRig& rig, ssPolicy policy, ssSolver solver) {
-  rig.def.policy = policy;
-  rig.def.solver = solver;
-  rig.def.max_step_s = 1.0 / 15.0;
+void OneStepPerFrame(OscillatorRig& rig, const char* policy, ssSolver solver) {
+  ssSteppingForPolicy(policy, 1.0 / 30, &rig.def.stepping);
+  rig.def.stepping.solver = solver;
+  rig.def.stepping.max_step_s = 1.0 / 15.0;
 }
 
 TEST_F(Oscillator, SpringFollowsImplicitEulerAtFixedAndVariableSteps) {
@@ -36,7 +36,7 @@ TEST_F(Oscillator, SpringFollowsImplicitEulerAtFixedAndVariableSteps) {
   for (const Case& c : cases) {
     SCOPED_TRACE(std::string(c.profile) + (c.solver == SS_SOLVER_STEP ? " step" : " quick"));
     OscillatorRig rig;
-    OneStepPerFrame(rig, SS_POLICY_SPRING, c.solver);
+    OneStepPerFrame(rig, "implicit-euler", c.solver);
     ASSERT_EQ(rig.Build(), SS_OK) << ssLastError();
     ASSERT_EQ(rig.Run(c.profile, 5.0, 7), SS_OK) << ssLastError();
     ASSERT_GT(rig.x.size(), 70u);
@@ -46,7 +46,7 @@ TEST_F(Oscillator, SpringFollowsImplicitEulerAtFixedAndVariableSteps) {
 
 TEST_F(Oscillator, SubstepsFollowImplicitEulerAtEachSubstep) {
   OscillatorRig rig;
-  rig.def.solver = SS_SOLVER_STEP;  // max_step_s stays 1/60: 15-45 fps frames become 1 to 4 substeps
+  rig.def.stepping.solver = SS_SOLVER_STEP;  // max_step_s stays 1/60: 15-45 fps frames become 1 to 4 substeps
   ASSERT_EQ(rig.Build(), SS_OK);
   ASSERT_EQ(rig.Run("uniform:15:45", 3.0, 3), SS_OK);
   for (double h : rig.h) EXPECT_LE(h, 1.0 / 60.0 + 1e-15);
@@ -62,8 +62,8 @@ double WorstAgainstImplicitEuler(dWorldID world, ssRegistry* registry, ssSolver 
   ssStepperDef def = ssDefaultStepperDef();
   def.world = world;
   def.registry = registry;
-  def.solver = solver;
-  def.max_step_s = 1.0 / 15.0;
+  def.stepping.solver = solver;
+  def.stepping.max_step_s = 1.0 / 15.0;
   ssStepper* stepper;
   if (ssStepper_Create(&def, &stepper) != SS_OK) return -1;
   std::mt19937_64 random(seed);
@@ -170,7 +170,7 @@ TEST_F(Oscillator, SpringIsConsistentAcrossFrameRatesAndNaiveIsNot) {
   for (int seed = 0; seed < seeds; ++seed) {
     double rms[2];
     for (int which = 0; which < 2; ++which) {
-      ssPolicy policy = which == 0 ? SS_POLICY_SPRING : SS_POLICY_NAIVE;
+      const char* policy = which == 0 ? "implicit-euler" : "naive";
       OscillatorRig fixed, variable;
       OneStepPerFrame(fixed, policy, SS_SOLVER_QUICK);
       OneStepPerFrame(variable, policy, SS_SOLVER_QUICK);
@@ -212,9 +212,9 @@ TEST_F(Oscillator, MatchedHasTheExactDecayAndFrequencyAtEveryFixedStep) {
   for (int fps : {15, 30, 60, 144}) {
     for (ssSolver solver : {SS_SOLVER_STEP, SS_SOLVER_QUICK}) {
       OscillatorRig rig;
-      rig.def.policy = SS_POLICY_MATCHED;
-      rig.def.solver = solver;
-      rig.def.max_step_s = 1.0 / fps;
+      ssSteppingForPolicy("matched", 1.0 / 30, &rig.def.stepping);
+      rig.def.stepping.solver = solver;
+      rig.def.stepping.max_step_s = 1.0 / fps;
       ASSERT_EQ(rig.Build(), SS_OK);
       ASSERT_EQ(rig.Run(("fixed:" + std::to_string(fps)).c_str(), 5.0), SS_OK);
       std::vector<double> xs = {rig.x0};
@@ -238,9 +238,9 @@ TEST_F(Oscillator, ExactReproducesTheExactMotionUnderVariableFrames) {
   for (ssSolver solver : {SS_SOLVER_STEP, SS_SOLVER_QUICK}) {
     for (double max_step_s : {1.0 / 15.0, 1.0 / 60.0}) {
       OscillatorRig rig;
-      rig.def.policy = SS_POLICY_EXACT;
-      rig.def.solver = solver;
-      rig.def.max_step_s = max_step_s;
+      ssSteppingForPolicy("exact", 1.0 / 30, &rig.def.stepping);
+      rig.def.stepping.solver = solver;
+      rig.def.stepping.max_step_s = max_step_s;
       ASSERT_EQ(rig.Build(), SS_OK);
       ASSERT_EQ(rig.Run("uniform:15:45", 5.0, 1), SS_OK) << ssLastError();
       double rms = RmsAgainstExact(rig);
@@ -257,24 +257,24 @@ TEST_F(Oscillator, ExactReproducesTheExactMotionUnderVariableFrames) {
 // exact again. The figures are printed; see docs/exact-mappings.md.
 TEST_F(Oscillator, GravityAlongTheSliderByMapping) {
   for (bool declared : {false, true}) {
-    for (ssPolicy policy : {SS_POLICY_SPRING, SS_POLICY_MATCHED, SS_POLICY_EXACT}) {
+    for (const char* policy : {"implicit-euler", "matched", "exact"}) {
       OscillatorRig rig;
       rig.gravity = 9.81;
       rig.declare_load = declared;
-      rig.def.policy = policy;
-      rig.def.solver = SS_SOLVER_STEP;
+      ssSteppingForPolicy(policy, 1.0 / 30, &rig.def.stepping);
+      rig.def.stepping.solver = SS_SOLVER_STEP;
       ASSERT_EQ(rig.Build(), SS_OK) << ssLastError();
       ASSERT_EQ(rig.Run("uniform:15:45", 60.0, 2), SS_OK);  // long enough for the motion to die out (e^-30)
       double rest = -rig.mass * rig.gravity / rig.spring.stiffness;
       double rest_error = std::fabs(rig.x.back() - rest) / std::fabs(rest), rms = RmsAgainstExact(rig);
       std::printf("gravity, %-7s load %-8s: rest position off by %.3g of m g / k, RMS vs exact / x0 %.3g\n",
-                  ssPolicyName(policy), declared ? "declared" : "unknown", rest_error, rms);
-      if (policy == SS_POLICY_SPRING || declared) {
+                  policy, declared ? "declared" : "unknown", rest_error, rms);
+      if (std::string(policy) == "implicit-euler" || declared) {
         EXPECT_LT(rest_error, 1e-6);
       } else {
         EXPECT_GT(rest_error, 1e-3);  // the effect the declared load removes
       }
-      if (policy == SS_POLICY_EXACT && declared) {
+      if (std::string(policy) == "exact" && declared) {
         EXPECT_LT(rms, 1e-6);
       }
     }
@@ -296,7 +296,7 @@ TEST_F(Oscillator, LoadsAreRefusedWhereTheyHaveNoMeaning) {
 TEST_F(Oscillator, UndampedSpringUnderMatchedGetsTheSpringMappingCounted) {
   OscillatorRig rig;
   rig.spring = {40.0, 0.0};  // poles on the unit circle: no finite matched softness
-  rig.def.policy = SS_POLICY_MATCHED;
+  ssSteppingForPolicy("matched", 1.0 / 30, &rig.def.stepping);
   ASSERT_EQ(rig.Build(), SS_OK);
   ssFrameReport report;
   ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 30.0, &report), SS_OK) << ssLastError();

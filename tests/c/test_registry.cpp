@@ -128,7 +128,7 @@ TEST_F(RegistryTest, EveryJointTypeAndParameterIsWrittenForEachStepLength) {
   EXPECT_EQ(ssRegistry_JointBindingCount(registry), bound);
   for (double step_s : {1.0 / 30.0, 1.0 / 144.0}) {
     ssApplyReport report;
-    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, step_s, 0, &report), SS_OK) << ssLastError();
+    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, step_s, 0, &report), SS_OK) << ssLastError();
     EXPECT_EQ(report.rows_written, bound);
     ssSoftness expected;
     ASSERT_EQ(ssSoftnessFromSpring(kSpring, step_s, &expected), SS_OK);
@@ -221,7 +221,7 @@ TEST_F(RegistryTest, BindingAgainReplacesAndUnbindRemoves) {
   ASSERT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, ssSpring{100, 1}, 0), SS_OK);
   ASSERT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_MOTOR, 1, ssSpring{0, 5}, 0), SS_OK);
   EXPECT_EQ(ssRegistry_JointBindingCount(registry), 2);
-  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 0.01, 0, nullptr), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 0.01, 0, nullptr), SS_OK);
   EXPECT_DOUBLE_EQ(dJointGetHingeParam(hinge, dParamStopCFM), 1.0 / (0.01 * 100 + 1));
   EXPECT_DOUBLE_EQ(dJointGetHingeParam(hinge, dParamCFM), 1.0 / 5.0);  // a pure damper: same at every h
 
@@ -229,7 +229,7 @@ TEST_F(RegistryTest, BindingAgainReplacesAndUnbindRemoves) {
   EXPECT_EQ(ssRegistry_JointBindingCount(registry), 0);
   EXPECT_EQ(ssRegistry_UnbindJoint(registry, hinge), SS_ERROR_NOT_FOUND);
   dJointDestroy(hinge);
-  EXPECT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 0.01, 0, nullptr), SS_OK);
+  EXPECT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 0.01, 0, nullptr), SS_OK);
   ssRegistry_Destroy(registry);
 }
 
@@ -250,15 +250,15 @@ TEST_F(RegistryTest, ApplyErrorWritesNothing) {
 
   // no finite softness under any mapping: refused, naming the joint, and nothing written (the first binding
   // included)
-  for (ssMapping mapping : {SS_MAPPING_SPRING, SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
+  for (ssMapping mapping : {SS_MAPPING_IMPLICIT_EULER, SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
     EXPECT_NE(ssRegistry_Apply(registry, mapping, 0.01, 0, nullptr), SS_OK);
     EXPECT_NE(std::string(ssLastError()).find("slider joint"), std::string::npos) << ssLastError();
   }
   for (double step_s : {0.0, -0.01, double(NAN), double(INFINITY)}) {
-    EXPECT_NE(ssRegistry_Apply(registry, SS_MAPPING_SPRING, step_s, 0, nullptr), SS_OK);
+    EXPECT_NE(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, step_s, 0, nullptr), SS_OK);
     EXPECT_NE(std::string(ssLastError()).find("step_s"), std::string::npos) << ssLastError();
   }
-  EXPECT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 0.01, -1, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 0.01, -1, nullptr), SS_ERROR_OUT_OF_RANGE);
   EXPECT_EQ(ssRegistry_Apply(registry, (ssMapping)9, 0.01, 0, nullptr), SS_ERROR_UNSUPPORTED);
   EXPECT_EQ(dWorldGetERP(world), erp);
   EXPECT_EQ(dWorldGetCFM(world), cfm);
@@ -266,7 +266,7 @@ TEST_F(RegistryTest, ApplyErrorWritesNothing) {
   EXPECT_EQ(dBodyGetLinearDamping(a), damping);
 
   ASSERT_EQ(ssRegistry_UnbindJoint(registry, undamped), SS_OK);
-  EXPECT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 0.01, 0, nullptr), SS_OK);
+  EXPECT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 0.01, 0, nullptr), SS_OK);
   ssRegistry_Destroy(registry);
 }
 
@@ -276,7 +276,7 @@ TEST_F(RegistryTest, DampingRatesRemoveTheSameFractionPerSecond) {
   ASSERT_EQ(ssRegistry_BindDamping(registry, nullptr, 0.25, 0.0), SS_OK);
   dWorldSetGravity(world, 0, 0, 0);
   for (double step_s : {1.0 / 15.0, 1.0 / 144.0}) {
-    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, step_s, 0, nullptr), SS_OK);
+    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, step_s, 0, nullptr), SS_OK);
     EXPECT_NEAR(dBodyGetLinearDamping(a), 1 - std::exp(-0.5 * step_s), 1e-15);
     EXPECT_NEAR(dBodyGetAngularDamping(a), 1 - std::exp(-2.0 * step_s), 1e-15);
     EXPECT_NEAR(dWorldGetLinearDamping(world), 1 - std::exp(-0.25 * step_s), 1e-15);
@@ -295,11 +295,11 @@ TEST_F(RegistryTest, DampingRatesRemoveTheSameFractionPerSecond) {
 TEST_F(RegistryTest, AutoDisableIsGivenInSeconds) {
   ssRegistry* registry = ssRegistry_Create(world);
   ASSERT_EQ(ssRegistry_BindAutoDisable(registry, a, 0.5, 0.1), SS_OK);
-  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 1.0 / 60.0, 0, nullptr), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 1.0 / 60.0, 0, nullptr), SS_OK);
   EXPECT_EQ(dBodyGetAutoDisableSteps(a), 30);
   EXPECT_DOUBLE_EQ(dBodyGetAutoDisableTime(a), 0.5);
   EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(a), 6u);
-  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_SPRING, 1.0 / 15.0, 0, nullptr), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 1.0 / 15.0, 0, nullptr), SS_OK);
   EXPECT_EQ(dBodyGetAutoDisableSteps(a), 8);
   EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(a), 2u);
   EXPECT_EQ(ssRegistry_BindAutoDisable(registry, a, 0, 0.1), SS_ERROR_OUT_OF_RANGE);
@@ -336,7 +336,7 @@ TEST_F(RegistryTest, ContactSoftenFillsTheSurface) {
   contact.geom.normal[2] = 1;
   dBodySetPosition(a, 0, 0, 0.05);
   contact.geom.pos[2] = 0;
-  ASSERT_EQ(ssContactSoften(&contact, a, nullptr, kSpring, SS_MAPPING_SPRING, 0.02, 0), SS_OK);
+  ASSERT_EQ(ssContactSoften(&contact, a, nullptr, kSpring, SS_MAPPING_IMPLICIT_EULER, 0.02, 0), SS_OK);
   ssSoftness expected;
   ssSoftnessFromSpring(kSpring, 0.02, &expected);
   EXPECT_TRUE(contact.surface.mode & dContactSoftERP);
@@ -356,9 +356,9 @@ TEST_F(RegistryTest, ContactSoftenFillsTheSurface) {
 
   dContact before = contact;
   EXPECT_EQ(ssContactSoften(&contact, a, nullptr, kSpring, (ssMapping)7, 0.02, 0), SS_ERROR_UNSUPPORTED);
-  EXPECT_EQ(ssContactSoften(&contact, a, nullptr, ssSpring{1, -1}, SS_MAPPING_SPRING, 0.02, 0),
+  EXPECT_EQ(ssContactSoften(&contact, a, nullptr, ssSpring{1, -1}, SS_MAPPING_IMPLICIT_EULER, 0.02, 0),
             SS_ERROR_OUT_OF_RANGE);
-  EXPECT_EQ(ssContactSoften(&contact, a, nullptr, kSpring, SS_MAPPING_SPRING, 0, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssContactSoften(&contact, a, nullptr, kSpring, SS_MAPPING_IMPLICIT_EULER, 0, 0), SS_ERROR_OUT_OF_RANGE);
   EXPECT_EQ(std::memcmp(&before, &contact, sizeof contact), 0);
 }
 

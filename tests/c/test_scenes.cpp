@@ -136,7 +136,9 @@ TEST(Scenes, DefaultParamsAreTheDocumentedOnes) {
   EXPECT_EQ(params.x0, 0.5);
   EXPECT_EQ(params.gravity, 0);
   ssStepping reference = ssReferenceStepping(1e-3);
-  EXPECT_EQ(reference.policy, SS_POLICY_SPRING);
+  EXPECT_EQ(reference.cut, SS_CUT_SUBSTEPS);
+  EXPECT_EQ(reference.mapping, SS_MAPPING_IMPLICIT_EULER);
+  EXPECT_STREQ(ssSteppingPolicyName(&reference), "implicit-euler");
   EXPECT_EQ(reference.max_step_s, 1e-3);
 }
 
@@ -205,14 +207,14 @@ TEST(Scenes, BadInputsAreRefusedByName) {
     const char* named;
   };
   const SteppingCase stepping_cases[] = {
-      {[](ssStepping& s) { s.policy = 9; }, SS_ERROR_UNSUPPORTED, "policy"},
-      {[](ssStepping& s) { s.policy = -1; }, SS_ERROR_UNSUPPORTED, "policy"},
-      {[](ssStepping& s) { s.solver = 7; }, SS_ERROR_UNSUPPORTED, "solver"},
-      {[](ssStepping& s) { s.quick_iterations = 0; }, SS_ERROR_OUT_OF_RANGE, "quick_iterations"},
+      {[](ssStepping& s) { s.cut = (ssFrameCut)9; }, SS_ERROR_UNSUPPORTED, "cut"},
+      {[](ssStepping& s) { s.mapping = (ssMapping)-1; }, SS_ERROR_UNSUPPORTED, "mapping"},
+      {[](ssStepping& s) { s.solver = (ssSolver)7; }, SS_ERROR_UNSUPPORTED, "solver"},
+      {[](ssStepping& s) { s.quick_iterations = -1; }, SS_ERROR_OUT_OF_RANGE, "quick_iterations"},
       {[](ssStepping& s) { s.max_step_s = 0; }, SS_ERROR_OUT_OF_RANGE, "max_step_s"},
       {[](ssStepping& s) { s.max_step_s = std::numeric_limits<double>::quiet_NaN(); }, SS_ERROR_NOT_FINITE,
        "max_step_s"},
-      {[](ssStepping& s) { s.reference_step_s = -1; }, SS_ERROR_OUT_OF_RANGE, "reference_step_s"},
+      {[](ssStepping& s) { s.frozen_step_s = -1; }, SS_ERROR_OUT_OF_RANGE, "frozen_step_s"},
       {[](ssStepping& s) { s.fixed_step_s = 0; }, SS_ERROR_OUT_OF_RANGE, "fixed_step_s"},
       {[](ssStepping& s) { s.max_steps_per_frame = 0; }, SS_ERROR_OUT_OF_RANGE, "max_steps_per_frame"},
   };
@@ -223,11 +225,12 @@ TEST(Scenes, BadInputsAreRefusedByName) {
     ExpectSceneRefused("drop", def.params, def.stepping, c.status, c.named);
   }
 
-  // The matched mapping has no finite softness for an undamped spring: refused before any world exists.
+  // The matched mapping has no finite softness for an undamped spring: the implicit-Euler mapping serves it.
   def = good;
   def.params.spring.damping = 0;
-  def.stepping.policy = SS_POLICY_MATCHED;
-  ExpectRunRefused(def, SS_ERROR_NO_FINITE_MAPPING, "c = 0");
+  def.stepping.mapping = SS_MAPPING_MATCHED;
+  Recorded undamped = Execute(def);
+  EXPECT_EQ(undamped.status, SS_OK) << undamped.message;
 
   for (double duration_s : {0.0, -1.0}) {
     def = good;
@@ -270,7 +273,6 @@ TEST(Scenes, SameSeedSameRunOtherSeedAnother) {
 // The truth, stated independently of ODE and of the library: implicit Euler of m x'' = -k x - c x'.
 TEST(Scenes, OscillatorFollowsImplicitEulerUnderTheArticlesMapping) {
   ssRunDef def = Def("oscillator", "fixed:30", 3.0);
-  def.stepping.policy = SS_POLICY_SPRING;
   def.stepping.solver = SS_SOLVER_STEP;
   def.stepping.max_step_s = 1.0 / 30;
   Recorded run = Execute(def);
@@ -311,13 +313,12 @@ TEST(Scenes, SpringPolicySpreadIsAtMostHalfOfNaive) {
     Recorded reference = Execute(reference_def);
     ASSERT_EQ(reference.status, SS_OK) << scene << ": " << reference.message;
     double spread[2] = {0, 0};
-    const ssPolicy policies[2] = {SS_POLICY_NAIVE, SS_POLICY_SPRING};
+    const char* const policies[2] = {"naive", "implicit-euler"};
     for (int p = 0; p < 2; ++p) {
       double sum = 0;
       for (const char* profile : profiles) {
         ssRunDef def = Def(scene, profile, 3.0);
-        def.stepping.policy = policies[p];
-        def.stepping.reference_step_s = 1.0 / 30;
+        ASSERT_EQ(ssLabStepping(policies[p], &def.stepping), SS_OK);
         def.stepping.max_step_s = 1.0 / 60;
         Recorded run = Execute(def);
         ASSERT_FALSE(run.times.empty());
@@ -364,7 +365,7 @@ TEST(Scenes, ValuesOutsideOdesRangeAreRefusedByName) {
   };
   const SteppingCase stepping_cases[] = {
       {[](ssStepping& s) { s.max_step_s = 1e-200; }, "stepping.max_step_s = 1e-200"},
-      {[](ssStepping& s) { s.reference_step_s = 1.7e308; }, "stepping.reference_step_s = 1.7e+308"},
+      {[](ssStepping& s) { s.frozen_step_s = 1.7e308; }, "stepping.frozen_step_s = 1.7e+308"},
       {[](ssStepping& s) { s.fixed_step_s = 1e-10; }, "stepping.fixed_step_s = 1e-10"},
       {[](ssStepping& s) { s.max_step_s = 1e4; }, "stepping.max_step_s = 10000"},
   };
@@ -402,7 +403,7 @@ TEST(Scenes, RunsAboveTheirBoundsAreRefusedNamingTheValue) {
   def = Def("oscillator", "fixed:1e12", 1.0);  // frames of 1e-12 s: 1e12 of them
   ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, "fixed:1e12");
   def = Def("oscillator", "fixed:1", 1000.0);  // 1000 frames, but the accumulator at 1e-9 s: 1e12 steps
-  def.stepping.policy = SS_POLICY_FIXED;
+  def.stepping.cut = SS_CUT_FIXED;
   def.stepping.fixed_step_s = 1e-9;
   ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, "steps");
   def = Def("oscillator", "fixed:1", 1e5);  // 1e5 frames cut into up to 8 substeps of at most 1e-3 s: 8e5 steps...

@@ -505,7 +505,7 @@ TEST(ConversionContract, NullOutputsAreRefusedByName) {
   EXPECT_TRUE(MessageNames("frequency_hz = NULL"));
   EXPECT_EQ(ssFrequencyFromSpring(ssSpring{1, 1}, 1, &hz, nullptr), SS_ERROR_OUT_OF_RANGE);
   EXPECT_TRUE(MessageNames("damping_ratio = NULL"));
-  for (ssMapping mapping : {SS_MAPPING_SPRING, SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
+  for (ssMapping mapping : {SS_MAPPING_IMPLICIT_EULER, SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
     EXPECT_EQ(ssSoftnessFor(mapping, ssSpring{1, 1}, 1, 0.01, 0.01, nullptr), SS_ERROR_OUT_OF_RANGE);
     EXPECT_TRUE(MessageNames("out = NULL"));
   }

@@ -1,6 +1,7 @@
 // The stepper: how frames become steps under each policy, what the callbacks are handed, refusals that leave the
 // world as it was, blow-up and speed checks, and the Nyquist report.
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -30,8 +31,7 @@ TEST_F(StepperTest, FramesAreSplitIntoEqualSubstepsNoLongerThanTheMaximum) {
 
 TEST_F(StepperTest, NaiveTakesOneStepWithSoftnessFrozenAtTheReference) {
   OscillatorRig rig;
-  rig.def.policy = SS_POLICY_NAIVE;
-  rig.def.reference_step_s = 1.0 / 30.0;
+  ssSteppingForPolicy("naive", 1.0 / 30, &rig.def.stepping);
   ASSERT_EQ(rig.Build(), SS_OK);
   ssSoftness reference;
   ASSERT_EQ(ssSoftnessFromSpring(rig.spring, 1.0 / 30.0, &reference), SS_OK);
@@ -47,9 +47,9 @@ TEST_F(StepperTest, NaiveTakesOneStepWithSoftnessFrozenAtTheReference) {
 
 TEST_F(StepperTest, FixedStepsFromAnAccumulatorWithInterpolationAndACap) {
   OscillatorRig rig;
-  rig.def.policy = SS_POLICY_FIXED;
-  rig.def.fixed_step_s = 0.01;
-  rig.def.max_steps_per_frame = 4;
+  ssSteppingForPolicy("fixed", 1.0 / 30, &rig.def.stepping);
+  rig.def.stepping.fixed_step_s = 0.01;
+  rig.def.stepping.max_steps_per_frame = 4;
   ASSERT_EQ(rig.Build(), SS_OK);
   ssFrameReport report;
   ASSERT_EQ(ssStepper_Step(rig.stepper, 0.025, &report), SS_OK);
@@ -97,17 +97,17 @@ TEST_F(StepperTest, CreateRefusesBadDefinitionsNamingTheField) {
     const char* named;
   } cases[] = {
       {[](ssStepperDef* d) { d->world = nullptr; }, SS_ERROR_OUT_OF_RANGE, "world"},
-      {[](ssStepperDef* d) { d->max_step_s = 0; }, SS_ERROR_OUT_OF_RANGE, "max_step_s = 0"},
-      {[](ssStepperDef* d) { d->max_step_s = NAN; }, SS_ERROR_NOT_FINITE, "max_step_s"},
-      {[](ssStepperDef* d) { d->reference_step_s = -1; }, SS_ERROR_OUT_OF_RANGE, "reference_step_s = -1"},
-      {[](ssStepperDef* d) { d->fixed_step_s = INFINITY; }, SS_ERROR_NOT_FINITE, "fixed_step_s"},
-      {[](ssStepperDef* d) { d->quick_iterations = -1; }, SS_ERROR_OUT_OF_RANGE, "quick_iterations = -1"},
-      {[](ssStepperDef* d) { d->max_step_s = 1e-12; }, SS_ERROR_OUT_OF_RANGE, "max_step_s = 1e-12"},
-      {[](ssStepperDef* d) { d->max_angular_speed = -1; }, SS_ERROR_OUT_OF_RANGE, "max_angular_speed = -1"},
-      {[](ssStepperDef* d) { d->max_steps_per_frame = -3; }, SS_ERROR_OUT_OF_RANGE, "max_steps_per_frame = -3"},
-      {[](ssStepperDef* d) { d->max_speed = -1; }, SS_ERROR_OUT_OF_RANGE, "max_speed = -1"},
-      {[](ssStepperDef* d) { d->policy = (ssPolicy)42; }, SS_ERROR_UNSUPPORTED, "policy = 42"},
-      {[](ssStepperDef* d) { d->solver = (ssSolver)7; }, SS_ERROR_UNSUPPORTED, "solver = 7"},
+      {[](ssStepperDef* d) { d->stepping.max_step_s = 0; }, SS_ERROR_OUT_OF_RANGE, "max_step_s = 0"},
+      {[](ssStepperDef* d) { d->stepping.max_step_s = NAN; }, SS_ERROR_NOT_FINITE, "max_step_s"},
+      {[](ssStepperDef* d) { d->stepping.frozen_step_s = -1; }, SS_ERROR_OUT_OF_RANGE, "frozen_step_s = -1"},
+      {[](ssStepperDef* d) { d->stepping.fixed_step_s = INFINITY; }, SS_ERROR_NOT_FINITE, "fixed_step_s"},
+      {[](ssStepperDef* d) { d->stepping.quick_iterations = -1; }, SS_ERROR_OUT_OF_RANGE, "quick_iterations = -1"},
+      {[](ssStepperDef* d) { d->stepping.max_step_s = 1e-12; }, SS_ERROR_OUT_OF_RANGE, "max_step_s = 1e-12"},
+      {[](ssStepperDef* d) { d->stepping.max_angular_speed = -1; }, SS_ERROR_OUT_OF_RANGE, "max_angular_speed = -1"},
+      {[](ssStepperDef* d) { d->stepping.max_steps_per_frame = -3; }, SS_ERROR_OUT_OF_RANGE, "max_steps_per_frame = -3"},
+      {[](ssStepperDef* d) { d->stepping.max_speed = -1; }, SS_ERROR_OUT_OF_RANGE, "max_speed = -1"},
+      {[](ssStepperDef* d) { d->stepping.cut = (ssFrameCut)42; }, SS_ERROR_UNSUPPORTED, "cut = 42"},
+      {[](ssStepperDef* d) { d->stepping.solver = (ssSolver)7; }, SS_ERROR_UNSUPPORTED, "solver = 7"},
   };
   for (const Case& c : cases) {
     ssStepperDef def = ssDefaultStepperDef();
@@ -121,16 +121,40 @@ TEST_F(StepperTest, CreateRefusesBadDefinitionsNamingTheField) {
   dWorldDestroy(other);
 }
 
-TEST_F(StepperTest, PolicyNamesRoundTrip) {
-  for (int p = SS_POLICY_NAIVE; p <= SS_POLICY_FIXED; ++p) {
-    ssPolicy parsed;
-    ASSERT_EQ(ssPolicyParse(ssPolicyName((ssPolicy)p), &parsed), SS_OK);
-    EXPECT_EQ(parsed, p);
+TEST_F(StepperTest, PoliciesArePresetsOfCutAndMappingNamedByTheLibrary) {
+  ASSERT_EQ(ssPolicyCount(), 7);
+  for (int i = 0; i < ssPolicyCount(); ++i) {
+    ssStepping stepping = ssDefaultStepping();
+    ASSERT_EQ(ssSteppingForPolicy(ssPolicyNameAt(i), 1.0 / 60, &stepping), SS_OK);
+    EXPECT_STREQ(ssSteppingPolicyName(&stepping), ssPolicyNameAt(i));
+    EXPECT_EQ(ssValidateStepping(&stepping), SS_OK);
   }
-  ssPolicy parsed;
-  EXPECT_EQ(ssPolicyParse("smooth", &parsed), SS_ERROR_PARSE);
+  EXPECT_EQ(ssPolicyNameAt(ssPolicyCount()), nullptr);
+  ssStepping stepping = ssDefaultStepping();
+  const ssStepping before = stepping;
+  EXPECT_EQ(ssSteppingForPolicy("smooth", 1.0 / 60, &stepping), SS_ERROR_PARSE);
   EXPECT_NE(std::string(ssLastError()).find("smooth"), std::string::npos);
-  EXPECT_EQ(ssPolicyName((ssPolicy)9), nullptr);
+  EXPECT_NE(std::string(ssLastError()).find("fixed-exact"), std::string::npos);  // the known names, listed
+  EXPECT_EQ(ssSteppingForPolicy("naive", 0, &stepping), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(std::memcmp(&before, &stepping, sizeof stepping), 0);
+  // Every combination of cut and mapping is a valid stepping; whole-frame matched is no preset.
+  stepping.cut = SS_CUT_WHOLE_FRAME;
+  stepping.mapping = SS_MAPPING_MATCHED;
+  EXPECT_EQ(ssValidateStepping(&stepping), SS_OK);
+  EXPECT_EQ(ssSteppingPolicyName(&stepping), nullptr);
+}
+
+TEST_F(StepperTest, FixedStepsWithTheExactMappingCarryTheirHistory) {
+  OscillatorRig rig;
+  ASSERT_EQ(ssSteppingForPolicy("fixed-exact", 1.0 / 30, &rig.def.stepping), SS_OK);
+  rig.def.stepping.fixed_step_s = 0.01;
+  ASSERT_EQ(rig.Build(), SS_OK);
+  ssFrameReport report;
+  for (double frame_s : {0.025, 0.013, 0.031}) ASSERT_EQ(ssStepper_Step(rig.stepper, frame_s, &report), SS_OK);
+  for (double h : rig.h) EXPECT_DOUBLE_EQ(h, 0.01);
+  ssStepInfo last = ssStepper_CurrentStep(rig.stepper);
+  EXPECT_EQ(last.mapping, SS_MAPPING_EXACT);
+  EXPECT_DOUBLE_EQ(last.previous_step_s, 0.01);  // fixed steps keep the exact mapping's history
 }
 
 struct CallbackLog {
@@ -140,7 +164,7 @@ struct CallbackLog {
 TEST_F(StepperTest, CallbacksAreHandedTheStepAndTheMapping) {
   OscillatorRig rig;
   CallbackLog log;
-  rig.def.policy = SS_POLICY_EXACT;
+  ssSteppingForPolicy("exact", 1.0 / 30, &rig.def.stepping);
   rig.def.before_step = [](void* context, ssStepper* stepper) {
     static_cast<CallbackLog*>(context)->before.push_back(ssStepper_CurrentStep(stepper));
   };
@@ -167,12 +191,15 @@ TEST_F(StepperTest, CallbacksAreHandedTheStepAndTheMapping) {
   ssStepper_ResetHistory(rig.stepper);
   ASSERT_EQ(ssStepper_Step(rig.stepper, 0.01, nullptr), SS_OK);
   EXPECT_EQ(log.collide.back().previous_step_s, 0.0);
-  ASSERT_EQ(ssStepper_SetPolicy(rig.stepper, SS_POLICY_NAIVE), SS_OK);
+  ssStepping naive = ssStepper_Stepping(rig.stepper);
+  ASSERT_EQ(ssSteppingForPolicy("naive", 1.0 / 30, &naive), SS_OK);
+  ASSERT_EQ(ssStepper_SetStepping(rig.stepper, &naive), SS_OK);
   ASSERT_EQ(ssStepper_Step(rig.stepper, 0.01, nullptr), SS_OK);
-  EXPECT_EQ(log.collide.back().mapping, SS_MAPPING_SPRING);
+  EXPECT_EQ(log.collide.back().mapping, SS_MAPPING_IMPLICIT_EULER);
   EXPECT_DOUBLE_EQ(log.collide.back().step_s, 0.01);
-  EXPECT_DOUBLE_EQ(log.collide.back().softness_step_s, 1.0 / 30.0);  // no adoption: the lab's reference step
-  EXPECT_EQ(ssStepper_SetPolicy(rig.stepper, (ssPolicy)-1), SS_ERROR_UNSUPPORTED);
+  EXPECT_DOUBLE_EQ(log.collide.back().softness_step_s, 1.0 / 30.0);  // frozen at the reference step
+  naive.mapping = (ssMapping)-1;
+  EXPECT_EQ(ssStepper_SetStepping(rig.stepper, &naive), SS_ERROR_UNSUPPORTED);
 }
 
 TEST_F(StepperTest, ContactGroupIsEmptiedAfterEveryStep) {
@@ -197,7 +224,7 @@ TEST_F(StepperTest, ContactGroupIsEmptiedAfterEveryStep) {
 
 TEST_F(StepperTest, BlowUpsAndRunawaysAreReportedAndStepsAreRefusedUntilReset) {
   OscillatorRig rig;
-  rig.def.max_speed = 100;
+  rig.def.stepping.max_speed = 100;
   ASSERT_EQ(rig.Build(), SS_OK);
   dBodyID loose = MakeBody(1.0);
   ssStepper_WatchBody(rig.stepper, loose);
@@ -238,13 +265,13 @@ TEST_F(StepperTest, BlowUpsAndRunawaysAreReportedAndStepsAreRefusedUntilReset) {
 
 TEST_F(StepperTest, TheSpeedGuardIsOnByDefaultForLinearAndAngularSpeed) {
   ssStepperDef def = ssDefaultStepperDef();
-  EXPECT_GT(def.max_speed, 0);
-  EXPECT_GT(def.max_angular_speed, 0);
+  EXPECT_GT(def.stepping.max_speed, 0);
+  EXPECT_GT(def.stepping.max_angular_speed, 0);
   OscillatorRig rig;
   ASSERT_EQ(rig.Build(), SS_OK);
   dBodyID spinning = MakeBody(1.0);
   ASSERT_EQ(ssStepper_WatchBody(rig.stepper, spinning), SS_OK);
-  dBodySetAngularVel(spinning, 0, 0, 2 * def.max_angular_speed);
+  dBodySetAngularVel(spinning, 0, 0, 2 * def.stepping.max_angular_speed);
   ssFrameReport report;
   EXPECT_EQ(ssStepper_Step(rig.stepper, 1.0 / 60, &report), SS_ERROR_SPEED_LIMIT);
   EXPECT_NE(std::string(ssLastError()).find("max_angular_speed"), std::string::npos) << ssLastError();
@@ -253,7 +280,7 @@ TEST_F(StepperTest, TheSpeedGuardIsOnByDefaultForLinearAndAngularSpeed) {
 TEST_F(StepperTest, FrequenciesAboveHalfTheStepRateAreReported) {
   OscillatorRig rig;
   rig.spring = {40000.0, 1.0};  // 1 kg: w = 200 rad/s, so w h > π above h = 15.7 ms
-  rig.def.max_step_s = 1.0 / 30.0;
+  rig.def.stepping.max_step_s = 1.0 / 30.0;
   ASSERT_EQ(rig.Build(), SS_OK);
   ssFrameReport report;
   ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 30.0, &report), SS_OK);
@@ -265,8 +292,8 @@ TEST_F(StepperTest, FrequenciesAboveHalfTheStepRateAreReported) {
 TEST_F(StepperTest, ExactFallsBackToMatchedWhereAStepPairHasNoFiniteMapping) {
   OscillatorRig rig;
   rig.spring = {40.0, 0.05};  // lightly damped
-  rig.def.policy = SS_POLICY_EXACT;
-  rig.def.max_step_s = 1.0;
+  ssSteppingForPolicy("exact", 1.0 / 30, &rig.def.stepping);
+  rig.def.stepping.max_step_s = 1.0;
   ASSERT_EQ(rig.Build(), SS_OK);
   int fallbacks = 0;
   for (double frame_s : {0.4, 0.004, 0.4, 0.004}) {

@@ -56,7 +56,7 @@ def test_compare_writes_the_report(tmp_path):
 
 
 def test_run_csv_on_stdout_and_to_a_file(tmp_path):
-    result = steadystep("run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--duration", "0.5")
+    result = steadystep("run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler", "--duration", "0.5")
     assert result.returncode == 0, result.stderr
     rows = list(csv.reader(io.StringIO(result.stdout)))
     assert rows[0] == ["t", "x", "v", "erp", "cfm"]
@@ -80,10 +80,10 @@ def test_run_json():
 
 
 def test_probe_prints_each_policy():
-    result = steadystep("probe", "chain", "--policies", "naive", "spring", "--duration", "1", "--json")
+    result = steadystep("probe", "chain", "--policies", "naive", "implicit-euler", "--duration", "1", "--json")
     assert result.returncode == 0, result.stderr
     found = json.loads(result.stdout)
-    assert [r["policy"] for r in found] == ["naive", "spring"]
+    assert [r["policy"] for r in found] == ["naive", "implicit-euler"]
     for r in found:
         assert 0.001 < r["stable_s"] < r["unstable_s"] <= 0.25 and r["reason"]
 
@@ -101,18 +101,18 @@ def test_convert_all_three_ways_equal_the_package():
 @pytest.mark.parametrize("args", [
     ["frobnicate"],
     [],
-    ["run", "oscillator", "--policy", "spring"],
+    ["run", "oscillator", "--policy", "implicit-euler"],
     ["run", "oscillator", "--profile", "fixed:30", "--policy", "sideways"],
-    ["run", "nosuch", "--profile", "fixed:30", "--policy", "spring"],
-    ["run", "oscillator", "--profile", "fixed:-30", "--policy", "spring"],
-    ["run", "oscillator", "--profile", "warp:9", "--policy", "spring"],
-    ["run", "oscillator", "--profile", "trace:/no/such/file", "--policy", "spring"],
-    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--duration", "-1"],
-    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--duration", "inf"],
-    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--seed", "-4"],
-    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--max-step", "0"],
-    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--json", "--csv", "x.csv"],
-    ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--csv", "no/such/dir/x.csv"],
+    ["run", "nosuch", "--profile", "fixed:30", "--policy", "implicit-euler"],
+    ["run", "oscillator", "--profile", "fixed:-30", "--policy", "implicit-euler"],
+    ["run", "oscillator", "--profile", "warp:9", "--policy", "implicit-euler"],
+    ["run", "oscillator", "--profile", "trace:/no/such/file", "--policy", "implicit-euler"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler", "--duration", "-1"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler", "--duration", "inf"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler", "--seed", "-4"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler", "--max-step", "0"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler", "--json", "--csv", "x.csv"],
+    ["run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler", "--csv", "no/such/dir/x.csv"],
     ["convert", "--k", "40"],
     ["convert", "--k", "40", "--c", "1", "--erp", "0.2", "--dt", "0.1"],
     ["convert", "--k", "-40", "--c", "1", "--dt", "0.1"],

@@ -52,7 +52,7 @@ def test_matched_and_exact_equal_c_and_agree_without_history():
     p = math.exp(-1.0 * h / mass)
     assert matched.cfm == pytest.approx(h * p / (mass * (1 - p)), rel=1e-12)
     assert softness_for("matched", spring, mass, h) == matched
-    assert softness_for("spring", spring, mass, h) == softness_from_spring(spring, h)
+    assert softness_for("implicit-euler", spring, mass, h) == softness_from_spring(spring, h)
     assert softness_for("exact", spring, mass, h, 1 / 20) == exact_softness(spring, mass, h, 1 / 20)
 
 

@@ -44,10 +44,10 @@ OUT = "{out}"
 SUBCOMMANDS = {
     "figure": (["figure", "--out", OUT, "--duration", "0.2", "--seed", "1"], ["--duration", "--seed"]),
     "compare": (["compare", "--out", OUT, "--scenes", "oscillator", "--profiles", "fixed:30", "--policies",
-                 "spring", "--duration", "0.2", "--seed", "1"], ["--duration", "--seed"]),
-    "run": (["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--duration", "0.2", "--json"],
+                 "implicit-euler", "--duration", "0.2", "--seed", "1"], ["--duration", "--seed"]),
+    "run": (["run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler", "--duration", "0.2", "--json"],
             ["--duration", "--seed", "--max-step"]),
-    "probe": (["probe", "oscillator", "--policies", "spring", "--duration", "0.2", "--low", "0.01", "--high", "0.1",
+    "probe": (["probe", "oscillator", "--policies", "implicit-euler", "--duration", "0.2", "--low", "0.01", "--high", "0.1",
                "--json"], ["--duration", "--low", "--high"]),
     "convert k c": (["convert", "--k", "40", "--c", "1", "--dt", "0.02", "--mass", "1", "--json"],
                     ["--k", "--c", "--dt", "--mass"]),
@@ -128,7 +128,7 @@ def random_text(rng: random.Random) -> str:
     if kind == 0:
         raw = bytes(rng.randrange(1, 256) for _ in range(rng.randrange(0, 40)))
     elif kind == 1:
-        head = rng.choice(["fixed", "uniform", "jitter", "hitch", "vsync", "trace", "oscillator", "spring", "naive"])
+        head = rng.choice(["fixed", "uniform", "jitter", "hitch", "vsync", "trace", "oscillator", "implicit-euler", "naive"])
         fields = [rng.choice(HOSTILE_NUMBERS + ["30", "60", "0.1", "1/60", "", "-"]) for _ in range(rng.randrange(4))]
         raw = ":".join([head, *fields]).encode("utf-8", "surrogateescape")
     elif kind == 2:
@@ -141,16 +141,16 @@ def random_text(rng: random.Random) -> str:
 def test_random_byte_arguments_in_every_slot(capsys, tmp_path):
     rng = random.Random(8)
     slots = [
-        lambda t: ["run", t, "--profile", "fixed:30", "--policy", "spring", "--duration", "0.2", "--json"],
-        lambda t: ["run", "oscillator", "--profile", t, "--policy", "spring", "--duration", "0.2",
+        lambda t: ["run", t, "--profile", "fixed:30", "--policy", "implicit-euler", "--duration", "0.2", "--json"],
+        lambda t: ["run", "oscillator", "--profile", t, "--policy", "implicit-euler", "--duration", "0.2",
                    "--json"],
         lambda t: ["run", "chain", "--profile", "fixed:30", "--policy", t, "--duration", "0.2"],
         lambda t: ["run", "oscillator", "--profile", "fixed:30", "--policy", "naive", "--duration", t, "--json"],
-        lambda t: ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring", "--duration", "0.2",
+        lambda t: ["run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler", "--duration", "0.2",
                    "--max-step", t, "--json"],
         lambda t: ["probe", t, "--duration", "0.2", "--json"],
         lambda t: ["probe", "oscillator", "--policies", t, "--duration", "0.2"],
-        lambda t: ["compare", "--out", str(tmp_path), "--scenes", t, "--profiles", "fixed:30", "--policies", "spring",
+        lambda t: ["compare", "--out", str(tmp_path), "--scenes", t, "--profiles", "fixed:30", "--policies", "implicit-euler",
                    "--duration", "0.2"],
         lambda t: ["compare", "--out", str(tmp_path), "--scenes", "oscillator", "--profiles", "fixed:30", t,
                    "--duration", "0.2"],
@@ -173,8 +173,8 @@ def test_random_byte_arguments_in_every_slot(capsys, tmp_path):
 
 
 def test_nul_and_lone_surrogates_from_python_are_refused_by_name(capsys):
-    for argv in (["run", "oscillator\0", "--profile", "fixed:30", "--policy", "spring"],
-                 ["run", "oscillator", "--profile", "fixed:30\0garbage", "--policy", "spring"],
+    for argv in (["run", "oscillator\0", "--profile", "fixed:30", "--policy", "implicit-euler"],
+                 ["run", "oscillator", "--profile", "fixed:30\0garbage", "--policy", "implicit-euler"],
                  ["run", "oscillator", "--profile", "fixed:30", "--policy", "spring\ud800"],
                  ["probe", "\ud800"]):
         code, out, err = run_cli(capsys, argv)
@@ -211,14 +211,14 @@ def test_trace_files_of_any_bytes(capsys, tmp_path):
     rng = random.Random(80)
     codes = {}
     for path in trace_files(tmp_path, rng):
-        for policy in ("spring", "naive"):
+        for policy in ("implicit-euler", "naive"):
             argv = ["run", "oscillator", "--profile", f"trace:{path}", "--policy", policy, "--duration", "0.3",
                     "--json"]
             code, out, err = run_cli(capsys, argv)
             check_outcome(argv, code, out, err)
             codes[os.path.basename(path), policy] = code
-    assert codes["bad\udcffname.txt", "spring"] == 0  # a good trace under a name that is not UTF-8 works
-    assert codes["random.bin", "spring"] == 2 and codes["nul_only.txt", "naive"] == 2
+    assert codes["bad\udcffname.txt", "implicit-euler"] == 0  # a good trace under a name that is not UTF-8 works
+    assert codes["random.bin", "implicit-euler"] == 2 and codes["nul_only.txt", "naive"] == 2
 
 
 def steadystep_bytes(*args: bytes):
@@ -228,13 +228,13 @@ def steadystep_bytes(*args: bytes):
 def test_non_utf8_argv_through_the_real_command(tmp_path):
     (tmp_path / os.fsdecode(b"tr\xe9ce.txt")).write_bytes(b"0.02\n0.05\n")
     cases = [
-        ([b"run", b"\xff\xfe", b"--profile", b"fixed:30", b"--policy", b"spring"], 2),
+        ([b"run", b"\xff\xfe", b"--profile", b"fixed:30", b"--policy", b"implicit-euler"], 2),
         ([b"run", b"oscillator", b"--profile", b"fixed:30", b"--policy", b"spr\xc3ing"], 2),
-        ([b"run", b"oscillator", b"--profile", b"trace:/no/such/\xff", b"--policy", b"spring"], 2),
+        ([b"run", b"oscillator", b"--profile", b"trace:/no/such/\xff", b"--policy", b"implicit-euler"], 2),
         ([b"convert", b"--k", b"4\xff0", b"--c", b"1", b"--dt", b"0.1"], 2),
         ([b"compare", b"--scenes", b"osc\x80", b"--out", os.fsencode(tmp_path / "report")], 2),
         ([b"run", b"oscillator", b"--profile", b"trace:" + os.fsencode(tmp_path) + b"/tr\xe9ce.txt", b"--policy",
-          b"spring", b"--duration", b"0.5", b"--json"], 0),
+          b"implicit-euler", b"--duration", b"0.5", b"--json"], 0),
     ]
     for args, expected in cases:
         result = steadystep_bytes(*args)

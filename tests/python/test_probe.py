@@ -17,16 +17,16 @@ def test_the_bracket_is_tight_and_the_stable_side_is_stable():
 
 
 def test_implicit_euler_keeps_the_lone_spring_stable_at_every_step():
-    found = probe.largest_stable_step("oscillator", "spring", duration_s=2.0)
+    found = probe.largest_stable_step("oscillator", "implicit-euler", duration_s=2.0)
     assert found.stable_s == probe.DEFAULT_HIGH_S and math.isinf(found.unstable_s) and found.trials == 1
 
 
 @pytest.mark.parametrize("scene, policy, kwargs", [
-    ("nosuch", "spring", {}),
+    ("nosuch", "implicit-euler", {}),
     ("chain", "sideways", {}),
-    ("chain", "spring", {"low_s": 0.2, "high_s": 0.1}),
-    ("chain", "spring", {"duration_s": float("nan")}),
-    ("chain", "spring", {"tolerance": 0}),
+    ("chain", "implicit-euler", {"low_s": 0.2, "high_s": 0.1}),
+    ("chain", "implicit-euler", {"duration_s": float("nan")}),
+    ("chain", "implicit-euler", {"tolerance": 0}),
 ])
 def test_bad_input_is_refused(scene, policy, kwargs):
     with pytest.raises(SteadystepError):

@@ -52,15 +52,15 @@ def test_a_binary_trace_is_refused_in_one_printable_line(tmp_path, capsys):
     message = error.value.message
     assert str(trace) in message
     assert not any(ord(ch) < 32 or 127 <= ord(ch) < 160 for ch in message), message
-    code, out, err = run_cli(capsys, "run", "oscillator", "--profile", f"trace:{trace}", "--policy", "spring")
+    code, out, err = run_cli(capsys, "run", "oscillator", "--profile", f"trace:{trace}", "--policy", "implicit-euler")
     assert code == EXIT_BAD_INPUT and len(err.splitlines()) == 1 and "\x1b" not in err
 
 
 def test_names_and_specs_of_the_wrong_kind_raise_steadystep_error():
     bad_calls = [
-        (lambda: runs.run(None, "fixed:30", "spring", 0.1), "scene = None"),
-        (lambda: runs.run("oscillator\0", "fixed:30", "spring", 0.1), "NUL"),
-        (lambda: runs.run("oscillator", b"fixed:30\0x", "spring", 0.1), "NUL"),
+        (lambda: runs.run(None, "fixed:30", "implicit-euler", 0.1), "scene = None"),
+        (lambda: runs.run("oscillator\0", "fixed:30", "implicit-euler", 0.1), "NUL"),
+        (lambda: runs.run("oscillator", b"fixed:30\0x", "implicit-euler", 0.1), "NUL"),
         (lambda: runs.run("oscillator", "fixed:30", "spring\ud800", 0.1), "surrogate"),
         (lambda: runs.run("oscillator", "fixed:30", 3, 0.1), "policy = 3"),
         (lambda: runs.scene_info(["oscillator"]), "scene = ['oscillator']"),
@@ -71,20 +71,20 @@ def test_names_and_specs_of_the_wrong_kind_raise_steadystep_error():
         (lambda: Profile("fixed:30", seed=10**5000), "seed = <an integer of"),
         (lambda: frame_times("fixed:30", 10**9), "count = 1000000000"),
         (lambda: frame_times("fixed:30", 2.5), "count = 2.5"),
-        (lambda: runs.run("oscillator", "fixed:30", "spring", "5"), "duration_s = '5'"),
-        (lambda: runs.run("oscillator", "fixed:30", "spring", 0.1, stepping={"max_steps_per_frame": 2**40}),
+        (lambda: runs.run("oscillator", "fixed:30", "implicit-euler", "5"), "duration_s = '5'"),
+        (lambda: runs.run("oscillator", "fixed:30", "implicit-euler", 0.1, stepping={"max_steps_per_frame": 2**40}),
          "stepping.max_steps_per_frame"),
-        (lambda: runs.run("oscillator", "fixed:30", "spring", 0.1, stepping={"max_step_s": "fast"}),
+        (lambda: runs.run("oscillator", "fixed:30", "implicit-euler", 0.1, stepping={"max_step_s": "fast"}),
          "stepping.max_step_s = 'fast'"),
-        (lambda: runs.run("oscillator", "fixed:30", "spring", 0.1, params={"spring": 5}), "params.spring = 5"),
-        (lambda: runs.run("oscillator", "fixed:30", "spring", 0.1, params=[1]), "params = [1]"),
+        (lambda: runs.run("oscillator", "fixed:30", "implicit-euler", 0.1, params={"spring": 5}), "params.spring = 5"),
+        (lambda: runs.run("oscillator", "fixed:30", "implicit-euler", 0.1, params=[1]), "params = [1]"),
         (lambda: runs.Scene("oscillator").frame("long"), "frame_s = 'long'"),
         (lambda: convert.softness_from_spring("ab", 0.1), "k = 'a'"),
         (lambda: convert.softness_from_spring((1, 2, 3), 0.1), "spring = (1, 2, 3)"),
         (lambda: convert.spring_from_softness(None, 0.1), "softness = None"),
         (lambda: convert.softness_for(5, (40, 1), 1, 0.1), "mapping = 5"),
         (lambda: convert.matched_softness((40, 1), [], 0.1), "mass = []"),
-        (lambda: probe.largest_stable_step("oscillator", "spring", tolerance=1e-300), "tolerance = 1e-300"),
+        (lambda: probe.largest_stable_step("oscillator", "implicit-euler", tolerance=1e-300), "tolerance = 1e-300"),
     ]
     for call, named in bad_calls:
         with pytest.raises(SteadystepError) as error:
@@ -113,7 +113,7 @@ def test_an_internal_error_is_one_line_with_its_own_exit_code(capsys, monkeypatc
 
 
 def test_a_reader_that_goes_away_ends_the_command_quietly():
-    command = [*COMMAND, "run", "oscillator", "--profile", "fixed:1000", "--policy", "spring", "--duration", "60",
+    command = [*COMMAND, "run", "oscillator", "--profile", "fixed:1000", "--policy", "implicit-euler", "--duration", "60",
                "--max-step", "0.001"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     process.stdout.read(100)
@@ -176,10 +176,10 @@ def test_the_bound_is_in_the_help_and_the_docstrings():
 
 
 def test_runs_above_the_bound_are_refused_by_name_before_they_start(capsys):
-    code, out, err = run_cli(capsys, "run", "oscillator", "--profile", "fixed:30", "--policy", "spring",
+    code, out, err = run_cli(capsys, "run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler",
                              "--duration", "1e9")
     assert code == EXIT_BAD_INPUT and "duration_s = 1e+09" in err and str(MAX_RUN_STEPS) in err
-    code, out, err = run_cli(capsys, "run", "oscillator", "--profile", "fixed:1e12", "--policy", "spring")
+    code, out, err = run_cli(capsys, "run", "oscillator", "--profile", "fixed:1e12", "--policy", "implicit-euler")
     assert code == EXIT_BAD_INPUT and "'fixed:1e12'" in err and str(MAX_RUN_STEPS) in err
     code, out, err = run_cli(capsys, "compare", "--duration", "1e9", "--scenes", "oscillator")
     assert code == EXIT_BAD_INPUT and "duration_s = 1e+09" in err
@@ -188,19 +188,19 @@ def test_runs_above_the_bound_are_refused_by_name_before_they_start(capsys):
     with pytest.raises(SteadystepError, match="duration_s = 1e\\+09"):
         runs.run("oscillator", "fixed:30", "naive", 1e9)
     with pytest.raises(SteadystepError, match="'fixed:1e12'"):
-        runs.run("oscillator", "fixed:1e12", "spring", 5.0)
+        runs.run("oscillator", "fixed:1e12", "implicit-euler", 5.0)
 
 
 def test_the_bound_sits_where_limits_says():
     # Steps: duration_s / max_step_s against MAX_RUN_STEPS, on either side of it.
     step_s = 1.0 / 1000
-    stepping = runs.make_stepping("spring", max_step_s=step_s)
+    stepping = runs.make_stepping("implicit-euler", max_step_s=step_s)
     with pytest.raises(SteadystepError, match="duration_s"):
         runs.check_run_size("fixed:1", MAX_RUN_STEPS * step_s * 1.001, 1, stepping)
     runs.check_run_size("fixed:1", MAX_RUN_STEPS * step_s * 0.999, 1, stepping)
     # Frames: a profile of 2000 fps against MAX_RUN_STEPS frames, with steps far below the bound.
     rate = 2000
-    coarse = runs.make_stepping("spring", max_step_s=1.0)
+    coarse = runs.make_stepping("implicit-euler", max_step_s=1.0)
     assert frame_count(f"fixed:{rate}", MAX_RUN_STEPS / rate * 0.999) < MAX_RUN_STEPS
     runs.check_run_size(f"fixed:{rate}", MAX_RUN_STEPS / rate * 0.999, 1, coarse)
     with pytest.raises(SteadystepError, match=f"'fixed:{rate}'"):
@@ -210,7 +210,7 @@ def test_the_bound_sits_where_limits_says():
 def test_a_profile_that_hands_out_a_frame_that_is_not_finite_is_refused():
     # 1/1e-320 overflows: the library's profile hands out infinite frames today; the run refuses them by name.
     with pytest.raises(SteadystepError, match="fixed:1e-320"):
-        runs.run("oscillator", "fixed:1e-320", "spring", 1.0)
+        runs.run("oscillator", "fixed:1e-320", "implicit-euler", 1.0)
 
 
 # ---- the pure-Python model and metrics ------------------------------------------------------------------------

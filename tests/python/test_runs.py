@@ -14,12 +14,13 @@ def test_scenes_and_policies_come_from_the_library():
     names = [info.name for info in runs.scenes()]
     assert {"oscillator", "buggy", "drop", "chain", "pile"} <= set(names)
     assert runs.scene_info("oscillator").quantities == ("x", "v", "erp", "cfm")
-    assert runs.policy_names() == ["naive", "spring", "matched", "exact", "fixed"]
+    assert runs.policy_names() == ["naive", "implicit-euler", "matched", "exact", "fixed", "fixed-matched",
+                                   "fixed-exact"]
     assert runs.default_params("oscillator")["spring"] == {"stiffness": 40.0, "damping": 1.0}
 
 
 def test_run_records_every_step_as_numpy_arrays():
-    result = runs.run("oscillator", "uniform:15:45", "spring", duration_s=2.0, seed=5)
+    result = runs.run("oscillator", "uniform:15:45", "implicit-euler", duration_s=2.0, seed=5)
     assert result.status == "ok" and not result.blew_up
     assert result.step_count == len(result.step_lengths) == len(result.quantities["x"])
     assert np.all(result.step_lengths > 0) and np.all(result.step_lengths <= 1 / 60 + 1e-12)
@@ -32,9 +33,9 @@ def test_run_records_every_step_as_numpy_arrays():
 
 
 def test_same_seed_same_run_other_seed_another():
-    a = runs.run("oscillator", "uniform:15:45", "spring", 1.0, seed=3)
-    b = runs.run("oscillator", "uniform:15:45", "spring", 1.0, seed=3)
-    c = runs.run("oscillator", "uniform:15:45", "spring", 1.0, seed=4)
+    a = runs.run("oscillator", "uniform:15:45", "implicit-euler", 1.0, seed=3)
+    b = runs.run("oscillator", "uniform:15:45", "implicit-euler", 1.0, seed=3)
+    c = runs.run("oscillator", "uniform:15:45", "implicit-euler", 1.0, seed=4)
     assert np.array_equal(a.quantities["x"], b.quantities["x"])
     assert not np.array_equal(a.times, c.times)
 
@@ -46,8 +47,8 @@ def test_reference_run_steps_at_a_millisecond():
 
 
 def test_python_frame_loop_matches_the_c_run():
-    c_run = runs.run("oscillator", "uniform:15:45", "spring", 1.0, seed=11, stepping={"max_step_s": 1 / 15})
-    scene = runs.Scene("oscillator", "spring", stepping={"max_step_s": 1 / 15})
+    c_run = runs.run("oscillator", "uniform:15:45", "implicit-euler", 1.0, seed=11, stepping={"max_step_s": 1 / 15})
+    scene = runs.Scene("oscillator", "implicit-euler", stepping={"max_step_s": 1 / 15})
     profile = Profile("uniform:15:45", seed=11)
     xs = []
     elapsed_s = 0.0
@@ -63,13 +64,13 @@ def test_python_frame_loop_matches_the_c_run():
 
 def test_bad_run_input_is_refused():
     with pytest.raises(SteadystepError, match="nosuch"):
-        runs.run("nosuch", "fixed:30", "spring", 1.0)
+        runs.run("nosuch", "fixed:30", "implicit-euler", 1.0)
     with pytest.raises(SteadystepError, match="mass"):
-        runs.run("oscillator", "fixed:30", "spring", 1.0, params={"mass": -1.0})
+        runs.run("oscillator", "fixed:30", "implicit-euler", 1.0, params={"mass": -1.0})
     with pytest.raises(SteadystepError, match="colour"):
-        runs.run("oscillator", "fixed:30", "spring", 1.0, params={"colour": 1})
+        runs.run("oscillator", "fixed:30", "implicit-euler", 1.0, params={"colour": 1})
     with pytest.raises(SteadystepError) as error:
-        runs.run("oscillator", "fixed:30", "spring", 0.0)
+        runs.run("oscillator", "fixed:30", "implicit-euler", 0.0)
     assert error.value.status == "out of range"
     with pytest.raises(SteadystepError, match="bogus"):
         runs.run("oscillator", "fixed:30", "bogus", 1.0)
@@ -78,10 +79,10 @@ def test_bad_run_input_is_refused():
 def test_spring_halves_the_spread_of_naive_in_every_soft_scene():
     soft_scenes = ["oscillator", "buggy", "drop", "chain"]
     result = report.compare(soft_scenes, ["fixed:30", "uniform:15:45", "hitch:60:30:0.1", "vsync:60:30"],
-                            ["naive", "spring"], duration_s=2.0, seed=1, progress=False)
+                            ["naive", "implicit-euler"], duration_s=2.0, seed=1, progress=False)
     for scene in soft_scenes:
         for quantity in runs.motion_quantities(scene):
             naive = result.spreads[scene]["naive"][quantity]
-            spring = result.spreads[scene]["spring"][quantity]
+            spring = result.spreads[scene]["implicit-euler"][quantity]
             assert math.isfinite(spring), (scene, quantity)
             assert spring <= 0.5 * naive, (scene, quantity, spring, naive)

@@ -1,0 +1,95 @@
+/* steadystep: how frames become physics steps, as plain data (no ODE types), shared by the stepper (stepper.h), the
+ * lab (scene.h) and the Python package.
+ *
+ * Two independent choices make a way of stepping:
+ *  - the cut: how a frame's time becomes steps (one step of the whole frame; equal substeps no longer than
+ *    max_step_s; or constant steps of fixed_step_s from an accumulator, "fix your timestep");
+ *  - the mapping: how each bound spring becomes ODE's ERP/CFM for a step (spring.h: implicit Euler, matched,
+ *    exact), for the step's own length, or frozen at one length as ODE programs usually do.
+ * Every combination works. The lab's policies are named presets of these (ssSteppingForPolicy).
+ */
+#ifndef STEADYSTEP_STEPPING_H
+#define STEADYSTEP_STEPPING_H
+
+#include "steadystep/spring.h"
+#include "steadystep/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** How a frame's time becomes physics steps. */
+typedef enum ssFrameCut {
+  SS_CUT_WHOLE_FRAME = 0, /* one step of the whole frame (what ODE programs usually do) */
+  SS_CUT_SUBSTEPS = 1,    /* n = ceil(frame / max_step_s) equal substeps (the article: cap the step) */
+  SS_CUT_FIXED = 2,       /* steps of fixed_step_s from an accumulator, at most max_steps_per_frame a frame, with an
+                           * interpolation factor for rendering */
+} ssFrameCut;
+
+/** Which ODE solver a step calls. */
+typedef enum ssSolver {
+  SS_SOLVER_QUICK = 0, /* dWorldQuickStep, iterative: the world's own iteration count and SOR w */
+  SS_SOLVER_STEP = 1,  /* dWorldStep, the direct (big matrix) solver */
+} ssSolver;
+
+/** Everything about stepping that needs no ODE handle. Start from ssDefaultStepping(). */
+typedef struct ssStepping {
+  ssFrameCut cut;          /* default SS_CUT_SUBSTEPS */
+  ssMapping mapping;       /* default SS_MAPPING_IMPLICIT_EULER */
+  /* > 0: every step's softness is computed for this step length (s), whatever the step's own: fixed ERP/CFM, the
+   * way ODE programs are usually tuned (the naive policy). 0 (default): each step's own length. */
+  double frozen_step_s;
+  ssSolver solver;         /* default SS_SOLVER_QUICK */
+  /* dWorldQuickStep iterations written into the world before each frame, >= 0; default 0: the world's own setting
+   * is left as the program set it. The stepper writes no other solver setting. */
+  int quick_iterations;
+  double max_step_s;       /* SUBSTEPS: the longest substep (s), in [SS_MIN_STEP_S, SS_MAX_STEP_S]; default 1/60 */
+  double fixed_step_s;     /* FIXED: the constant step (s), in the same range; default 1/60 */
+  int max_steps_per_frame; /* FIXED: cap against the spiral of death (later time is dropped), > 0; default 8 */
+  /* A known body faster than this after a step is a runaway (m/s, rad/s), in [0, SS_MAX_SAFE_SPEED]. Default
+   * 1e4 m/s and 1e4 rad/s: far above anything a game moves, and a blow-up is stopped long before ODE 0.16 would
+   * abort the process (a non-finite rotation fails an assertion inside the next step). Raise them for faster
+   * bodies; 0 leaves only the guard ODE itself needs, SS_MAX_SAFE_SPEED (limits.h). */
+  double max_speed;
+  double max_angular_speed;
+} ssStepping;
+
+/** The defaults listed at each field. */
+ssStepping ssDefaultStepping(void);
+
+/** Checks every field, naming the first one out of range.
+ *  Errors: SS_ERROR_OUT_OF_RANGE (NULL, or a field outside its range), SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED
+ *  (an unknown cut, mapping or solver). */
+ssStatus ssValidateStepping(const ssStepping* stepping);
+
+/** The cut's name: "whole-frame", "substeps", "fixed"; NULL for an unknown value. */
+const char* ssFrameCutName(ssFrameCut cut);
+
+/** The lab's policies, named presets of (cut, mapping, frozen step), in the order the lab reports them:
+ *    naive           whole frame, implicit Euler frozen at the reference step: the problem the article fixes
+ *    implicit-euler  substeps, implicit Euler at each step's length: the article's method
+ *    matched         substeps, matched
+ *    exact           substeps, exact
+ *    fixed           fixed steps, implicit Euler
+ *    fixed-matched   fixed steps, matched
+ *    fixed-exact     fixed steps, exact */
+int ssPolicyCount(void);
+
+/** The name of policy index (0 <= index < ssPolicyCount()), or NULL. */
+const char* ssPolicyNameAt(int index);
+
+/** Sets stepping's cut, mapping and frozen step to the policy's (the other fields are kept). reference_step_s (s,
+ *  in the step range) is the length naive freezes its softness at, e.g. the step a program was tuned for.
+ *  Errors, with stepping unchanged: SS_ERROR_PARSE for an unknown name (named, with the known ones);
+ *  SS_ERROR_OUT_OF_RANGE for NULL or a reference_step_s out of range; SS_ERROR_NOT_FINITE. */
+ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssStepping* stepping);
+
+/** The name of the policy stepping is (cut, mapping and whether the softness is frozen), or NULL when it is no
+ *  preset (e.g. whole frame with matched). */
+const char* ssSteppingPolicyName(const ssStepping* stepping);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
