@@ -23,7 +23,7 @@ typedef struct JointBinding {
   ssSoftness written;    /* last written: the registry owns the row, so an unchanged value is not written again */
   double load; /* the steady force or torque the row carries (ssRegistry_SetJointLoad); 0 = none declared */
   double load_correction; /* the force this Apply adds along the row for the load (N or N·m) */
-  /* The spring mapping needs the mass only for the Nyquist report: it is refreshed every few Applies there. */
+  /* The implicit-Euler mapping needs the mass only for the Nyquist report: it is refreshed every few Applies there. */
   double report_mass;
   int report_mass_age;
   /* what pending was computed from: the mappings are pure functions of these, so equal inputs reuse it */
@@ -242,14 +242,14 @@ static ssStatus failBinding(ssStatus status, const JointBinding* binding) {
                 ssJointParamName(binding->param), binding->axis, cause);
 }
 
-/* How many Applies of the spring mapping reuse a computed effective mass for the Nyquist report. */
+/* How many Applies of the implicit-Euler mapping reuse a computed effective mass for the Nyquist report. */
 enum { kReportMassRefresh = 16 };
 
 /* The softness of one row for this step, counting the fallbacks in the report. */
 static void countRow(const ssRowLaw* law, double mass, double step_s, const ssRowFallback* fallback,
                      ssApplyReport* report) {
   report->rows_exact_fallback += fallback->exact_to_matched;
-  report->rows_spring_fallback += fallback->to_spring;
+  report->rows_implicit_euler_fallback += fallback->to_implicit_euler;
   if (!law->hard) report->rows_over_nyquist += ssOverNyquist(law->spring, mass, step_s);
 }
 
@@ -263,8 +263,8 @@ static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass,
 }
 
 /* The binding's mass for this Apply: given, or computed (every time where the mapping depends on it; under the
- * spring mapping every few Applies, for the Nyquist report). NAN when the row has none (no dynamic body, or a
- * transmission): the accurate mappings then hand the row to the spring mapping. */
+ * implicit-Euler mapping every few Applies, for the Nyquist report). NAN when the row has none (no dynamic body, or a
+ * transmission): the accurate mappings then hand the row to the implicit-Euler mapping. */
 static double bindingMass(JointBinding* binding, ssMapping mapping) {
   if (binding->effective_mass > 0) return binding->effective_mass;
   if (binding->law.hard) return NAN;
@@ -347,7 +347,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
       status = ssCheckSoftnessForOde("softness", registry->world_pending.erp, registry->world_pending.cfm);
     if (status != SS_OK) return failBinding(status, NULL);
   }
-  /* Programs bind many rows to a few springs: under the spring mapping each one's softness is computed once. */
+  /* Programs bind many rows to a few springs: under the implicit-Euler mapping each one's softness is computed once. */
   enum { kCacheSize = 4 };
   ssRowLaw cached_law[kCacheSize];
   ssSoftness cached_softness[kCacheSize];

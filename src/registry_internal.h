@@ -51,9 +51,9 @@ ssSoftness ssRegistryTunedWorld(const ssRegistry* registry);
 /* Undoes ssRegistry_AdoptWorld, when the rest of an adoption failed. */
 void ssRegistryForgetWorldAdoption(ssRegistry* registry);
 
-/* ssContactSoften for a law, without checking its arguments; *spring_fallback (may be NULL) says whether the
- * accurate mapping handed the contact to the spring mapping. */
+/* ssContactSoften for a law, without checking its arguments; *implicit_euler_fallback (may be NULL) says whether the
+ * accurate mapping handed the contact to the implicit-Euler mapping. */
 ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
-                            double step_s, double previous_step_s, int* spring_fallback);
+                            double step_s, double previous_step_s, int* implicit_euler_fallback);
 
 #endif

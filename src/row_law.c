@@ -1,4 +1,4 @@
-/* Row laws: a spring or a hard row, and the one rule for when an accurate mapping hands a row to the spring one. */
+/* Row laws: a spring or a hard row, and the one rule for when an accurate mapping hands a row to the implicit-Euler one. */
 #include "row_law.h"
 
 #include <math.h>
@@ -60,7 +60,7 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
       if (status != SS_ERROR_NO_FINITE_MAPPING) return status;
     }
     fallback->exact_to_matched = 0;
-    fallback->to_spring = 1;
+    fallback->to_implicit_euler = 1;
   }
   return ssSoftnessFromSpring(law->spring, step_s, out);
 }

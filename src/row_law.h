@@ -15,7 +15,7 @@ typedef struct ssRowLaw {
 /* How a row's softness for one step was obtained, beyond the mapping asked for. */
 typedef struct ssRowFallback {
   int exact_to_matched; /* SS_MAPPING_EXACT had no finite softness for this pair of steps: matched was used */
-  int to_spring;        /* an accurate mapping could not serve the row: the spring mapping was used */
+  int to_implicit_euler;        /* an accurate mapping could not serve the row: the implicit-Euler mapping was used */
 } ssRowFallback;
 
 /* A spring's law (the spring is not checked here: bind time does). */
@@ -28,8 +28,8 @@ ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tune
 
 /* The softness of the row for a step of step_s under mapping. mass (kg or kg·m²) is read by the accurate mappings
  * only; pass NAN when the row has none. Where MATCHED or EXACT cannot serve the row (no mass, c = 0, natural
- * frequency above the step's Nyquist frequency, no finite softness) the spring mapping serves it and
- * fallback->to_spring says so. fallback may be NULL. Errors: those of ssSoftnessFromSpring. */
+ * frequency above the step's Nyquist frequency, no finite softness) the implicit-Euler mapping serves it and
+ * fallback->to_implicit_euler says so. fallback may be NULL. Errors: those of ssSoftnessFromSpring. */
 ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
                        ssRowFallback* fallback, ssSoftness* out);
 

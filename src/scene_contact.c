@@ -23,7 +23,7 @@ static void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
     contact->surface.mode = recipe->surface_mode;
     contact->surface.mu = recipe->mu;
     /* Only a validated spring gets here, and an accurate mapping that cannot serve a contact hands it to the
-     * spring mapping: softening cannot fail, so no contact is dropped. */
+     * implicit-Euler mapping: softening cannot fail, so no contact is dropped. */
     const ssStepInfo* step = &call->step;
     ssContactSoften(contact, body1, body2, recipe->spring, step->mapping, step->softness_step_s,
                     step->previous_step_s);

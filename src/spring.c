@@ -34,7 +34,7 @@ static ssStatus softness_from_spring(ssSpring spring, double step_s, ssSoftness*
     return ssFail(SS_ERROR_NO_FINITE_MAPPING,
                   "k = %g N/m, c = %g N*s/m at step_s = %g s: h*k + c = %g N*s/m gives cfm = %g, above %g", spring.stiffness,
                   spring.damping, step_s, hk_plus_c, softness.cfm, SS_MAX_CFM);
-  status = ssCheckComputedSoftness("spring mapping", softness);
+  status = ssCheckComputedSoftness("implicit-Euler mapping", softness);
   if (status != SS_OK) return status;
   *result = softness;
   return SS_OK;

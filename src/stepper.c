@@ -214,7 +214,7 @@ ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID 
   if (status != SS_OK) return status;
   if (stepper->report != NULL) {
     stepper->report->contacts_softened += 1;
-    stepper->report->contacts_spring_fallback += fell_back;
+    stepper->report->contacts_implicit_euler_fallback += fell_back;
   }
   return SS_OK;
 }
@@ -367,7 +367,7 @@ static ssStatus apply(ssStepper* stepper, ssMapping mapping, double step_s, doub
   report->apply.rows_written += applied.rows_written;
   report->apply.rows_over_nyquist += applied.rows_over_nyquist;
   report->apply.rows_exact_fallback += applied.rows_exact_fallback;
-  report->apply.rows_spring_fallback += applied.rows_spring_fallback;
+  report->apply.rows_implicit_euler_fallback += applied.rows_implicit_euler_fallback;
   return SS_OK;
 }
 

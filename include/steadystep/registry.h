@@ -45,10 +45,10 @@ typedef struct ssApplyReport {
   int rows_written;           /* joint parameter sets brought up to date, plus 1 for a bound world */
   int rows_over_nyquist;      /* rows whose natural frequency exceeds half the step rate (1/(2h)) */
   int rows_exact_fallback;    /* SS_MAPPING_EXACT rows that this step length could not serve: matched was used */
-  /* SS_MAPPING_MATCHED or SS_MAPPING_EXACT rows served by the spring mapping for this step: rows above the step's
+  /* SS_MAPPING_MATCHED or SS_MAPPING_EXACT rows served by the implicit-Euler mapping for this step: rows above the step's
    * Nyquist frequency (near-rigid), undamped rows, rows with no effective mass, rows whose accurate softness would
    * underflow or overflow. */
-  int rows_spring_fallback;
+  int rows_implicit_euler_fallback;
 } ssApplyReport;
 
 /** Creates an empty registry for world. Returns NULL when out of memory. */
@@ -79,7 +79,7 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
  *  k' = erp/(h·cfm) differ from k, so under a load the rest position would be load/k' instead of load/k. With the
  *  load declared, every Apply under those mappings adds load·(k'/k - 1) along the row (the opposite to the second
  *  body) for the coming step, which puts the rest position back at load/k; for a lone spring under a constant load
- *  the exact mapping's samples are then exact again. The spring mapping needs nothing (its k' is k). Call Apply
+ *  the exact mapping's samples are then exact again. The implicit-Euler mapping needs nothing (its k' is k). Call Apply
  *  once per step (the stepper does), since the force is added each time. Binding the row again clears the load.
  *  Errors: SS_ERROR_NOT_FINITE; SS_ERROR_OUT_OF_RANGE for |load| > SS_MAX_FORCE_N (limits.h), or a NULL registry;
  *  SS_ERROR_NOT_FOUND when that row is not bound; SS_ERROR_UNSUPPORTED for SS_PARAM_JOINT rows, which have no

@@ -34,7 +34,7 @@ typedef struct ssSpring {
 
 /** ODE's softness of one constraint row for one step. */
 typedef struct ssSoftness {
-  double erp; /* error reduction parameter, non-dimensional; [0, 1] for the spring mapping, may exceed 1 for the
+  double erp; /* error reduction parameter, non-dimensional; [0, 1] for the implicit-Euler mapping, may exceed 1 for the
                * others; |erp| <= SS_MAX_ERP (limits.h) */
   double cfm; /* constraint force mixing, m/(N·s) for a linear row (what ODE multiplies the force by),
                * in (0, SS_MAX_CFM] */

@@ -91,7 +91,8 @@ typedef struct ssFrameReport {
   double interpolation;       /* FIXED: accumulator / fixed_step_s in [0, 1), to blend the last two states */
   ssApplyReport apply;        /* summed over the frame's steps */
   int contacts_softened;      /* contacts softened with ssStepper_SoftenContact */
-  int contacts_spring_fallback; /* of those, contacts the accurate mapping could not serve: spring mapping used */
+  int contacts_implicit_euler_fallback; /* of those, contacts the accurate mapping could not serve: implicit Euler
+                                         * served them */
   dBodyID failed_body;        /* the body that blew up or ran too fast, else 0 */
 } ssFrameReport;
 
@@ -137,7 +138,7 @@ ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
  *  world's ERP/CFM, as the program tuned them at the registry's tuned step (ssRegistry_Adopt), become a spring; it
  *  is written back as soft_erp/soft_cfm for this step's length and mapping, both mode bits set. body1 and body2
  *  (either may be 0 for the static world) give the effective mass along the normal for matched and exact; where
- *  those cannot serve the contact, the spring mapping does (counted in the frame report). A contact tuned with
+ *  those cannot serve the contact, the implicit-Euler mapping does (counted in the frame report). A contact tuned with
  *  cfm = 0 stays hard (erp follows h as for adopted hard rows).
  *  Errors, with the contact unchanged: SS_ERROR_OUT_OF_RANGE (stepper or contact NULL, no tuned step: adopt
  *  first, or a tuned erp outside [0, 1] or cfm < 0); SS_ERROR_NOT_FINITE. */

@@ -162,7 +162,7 @@ double RmsAgainst(const OscillatorRig& variable, const OscillatorRig& fixed) {
   return std::sqrt(sum / variable.t.size()) / variable.x0;
 }
 
-// The article's claim: with the spring mapping a run at 15-45 fps stays with the run at 30 fps; with ERP/CFM
+// The article's claim: with the implicit-Euler mapping a run at 15-45 fps stays with the run at 30 fps; with ERP/CFM
 // frozen at their 30 fps values it does not.
 TEST_F(Oscillator, SpringIsConsistentAcrossFrameRatesAndNaiveIsNot) {
   double spring_sum = 0, naive_sum = 0;
@@ -252,7 +252,7 @@ TEST_F(Oscillator, ExactReproducesTheExactMotionUnderVariableFrames) {
   }
 }
 
-// Gravity along the slider: the spring mapping keeps the static deflection m g / k (its erp/(h cfm) is k); matched
+// Gravity along the slider: the implicit-Euler mapping keeps the static deflection m g / k (its erp/(h cfm) is k); matched
 // and exact have erp/(h cfm) != k, so their rest position is off unless the load is declared, which makes exact
 // exact again. The figures are printed; see docs/exact-mappings.md.
 TEST_F(Oscillator, GravityAlongTheSliderByMapping) {
@@ -301,7 +301,7 @@ TEST_F(Oscillator, UndampedSpringUnderMatchedGetsTheSpringMappingCounted) {
   ssFrameReport report;
   ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 30.0, &report), SS_OK) << ssLastError();
   EXPECT_EQ(report.steps, 2);
-  EXPECT_EQ(report.apply.rows_spring_fallback, 2);
+  EXPECT_EQ(report.apply.rows_implicit_euler_fallback, 2);
   ssSoftness spring;
   ASSERT_EQ(ssSoftnessFromSpring(rig.spring, 1.0 / 60.0, &spring), SS_OK);
   EXPECT_EQ(dJointGetSliderParam(rig.slider, dParamStopERP), spring.erp);

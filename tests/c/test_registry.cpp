@@ -349,7 +349,7 @@ TEST_F(RegistryTest, ContactSoftenFillsTheSurface) {
   ssMatchedSoftness(kSpring, 2.0, 0.02, &expected);
   EXPECT_NEAR(contact.surface.soft_cfm, expected.cfm, 1e-12);
 
-  // Without a dynamic body there is no mass for matched: the spring mapping serves the contact, none is dropped.
+  // Without a dynamic body there is no mass for matched: the implicit-Euler mapping serves the contact, none is dropped.
   ASSERT_EQ(ssContactSoften(&contact, nullptr, nullptr, kSpring, SS_MAPPING_MATCHED, 0.02, 0), SS_OK);
   ssSoftnessFromSpring(kSpring, 0.02, &expected);
   EXPECT_EQ(contact.surface.soft_cfm, expected.cfm);

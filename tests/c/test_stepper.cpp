@@ -25,7 +25,7 @@ TEST_F(StepperTest, FramesAreSplitIntoEqualSubstepsNoLongerThanTheMaximum) {
     EXPECT_EQ(report.steps, c.steps) << c.frame_s;
     EXPECT_NEAR(report.step_s, c.frame_s / c.steps, 1e-15);
     EXPECT_NEAR(report.simulated_s, c.frame_s, 1e-15);
-    EXPECT_EQ(report.apply.rows_written, 1);  // the spring mapping is written once a frame
+    EXPECT_EQ(report.apply.rows_written, 1);  // the implicit-Euler mapping is written once a frame
   }
 }
 
