@@ -303,7 +303,8 @@ ssStatus ssRegistry_AdoptWorld(ssRegistry* registry, double tuned_step_s, ssAdop
   if (status != SS_OK) return status;
   double adopted_s = ssRegistry_TunedStep(registry);
   if (adopted_s != 0 && adopted_s != tuned_step_s)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "tuned_step_s = %g s: this registry adopted values tuned at %g s", tuned_step_s,
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "tuned_step_s = %g s: this registry adopted values tuned at %g s",
+                  tuned_step_s,
                   adopted_s);
   if (adopted_s != 0) return SS_OK; /* adopted already: idempotent */
   dWorldID world = ssRegistryWorld(registry);
@@ -311,7 +312,8 @@ ssStatus ssRegistry_AdoptWorld(ssRegistry* registry, double tuned_step_s, ssAdop
   ssRowLaw law;
   status = ssRowLawFromTuned("world", tuned.erp, tuned.cfm, tuned_step_s, &law);
   PlannedBody defaults = {0};
-  if (status == SS_OK) status = dampingRate("world", dWorldGetLinearDamping(world), tuned_step_s, &defaults.linear_rate_per_s);
+  if (status == SS_OK)
+    status = dampingRate("world", dWorldGetLinearDamping(world), tuned_step_s, &defaults.linear_rate_per_s);
   if (status == SS_OK)
     status = dampingRate("world", dWorldGetAngularDamping(world), tuned_step_s, &defaults.angular_rate_per_s);
   if (status == SS_OK)

@@ -371,8 +371,9 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
     double previous_s = mapping == SS_MAPPING_EXACT ? previous_step_s : 0;
-    if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_mapping == mapping && binding->computed_mass == mass &&
-        binding->computed_step_s == step_s && binding->computed_previous_s == previous_s) {
+    int same_inputs = binding->computed_mapping == mapping && binding->computed_mass == mass &&
+                      binding->computed_step_s == step_s && binding->computed_previous_s == previous_s;
+    if (mapping != SS_MAPPING_IMPLICIT_EULER && same_inputs) {
       countRow(&binding->law, mass, step_s, &binding->computed_fallback, &counts);
       continue;
     }

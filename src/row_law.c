@@ -1,4 +1,4 @@
-/* Row laws: a spring or a hard row, and the one rule for when an accurate mapping hands a row to the implicit-Euler one. */
+/* Row laws: a spring or a hard row, and the one rule for when an accurate mapping hands a row to implicit Euler. */
 #include "row_law.h"
 
 #include <math.h>

@@ -33,7 +33,8 @@ ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tune
 ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
                        ssRowFallback* fallback, ssSoftness* out);
 
-/* w·h > π, i.e. k·h² > π²·m: the spring's natural frequency is above half the step rate. False for a NAN mass. */
+/* w·h > π, i.e. k·h² > π²·m: the spring's natural frequency is above half the step rate. False for a NAN
+ * mass. */
 int ssOverNyquist(ssSpring spring, double mass, double step_s);
 
 #endif

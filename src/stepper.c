@@ -128,7 +128,7 @@ ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body) {
   REQUIRE_STEPPER(stepper);
   if (body == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "body = NULL: a body is required");
   for (int i = 0; i < stepper->watched_count; ++i)
-    if (stepper->watched[i] == body) ssStepper_UnwatchBody(stepper, body);
+    if (stepper->watched[i] == body) stepper->watched[i--] = stepper->watched[--stepper->watched_count];
   ssRegistry* registry = stepper->def.registry;
   if (registry != NULL) {
     if (ssRegistryHasBody(registry, body)) ssRegistry_UnbindBody(registry, body);
@@ -209,8 +209,8 @@ ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID 
   }
   const ssStepInfo* step = &stepper->current;
   int fell_back = 0;
-  ssStatus status = ssContactSoftenLaw(contact, body1, body2, &stepper->contact_law, step->mapping, step->softness_step_s,
-                              step->previous_step_s, &fell_back);
+  ssStatus status = ssContactSoftenLaw(contact, body1, body2, &stepper->contact_law, step->mapping,
+                                       step->softness_step_s, step->previous_step_s, &fell_back);
   if (status != SS_OK) return status;
   if (stepper->report != NULL) {
     stepper->report->contacts_softened += 1;

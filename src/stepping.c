@@ -42,7 +42,8 @@ static ssStatus checkSpeed(const char* name, const char* unit, double value) {
 ssStatus ssValidateStepping(const ssStepping* stepping) {
   if (stepping == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping = NULL: a stepping is required");
   if (ssFrameCutName(stepping->cut) == NULL)
-    return ssFail(SS_ERROR_UNSUPPORTED, "stepping.cut = %d: unknown (0 whole-frame, 1 substeps, 2 fixed)", (int)stepping->cut);
+    return ssFail(SS_ERROR_UNSUPPORTED, "stepping.cut = %d: unknown (0 whole-frame, 1 substeps, 2 fixed)",
+                  (int)stepping->cut);
   if (ssMappingName(stepping->mapping) == NULL)
     return ssFail(SS_ERROR_UNSUPPORTED, "stepping.mapping = %d: unknown (0 implicit-euler, 1 matched, 2 exact)",
                   (int)stepping->mapping);
@@ -52,10 +53,12 @@ ssStatus ssValidateStepping(const ssStepping* stepping) {
     return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.quick_iterations = %d: must not be negative (0 = the world's own)",
                   stepping->quick_iterations);
   if (stepping->max_steps_per_frame <= 0)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.max_steps_per_frame = %d: must be positive", stepping->max_steps_per_frame);
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.max_steps_per_frame = %d: must be positive",
+                  stepping->max_steps_per_frame);
   ssStatus status = ssCheckStepLength("stepping.max_step_s", stepping->max_step_s);
   if (status == SS_OK) status = ssCheckStepLength("stepping.fixed_step_s", stepping->fixed_step_s);
-  if (status == SS_OK && stepping->frozen_step_s != 0) status = ssCheckStepLength("stepping.frozen_step_s", stepping->frozen_step_s);
+  if (status == SS_OK && stepping->frozen_step_s != 0)
+    status = ssCheckStepLength("stepping.frozen_step_s", stepping->frozen_step_s);
   if (status == SS_OK) status = checkSpeed("stepping.max_speed", "m/s", stepping->max_speed);
   if (status == SS_OK) status = checkSpeed("stepping.max_angular_speed", "rad/s", stepping->max_angular_speed);
   return status;

@@ -45,9 +45,9 @@ typedef struct ssApplyReport {
   int rows_written;           /* joint parameter sets brought up to date, plus 1 for a bound world */
   int rows_over_nyquist;      /* rows whose natural frequency exceeds half the step rate (1/(2h)) */
   int rows_exact_fallback;    /* SS_MAPPING_EXACT rows that this step length could not serve: matched was used */
-  /* SS_MAPPING_MATCHED or SS_MAPPING_EXACT rows served by the implicit-Euler mapping for this step: rows above the step's
-   * Nyquist frequency (near-rigid), undamped rows, rows with no effective mass, rows whose accurate softness would
-   * underflow or overflow. */
+  /* SS_MAPPING_MATCHED or SS_MAPPING_EXACT rows served by the implicit-Euler mapping for this step: rows above the
+   * step's Nyquist frequency (near-rigid), undamped rows, rows with no effective mass, rows whose accurate softness
+   * would underflow or overflow. */
   int rows_implicit_euler_fallback;
 } ssApplyReport;
 
