@@ -32,4 +32,5 @@ if [ ! -x "$venv/bin/python" ]; then
   "$venv/bin/pip" install --quiet --upgrade pip
 fi
 "$venv/bin/pip" install --quiet scikit-build-core
-"$venv/bin/pip" install --quiet --no-build-isolation "$repo[test]"
+# test: pytest and ode-python (the tests' own ODE worlds); report: matplotlib and tqdm (figures, the report).
+"$venv/bin/pip" install --quiet --no-build-isolation "$repo[test,report]"

@@ -1,11 +1,29 @@
 """steadystep: frame-rate independent constraint softness for the Open Dynamics Engine, from Python.
 
-The conversions (``softness_from_spring`` ...), the article's own model (``steadystep.article``), frame-time
-profiles, scenes and runs on real ODE (``steadystep.runs``), metrics, figures and the report. Every failure of the
-C library raises ``SteadystepError`` (a ValueError) naming the value at fault.
+On a program's own ODE world (built with odepy, PyPI ode-python): ``Registry`` (bind springs, adopt what the program
+tuned), ``Stepper`` (one call per frame: substeps, mappings, forces kept over the frame, failures refused until
+reset), ``Stepper.soften_contact`` in the near callback, and ``Stepping`` for how frames become steps. The
+conversions (``softness_from_spring`` ..., scalars or numpy arrays), the lab's profiles and runs on built-in scenes
+(``steadystep.runs``, ``steadystep.profiles``), the article's model (``steadystep.article``), metrics; figures and
+the HTML report need the ``report`` extra (``pip install steadystep[report]``). Every failure of the C library
+raises ``SteadystepError`` (a ValueError) naming the value at fault. Importing the package changes no global state.
 """
 
 from steadystep._native import SteadystepError
+from steadystep.convert import (Softness, Spring, exact_softness, frequency_from_spring, matched_softness,
+                                softness_for, softness_from_spring, spring_from_frequency, spring_from_softness)
+from steadystep.enums import FrameCut, JointParam, Mapping, Solver, Status
+from steadystep.profiles import Profile, frame_times
+from steadystep.registry import (AdoptReport, ApplyReport, Registry, contact_soften, joint_effective_mass,
+                                 joint_supports)
+from steadystep.stepper import FrameReport, Stepper, StepInfo
+from steadystep.stepping import Stepping, policy_names
 
-__all__ = ["SteadystepError"]
+__all__ = [
+    "AdoptReport", "ApplyReport", "FrameCut", "FrameReport", "JointParam", "Mapping", "Profile", "Registry",
+    "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper", "SteadystepError", "Stepping", "contact_soften",
+    "exact_softness", "frame_times", "frequency_from_spring", "joint_effective_mass", "joint_supports",
+    "matched_softness", "policy_names", "softness_for", "softness_from_spring", "spring_from_frequency",
+    "spring_from_softness",
+]
 __version__ = "0.1.0"

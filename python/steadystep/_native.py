@@ -52,6 +52,31 @@ def _cdef_source() -> str:
 
 ffi = cffi.FFI()
 ffi.cdef(_cdef_source())
+
+# ---- the core for a program's own ODE world (registry, adoption, stepper) ------------------------------------------
+# These headers take ODE's handles. ODE's own headers are not read: cffi needs only the handles' names, as opaque
+# pointers (the Python side passes addresses, e.g. of an odepy world), dReal (a double build, as Debian's) and
+# dContact, which the library reads and writes through a pointer only. limits.h brings the integer bounds
+# (SS_MAX_RUN_STEPS ...); its floating-point #defines are not kept (cffi's ABI mode takes integer constants only).
+_ODE_HANDLES = """
+typedef struct dxWorld* dWorldID;
+typedef struct dxBody* dBodyID;
+typedef struct dxJoint* dJointID;
+typedef struct dxSpace* dSpaceID;
+typedef struct dxJointGroup* dJointGroupID;
+typedef double dReal;
+typedef struct dContact dContact;
+"""
+_CORE_HEADERS = ("limits.h", "registry.h", "adopt.h", "stepper.h")
+
+
+def _core_cdef_source() -> str:
+    return _ODE_HANDLES + "\n".join(_declarations((INCLUDE_DIR / header).read_text()) for header in _CORE_HEADERS)
+
+
+ffi.cdef(_core_cdef_source())
+# ---- end of the core for a program's own world ----------------------------------------------------------------------
+
 lib = ffi.dlopen(str(LIBRARY_PATH))
 
 

@@ -1,0 +1,84 @@
+"""ODE handles from Python: an odepy handle as it is, or a plain integer address, as the C type the library takes.
+
+odepy (PyPI ode-python) types its handles as ctypes pointers to opaque structs named after ODE's own (dWorldID is
+POINTER(dxWorld), dBodyID POINTER(dxBody), ...), so the kind of a handle is checked by that name, without importing
+odepy. A NULL handle (None, 0, an odepy NULL pointer) is passed on: the library refuses it by name where one is
+required, as it does in C. A handle of another kind, or any other object, is refused here by name. An integer is
+taken as the address it is: the library cannot tell a stale or foreign address from a live object (nor can C).
+"""
+
+from __future__ import annotations
+
+import ctypes
+
+from steadystep._native import SteadystepError, ffi, shown
+
+# The kind of handle, as the library's parameter names say it -> (ODE's struct name, the C type of the parameter).
+KINDS = {
+    "world": ("dxWorld", "dWorldID"),
+    "body": ("dxBody", "dBodyID"),
+    "joint": ("dxJoint", "dJointID"),
+    "space": ("dxSpace", "dSpaceID"),
+    "joint group": ("dxJointGroup", "dJointGroupID"),
+}
+_ADDRESS_LIMIT = 2**64
+
+
+def _wrong(name: str, kind: str, value, what: str) -> SteadystepError:
+    return SteadystepError("out of range", f"{name} = {shown(value)}: {what}; must be an ODE {kind} (an odepy "
+                           f"{KINDS[kind][1] if kind in KINDS else 'dContact'} or an integer address)")
+
+
+def address(name: str, kind: str, value) -> int:
+    """The address of the ODE object `value` of the given kind ("world", "body", "joint", "space", "joint group"),
+    0 for NULL. Raises SteadystepError naming the parameter for a handle of another kind or a foreign object."""
+    struct_name, c_type = KINDS[kind]
+    if value is None:
+        return 0
+    if isinstance(value, bool):
+        raise _wrong(name, kind, value, "a bool")
+    if isinstance(value, int):
+        if not 0 <= value < _ADDRESS_LIMIT:
+            raise _wrong(name, kind, value, "not an address")
+        return value
+    if isinstance(value, ctypes._Pointer):
+        pointee = type(value)._type_.__name__
+        if pointee != struct_name:
+            raise _wrong(name, kind, value, f"a pointer to {pointee}, not to {struct_name}")
+        return ctypes.cast(value, ctypes.c_void_p).value or 0
+    if isinstance(value, ctypes.c_void_p):
+        return value.value or 0
+    if isinstance(value, ffi.CData):
+        ctype = ffi.typeof(value)
+        if ctype.kind == "pointer" and ctype.item.cname in (f"struct {struct_name}", "void"):
+            return int(ffi.cast("uintptr_t", value))
+        raise _wrong(name, kind, value, f"a C {ctype.cname}")
+    raise _wrong(name, kind, value, f"a {type(value).__name__}")
+
+
+def handle(name: str, kind: str, value):
+    """value as the library's handle type (dWorldID ...), NULL included: see address()."""
+    return ffi.cast(KINDS[kind][1], address(name, kind, value))
+
+
+def contact(name: str, value):
+    """An ODE dContact as the library's `dContact*`: an odepy dContact (a ctypes Structure, by its address), a
+    ctypes pointer to one, or an integer address; None or 0 is NULL (refused by the library by name)."""
+    if value is None:
+        return ffi.NULL
+    if isinstance(value, bool):
+        raise _wrong(name, "contact", value, "a bool")
+    if isinstance(value, int):
+        if not 0 <= value < _ADDRESS_LIMIT:
+            raise _wrong(name, "contact", value, "not an address")
+        return ffi.cast("dContact*", value)
+    if isinstance(value, ctypes.Structure):
+        if type(value).__name__ != "dContact":
+            raise _wrong(name, "contact", value, f"a {type(value).__name__}, not a dContact")
+        return ffi.cast("dContact*", ctypes.addressof(value))
+    if isinstance(value, ctypes._Pointer):
+        pointee = type(value)._type_.__name__
+        if pointee != "dContact":
+            raise _wrong(name, "contact", value, f"a pointer to {pointee}, not to dContact")
+        return ffi.cast("dContact*", ctypes.cast(value, ctypes.c_void_p).value or 0)
+    raise _wrong(name, "contact", value, f"a {type(value).__name__}")

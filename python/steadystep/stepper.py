@@ -1,0 +1,249 @@
+"""The stepper for a program's own ODE world (stepper.h): one call per rendered frame instead of dWorldQuickStep.
+
+    stepper = Stepper(world, registry, policy="exact", collide=collide, contact_group=contacts)
+    for frame_s in frames:                    # the frame's real length (s)
+        odepy.dBodyAddForce(car, throttle, 0, 0)   # forces added once a frame act for the whole frame
+        report = stepper.step(frame_s)        # FrameReport; SteadystepError on a blow-up: repair, then reset()
+
+Callbacks are plain Python callables, called from C during step(): before_step(stepper) and collide(stepper) before
+each physics step (stepper.current_step() tells the step), step_done(step_s) after each step that passed the
+checks. collide typically calls odepy.dSpaceCollide(space, None, near) and the near callback calls
+stepper.soften_contact(contact, body1, body2) before dJointCreateContact. An exception raised by a callback does
+not cross C: it is kept, the callbacks are not called again for the rest of that frame (whose remaining steps
+ODE still takes), and step() raises it once the frame is over.
+
+Handles (world, bodies, joints, the contact group) are odepy handles or integer addresses, borrowed: the world and
+the registry must outlive the stepper (it keeps its Registry alive; close() the stepper before dWorldDestroy).
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from steadystep import _handles
+from steadystep._native import SteadystepError, check, ffi, lib, number, shown
+from steadystep.enums import Mapping, Status
+from steadystep.registry import ApplyReport, Registry, from_struct
+from steadystep.stepping import Stepping, stepping_from
+
+
+@dataclass(frozen=True)
+class StepInfo:
+    """The physics step about to be taken (ssStepInfo), as current_step() gives it inside the callbacks."""
+
+    mapping: Mapping = field(metadata={"convert": Mapping})  # the mapping this step's softness is written with
+    step_s: float            # the length of the step about to be taken (s)
+    softness_step_s: float   # the step length the softness is for (s): step_s, or stepping.frozen_step_s
+    previous_step_s: float   # the step before, for Mapping.EXACT (s); 0 when there is no usable history
+    index: int               # 0-based index of this step within the frame
+    count: int               # steps this frame takes
+
+
+@dataclass(frozen=True)
+class FrameReport:
+    """What one frame did (ssFrameReport)."""
+
+    steps: int                   # physics steps taken
+    step_s: float                # length of the last step taken (s); 0 when none
+    simulated_s: float           # time simulated this frame (s)
+    carried_s: float             # time carried to the next frame (s): FIXED's accumulator, or a too-short frame
+    dropped_s: float             # FIXED: time dropped by max_steps_per_frame (s)
+    interpolation: float         # FIXED: accumulator / fixed_step_s in [0, 1), to blend the last two states
+    apply: ApplyReport = field(metadata={"struct": ApplyReport})  # summed over the frame's steps
+    contacts_softened: int       # contacts softened with soften_contact
+    contacts_spring_fallback: int  # of those, served by the implicit-Euler mapping
+    failed_body: int = field(metadata={"convert": lambda body: int(ffi.cast("uintptr_t", body))})
+    # the address of the body that blew up or ran too fast, else 0 (compare with ctypes.cast(body, c_void_p).value)
+
+
+def _checked_callable(name: str, value):
+    if value is not None and not callable(value):
+        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be callable or None")
+    return value
+
+
+class Stepper:
+    """Steps one ODE world frame by frame (ssStepper).
+
+    world: an odepy dWorldID or an address. registry: a Registry of that world, or None (nothing soft is rewritten,
+    only watched bodies are known). stepping: a Stepping, or policy: a preset's name (policy_names()), whose naive
+    softness is frozen at reference_step_s (s; default the registry's tuned step, else 1/60 s); neither: the
+    defaults. before_step(stepper), collide(stepper): called before each physics step; step_done(step_s): after
+    each step that passed the checks. contact_group: an odepy dJointGroupID emptied after every step, or None.
+    Raises SteadystepError naming a bad value."""
+
+    def __init__(self, world, registry: Registry | None = None, *, stepping: Stepping | None = None,
+                 policy: str | None = None, reference_step_s: float | None = None,
+                 before_step: Callable[["Stepper"], object] | None = None,
+                 collide: Callable[["Stepper"], object] | None = None,
+                 step_done: Callable[[float], object] | None = None, contact_group=None):
+        if registry is not None and not isinstance(registry, Registry):
+            raise SteadystepError("out of range", f"registry = {shown(registry)}: must be a steadystep.Registry or "
+                                  "None")
+        if reference_step_s is None:
+            tuned = registry.tuned_step_s if registry is not None else 0.0
+            reference_step_s = tuned if tuned > 0 else 1.0 / 60.0
+        self._stepping = stepping_from(stepping, policy, reference_step_s)
+        self._registry = registry  # kept alive: the C stepper borrows it
+        self._user = {"before_step": _checked_callable("before_step", before_step),
+                      "collide": _checked_callable("collide", collide),
+                      "step_done": _checked_callable("step_done", step_done)}
+        self._pending: BaseException | None = None  # the first exception a callback raised in this frame
+        self._in_frame = False
+        self._report = None
+
+        definition = ffi.new("ssStepperDef*", lib.ssDefaultStepperDef())
+        definition.world = _handles.handle("world", "world", world)
+        definition.registry = registry._handle() if registry is not None else ffi.NULL
+        definition.stepping = self._stepping.as_c_fields()
+        definition.contact_group = _handles.handle("contact_group", "joint group", contact_group)
+        # The C callbacks hold only a weak reference, so that the stepper can be collected; they live as long as
+        # the stepper (self._callbacks), which is what C needs.
+        me = weakref.ref(self)
+        self._callbacks = []
+        if before_step is not None:
+            definition.before_step = self._callback("ssStepCallback*", lambda context, handle: _call(me, "before_step"))
+        if collide is not None:
+            definition.collide = self._callback("ssStepCallback*", lambda context, handle: _call(me, "collide"))
+        if step_done is not None:
+            definition.step_done = self._callback("ssStepDoneFn*",
+                                                  lambda context, step_s: _call(me, "step_done", step_s))
+        out = ffi.new("ssStepper**")
+        check(lib.ssStepper_Create(definition, out))
+        self._stepper = ffi.gc(out[0], lib.ssStepper_Destroy)
+
+    def _callback(self, ctype: str, function):
+        made = ffi.callback(ctype, function)
+        self._callbacks.append(made)
+        return made
+
+    def _handle(self):
+        if self._stepper is None:
+            raise SteadystepError("out of range", "stepper: used after close()")
+        return self._stepper
+
+    def _between_frames(self, what: str):
+        if self._in_frame:
+            raise SteadystepError("out of range", f"stepper.{what}: called from a callback of the same stepper, "
+                                  "inside its frame")
+        return self._handle()
+
+    @property
+    def registry(self) -> Registry | None:
+        return self._registry
+
+    @property
+    def stepping(self) -> Stepping:
+        """How frames become steps now."""
+        return Stepping.from_c(lib.ssStepper_Stepping(self._handle()))
+
+    @stepping.setter
+    def stepping(self, stepping: Stepping) -> None:
+        """Changes the stepping between frames (resets the step history and the FIXED accumulator)."""
+        stepping = stepping_from(stepping, None, 0.0)
+        check(lib.ssStepper_SetStepping(self._between_frames("stepping"),
+                                        ffi.new("ssStepping*", stepping.as_c_fields())))
+        self._stepping = stepping
+
+    def step(self, frame_s: float) -> FrameReport:
+        """Advances the world by one frame of frame_s seconds (0 <= frame_s <= 3600; 0 does nothing). Forces the
+        program added to known bodies before this call act for the whole frame. Raises SteadystepError with the
+        library's message (the world left as it was for a refused frame); for a blow-up or a runaway
+        (Status.BLOWUP, Status.SPEED_LIMIT) the error's `report` is the FrameReport, whose failed_body names the
+        body, and every later frame is refused (Status.FAILED) until reset(). An exception raised by a callback
+        is raised here, after the frame, with the frame's FrameReport (or its error) as its `steadystep_report`
+        (or `__context__`)."""
+        handle = self._between_frames("step")
+        frame_s = number("frame_s", frame_s, "s")
+        report = ffi.new("ssFrameReport*")
+        self._pending = None
+        self._in_frame = True
+        try:
+            status = lib.ssStepper_Step(handle, frame_s, report)
+        finally:
+            self._in_frame = False
+        pending, self._pending = self._pending, None
+        made = from_struct(FrameReport, report[0])
+        error = None
+        try:
+            check(status)
+        except SteadystepError as failure:
+            if status in (Status.BLOWUP, Status.SPEED_LIMIT):
+                failure.report = made
+            error = failure
+        if pending is not None:
+            try:
+                pending.steadystep_report = made
+            except AttributeError:
+                pass
+            if error is not None:
+                raise pending from error
+            raise pending
+        if error is not None:
+            raise error
+        return made
+
+    def current_step(self) -> StepInfo:
+        """The step about to be taken: meaningful inside before_step and collide; between frames, the next step of
+        the default length."""
+        return from_struct(StepInfo, lib.ssStepper_CurrentStep(self._handle()))
+
+    def soften_contact(self, contact, body1, body2) -> None:
+        """In the near callback, before dJointCreateContact: turns the contact's tuned softness (its soft_erp /
+        soft_cfm where surface.mode has them, else the world's ERP/CFM, as tuned at the registry's tuned step) into
+        the softness for the step about to be taken. contact: an odepy dContact (or its address); body1, body2 its
+        bodies (None for the static world). Raises SteadystepError with the contact unchanged (adopt first)."""
+        check(lib.ssStepper_SoftenContact(self._handle(), _handles.contact("contact", contact),
+                                          _handles.handle("body1", "body", body1),
+                                          _handles.handle("body2", "body", body2)))
+
+    def reset(self) -> None:
+        """After a failure, once the program repaired or restored its bodies: accepts frames again. Also forgets
+        the step history, the FIXED accumulator and the momentum carried over."""
+        lib.ssStepper_Reset(self._between_frames("reset"))
+
+    def reset_history(self) -> None:
+        """Forgets the previous step length (after teleporting a body or setting its velocity), so that the next
+        exact step maps the true velocities."""
+        lib.ssStepper_ResetHistory(self._between_frames("reset_history"))
+
+    def watch_body(self, body) -> None:
+        """Makes a body known: its forces kept for the whole frame, its state checked after each step."""
+        check(lib.ssStepper_WatchBody(self._handle(), _handles.handle("body", "body", body)))
+
+    def unwatch_body(self, body) -> None:
+        """Stops watching a body; SteadystepError ("not found") when it was not watched."""
+        check(lib.ssStepper_UnwatchBody(self._handle(), _handles.handle("body", "body", body)))
+
+    def destroy_body(self, body) -> None:
+        """Destroys a body the stepper may know (unwatched, unbound, its joints unbound, then dBodyDestroy). Use it
+        instead of odepy.dBodyDestroy for any known body."""
+        check(lib.ssStepper_DestroyBody(self._between_frames("destroy_body"), _handles.handle("body", "body", body)))
+
+    def destroy_joint(self, joint) -> None:
+        """Destroys a joint (unbound, then dJointDestroy). Use it instead of odepy.dJointDestroy for a bound or
+        adopted joint."""
+        check(lib.ssStepper_DestroyJoint(self._between_frames("destroy_joint"),
+                                         _handles.handle("joint", "joint", joint)))
+
+    def close(self) -> None:
+        """Destroys the stepper now (the world and the registry are left as they are). Call it before destroying
+        the world."""
+        if self._stepper is not None:
+            self._between_frames("close")
+            ffi.release(self._stepper)
+            self._stepper = None
+
+
+def _call(stepper_ref, which: str, *args) -> None:
+    """Runs a user callback from C. Nothing may propagate into C: the first exception is kept for step()."""
+    stepper = stepper_ref()
+    if stepper is None or stepper._pending is not None:
+        return
+    try:
+        function = stepper._user[which]
+        function(*args) if which == "step_done" else function(stepper)
+    except BaseException as error:  # noqa: BLE001 - re-raised by step(), KeyboardInterrupt included
+        stepper._pending = error

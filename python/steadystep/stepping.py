@@ -1,0 +1,93 @@
+"""How frames become physics steps (stepping.h): the cut of a frame and the mapping of each step, as one dataclass.
+
+    Stepping()                                        # the library's defaults: substeps of at most 1/60 s,
+                                                      # implicit Euler (the article's method)
+    Stepping.for_policy("exact")                      # a named preset: substeps, exact mapping
+    Stepping(cut=FrameCut.FIXED, mapping=Mapping.MATCHED, fixed_step_s=1 / 120)   # any combination
+
+Times in s, speeds in m/s and rad/s. The library validates (ssValidateStepping): a Stepper refuses a bad one with
+SteadystepError naming the field.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from steadystep._native import SteadystepError, c_string, check, ffi, integer, lib, number, shown, text
+from steadystep.enums import FrameCut, Mapping, Solver
+
+_DEFAULT = lib.ssDefaultStepping()
+_INT_RANGE = (-2**31, 2**31 - 1)
+
+
+def policy_names() -> list[str]:
+    """The library's named presets (naive, implicit-euler, matched, exact, fixed, fixed-matched, fixed-exact)."""
+    return [text(lib.ssPolicyNameAt(i)) for i in range(lib.ssPolicyCount())]
+
+
+@dataclass(frozen=True)
+class Stepping:
+    """Everything about stepping that needs no ODE handle (ssStepping); defaults are the library's."""
+
+    cut: FrameCut = FrameCut(_DEFAULT.cut)             # how a frame becomes steps
+    mapping: Mapping = Mapping(_DEFAULT.mapping)       # how each spring becomes ERP/CFM for a step
+    frozen_step_s: float = _DEFAULT.frozen_step_s      # s; > 0 freezes the softness at that step (naive); 0: none
+    solver: Solver = Solver(_DEFAULT.solver)           # dWorldQuickStep or dWorldStep
+    quick_iterations: int = _DEFAULT.quick_iterations  # QuickStep iterations set before each frame; 0: the world's
+    max_step_s: float = _DEFAULT.max_step_s            # SUBSTEPS: the longest substep (s), default 1/60
+    fixed_step_s: float = _DEFAULT.fixed_step_s        # FIXED: the constant step (s), default 1/60
+    max_steps_per_frame: int = _DEFAULT.max_steps_per_frame  # FIXED: steps a frame at most (later time dropped)
+    max_speed: float = _DEFAULT.max_speed              # m/s above which a known body is a runaway; 0: ODE's guard
+    max_angular_speed: float = _DEFAULT.max_angular_speed  # rad/s, likewise
+
+    @classmethod
+    def for_policy(cls, policy: str, reference_step_s: float = 1.0 / 60.0, **fields) -> "Stepping":
+        """The named preset's cut, mapping and frozen step (policy_names()) over Stepping(**fields).
+        reference_step_s (s) is the step naive freezes its softness at, e.g. the step the program was tuned for.
+        Raises SteadystepError ("parse error") naming an unknown policy."""
+        out = ffi.new("ssStepping*", cls(**fields).as_c_fields())
+        check(lib.ssSteppingForPolicy(c_string("policy", policy), number("reference_step_s", reference_step_s, "s"),
+                                      out))
+        return cls.from_c(out[0])
+
+    @classmethod
+    def from_c(cls, cdata) -> "Stepping":
+        """The Stepping of a C ssStepping."""
+        return cls(cut=FrameCut(cdata.cut), mapping=Mapping(cdata.mapping), frozen_step_s=cdata.frozen_step_s,
+                   solver=Solver(cdata.solver), quick_iterations=cdata.quick_iterations, max_step_s=cdata.max_step_s,
+                   fixed_step_s=cdata.fixed_step_s, max_steps_per_frame=cdata.max_steps_per_frame,
+                   max_speed=cdata.max_speed, max_angular_speed=cdata.max_angular_speed)
+
+    def as_c_fields(self) -> dict:
+        """The fields as the C struct takes them; SteadystepError naming a field whose value C cannot hold."""
+        out = {}
+        for item in dataclasses.fields(self):
+            value = getattr(self, item.name)
+            if item.type in ("float",):
+                out[item.name] = number(f"stepping.{item.name}", value)
+            else:  # the enums and the counts: C ints; the library names a value outside its range
+                out[item.name] = integer(f"stepping.{item.name}", value, *_INT_RANGE)
+        return out
+
+    def validate(self) -> None:
+        """Raises SteadystepError naming the first field out of range (ssValidateStepping)."""
+        check(lib.ssValidateStepping(ffi.new("ssStepping*", self.as_c_fields())))
+
+    @property
+    def policy(self) -> str | None:
+        """The name of the preset this stepping is, or None (e.g. the whole frame with matched)."""
+        return text(lib.ssSteppingPolicyName(ffi.new("ssStepping*", self.as_c_fields())))
+
+
+def stepping_from(stepping: Stepping | None, policy: str | None, reference_step_s: float) -> Stepping:
+    """One stepping from a Stepper's arguments: stepping, or the named policy, or the defaults (not both)."""
+    if stepping is not None and policy is not None:
+        raise SteadystepError("out of range", f"policy = {shown(policy)}: give either stepping or policy, not both")
+    if policy is not None:
+        return Stepping.for_policy(policy, reference_step_s)
+    if stepping is None:
+        return Stepping()
+    if not isinstance(stepping, Stepping):
+        raise SteadystepError("out of range", f"stepping = {shown(stepping)}: must be a steadystep.Stepping")
+    return stepping
