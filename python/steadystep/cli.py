@@ -212,7 +212,21 @@ def _first_non_finite(data, name: str = ""):
     return None
 
 
+REPORT_EXTRA = ("matplotlib", "tqdm")  # what figure and compare need beyond the core (pyproject's report extra)
+
+
+def _require_report_extra(command: str) -> None:
+    """Refuses the command in one line when the report extra is not installed."""
+    import importlib.util
+
+    missing = [name for name in REPORT_EXTRA if importlib.util.find_spec(name) is None]
+    if missing:
+        raise _UsageError(f"steadystep {command}: needs the report extra, {' and '.join(missing)} not installed: "
+                          "pip install 'steadystep[report]'")
+
+
 def _figure(args, argv) -> int:
+    _require_report_extra("figure")
     from steadystep.figures import article_figure
 
     args.out.mkdir(parents=True, exist_ok=True)
@@ -222,6 +236,7 @@ def _figure(args, argv) -> int:
 
 
 def _compare(args, argv) -> int:
+    _require_report_extra("compare")
     from steadystep import report
     from steadystep.figures import article_figure
 

@@ -1,4 +1,8 @@
-"""Figures with matplotlib (Agg, no display): the article's figure and the per-scene comparison plots.
+"""Figures with matplotlib: the article's figure and the per-scene comparison plots.
+
+Figures are made with matplotlib's Figure class and written to files, never shown: no backend is chosen, pyplot is
+not used, and the style applies only while a figure is drawn (rc_context), so neither importing this module nor
+drawing changes matplotlib's global state.
 
 One colour per policy everywhere, and the article's own colours for its figure (exact solution blue, fixed 30 fps
 red, variable 15-45 fps green). The reference run and the exact solution are drawn in black / blue, dashed.
@@ -6,20 +10,19 @@ red, variable 15-45 fps green). The reference run and the exact solution are dra
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from steadystep import article, runs  # noqa: E402
-from steadystep._native import SteadystepError, number, printable  # noqa: E402
-from steadystep.limits import MIN_MEASURED_DURATION_S  # noqa: E402
-from steadystep.profiles import seed_value  # noqa: E402
-from steadystep.files import save_figure  # noqa: E402
-from steadystep.profiles import frame_times  # noqa: E402
+from steadystep import article, runs
+from steadystep._native import SteadystepError, number, printable
+from steadystep.limits import MIN_MEASURED_DURATION_S
+from steadystep.profiles import seed_value
+from steadystep.files import save_figure
+from steadystep.profiles import frame_times
 
 POLICY_COLORS = {
     "naive": "#e6550d",    # orange
@@ -33,10 +36,19 @@ EXACT_COLOR = "#1f5fbf"      # the article's blue
 FIXED_30_COLOR = "#d62728"   # the article's red
 VARIABLE_COLOR = "#2ca02c"   # the article's green
 
-plt.rcParams.update({
+STYLE = {
     "figure.dpi": 100, "axes.grid": True, "grid.alpha": 0.3, "axes.spines.top": False,
     "axes.spines.right": False, "font.size": 10, "legend.fontsize": 9, "legend.framealpha": 0.9,
-})
+}
+
+
+def _styled(draw):
+    """draw with STYLE in force while it runs (matplotlib's rc_context: nothing global is left changed)."""
+    @functools.wraps(draw)
+    def styled(*args, **kwargs):
+        with matplotlib.rc_context(STYLE):
+            return draw(*args, **kwargs)
+    return styled
 
 
 def _label(text: str) -> str:
@@ -50,13 +62,13 @@ def policy_color(policy: str) -> str:
 
 
 def save(figure, out_dir: Path, stem: str, formats=("png", "svg")) -> list[Path]:
-    """Saves the figure as out_dir/stem.png and .svg (each written whole) and closes it."""
+    """Saves the figure as out_dir/stem.png and .svg (each written whole). A Figure made without pyplot needs no
+    closing: it is freed with its last reference."""
     out_dir = Path(out_dir)
-    paths = [save_figure(figure, out_dir / f"{stem}.{suffix}") for suffix in formats]
-    plt.close(figure)
-    return paths
+    return [save_figure(figure, out_dir / f"{stem}.{suffix}") for suffix in formats]
 
 
+@_styled
 def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> list[Path]:
     """The article's figure, twice: from its equations 4 and 5, and from real ODE with the article's method.
 
@@ -83,7 +95,8 @@ def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> lis
     variable_frames = frame_times("uniform:15:45", int(duration_s * 45) + 2, seed)
     variable_frames = variable_frames[: int(np.searchsorted(np.cumsum(variable_frames), duration_s)) + 1]
 
-    figure, axes = plt.subplots(2, 1, figsize=(12, 7.2), sharex=True, constrained_layout=True)
+    figure = Figure(figsize=(12, 7.2), constrained_layout=True)
+    axes = figure.subplots(2, 1, sharex=True)
     top, bottom = axes
     for ax in axes:
         ax.plot(fine_t, exact_x, color=EXACT_COLOR, lw=2.0, label="exact solution")
@@ -118,6 +131,7 @@ def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> lis
     return save(figure, out_dir, "article_figure")
 
 
+@_styled
 def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_dir: Path,
                  exact_curve=None) -> list[Path]:
     """One panel per profile: the quantity over time for each policy, over the reference (and exact solution).
@@ -128,8 +142,8 @@ def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_d
     policies = list(dict.fromkeys(policy for _, policy in results))
     columns = min(3, len(profiles))
     rows = (len(profiles) + columns - 1) // columns
-    figure, axes = plt.subplots(rows, columns, figsize=(4.6 * columns, 3.1 * rows + 0.8), squeeze=False,
-                                sharex=True, sharey=True, constrained_layout=True)
+    figure = Figure(figsize=(4.6 * columns, 3.1 * rows + 0.8), constrained_layout=True)
+    axes = figure.subplots(rows, columns, squeeze=False, sharex=True, sharey=True)
     low, high = _limits(reference.quantities[quantity],
                         [r.quantities[quantity] for r in results.values() if r.step_count])
     for index, profile in enumerate(profiles):
@@ -179,6 +193,7 @@ def _limits(reference: np.ndarray, others: list[np.ndarray]) -> tuple[float, flo
     return low - margin, high + margin
 
 
+@_styled
 def deviation_figure(scene: str, quantity: str, deviations: dict, out_dir: Path) -> list[Path]:
     """Grouped bars: the deviation per profile (groups) and policy (colours), on a log scale.
 
@@ -188,8 +203,9 @@ def deviation_figure(scene: str, quantity: str, deviations: dict, out_dir: Path)
     finite = [v for v in deviations.values() if np.isfinite(v) and v > 0]
     top = max(finite) * 3 if finite else 1.0
     bottom = min(finite) / 3 if finite else 1e-6
-    figure, ax = plt.subplots(figsize=(max(6.0, 1.3 * len(profiles) * max(1, len(policies)) / 2.5 + 2), 3.8),
-                              constrained_layout=True)
+    figure = Figure(figsize=(max(6.0, 1.3 * len(profiles) * max(1, len(policies)) / 2.5 + 2), 3.8),
+                    constrained_layout=True)
+    ax = figure.subplots()
     width = 0.8 / max(1, len(policies))
     for j, policy in enumerate(policies):
         positions, heights, hatched = [], [], []
