@@ -60,7 +60,7 @@ def largest_stable_step(scene: str, policy: str, duration_s: float = 3.0, low_s:
                         ) -> ProbeResult:
     """Bisects for the longest step in [low_s, high_s] at which scene stays stable under policy, to a relative
     tolerance (at least 1e-9). duration_s (s) is at least MIN_MEASURED_DURATION_S (0.1 s), and a trial at low_s may
-    take at most MAX_RUN_STEPS steps (limits.py): duration_s / low_s <= 1e6. Raises SteadystepError naming the value
+    take at most MAX_RUN_STEPS steps (limits.py): duration_s / low_s <= 1e7. Raises SteadystepError naming the value
     for bad input (the scene, policy and parameters are checked by the library)."""
     values = {}
     for name, value in (("duration_s", duration_s), ("low_s", low_s), ("high_s", high_s), ("tolerance", tolerance)):

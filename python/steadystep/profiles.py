@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from steadystep._native import SteadystepError, c_string, check, ffi, integer, lib, number, shown
-from steadystep.limits import MAX_RUN_STEPS
+from steadystep.limits import MAX_RUN_FRAMES
 
 DEFAULT_PROFILES = ("fixed:30", "uniform:15:45", "jitter:30:3", "hitch:60:30:0.1", "vsync:60:30")
 SEED_RANGE = (0, 2**64 - 1)
@@ -39,8 +39,8 @@ class Profile:
         return lib.ssProfile_Next(self._profile)
 
     def frames(self, count: int) -> np.ndarray:
-        """The next `count` frame durations (s); count in [0, MAX_RUN_STEPS] (limits.py)."""
-        count = integer("count", count, 0, MAX_RUN_STEPS)
+        """The next `count` frame durations (s); count in [0, MAX_RUN_FRAMES] (limits.py)."""
+        count = integer("count", count, 0, MAX_RUN_FRAMES)
         return np.array([lib.ssProfile_Next(self._profile) for _ in range(count)], dtype=float)
 
     def reset(self) -> None:
@@ -49,12 +49,12 @@ class Profile:
 
 
 def frame_times(spec: str, count: int, seed: int = 1) -> np.ndarray:
-    """`count` frame durations (s) of a profile from its start; count in [0, MAX_RUN_STEPS] (limits.py)."""
-    count = integer("count", count, 0, MAX_RUN_STEPS)
+    """`count` frame durations (s) of a profile from its start; count in [0, MAX_RUN_FRAMES] (limits.py)."""
+    count = integer("count", count, 0, MAX_RUN_FRAMES)
     return Profile(spec, seed).frames(count)
 
 
-def frame_count(spec: str, duration_s: float, seed: int = 1, limit: int = MAX_RUN_STEPS) -> int:
+def frame_count(spec: str, duration_s: float, seed: int = 1, limit: int = MAX_RUN_FRAMES) -> int:
     """The frames the profile hands out within duration_s (s), as a run plays them (the last one shortened to end
     at duration_s), counted up to limit + 1. Raises SteadystepError for a bad spec, and naming the frame when the
     profile hands out one that is not a finite positive duration."""
@@ -62,8 +62,9 @@ def frame_count(spec: str, duration_s: float, seed: int = 1, limit: int = MAX_RU
     profile = Profile(spec, seed)
     end_tolerance_s = 1e-9 * max(1.0, duration_s)  # as run.c: a rounding remainder is the end, not one more frame
     elapsed_s, count = 0.0, 0
+    next_frame, handle = lib.ssProfile_Next, profile._profile  # looked up once: a run may have 10^7 frames
     while duration_s - elapsed_s > end_tolerance_s and count <= limit:
-        frame_s = profile.next()
+        frame_s = next_frame(handle)
         if not (math.isfinite(frame_s) and frame_s > 0):
             raise SteadystepError("out of range", f"profile = {shown(spec)}: frame {count + 1} lasts {frame_s!r} s, "
                                   "not a finite positive duration")

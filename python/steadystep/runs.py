@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from steadystep._native import SteadystepError, c_string, check, ffi, lib, number, shown, text
-from steadystep.limits import MAX_RUN_STEPS
+from steadystep.limits import MAX_RUN_FRAMES, MAX_RUN_STEPS
 from steadystep.profiles import frame_count, seed_value
 
 REFERENCE_STEP_S = 1.0 / 1000.0
@@ -168,8 +168,8 @@ class RunResult:
 def check_run_size(profile: str, duration_s: float, seed: int, stepping: dict) -> None:
     """Refuses, before anything runs, a run larger than the bound of limits.py: duration_s (s) must be finite and
     positive, duration_s / step_s at most MAX_RUN_STEPS (step_s: stepping's fixed_step_s under policy fixed, its
-    max_step_s otherwise; under the fixed cut, its fixed_step_s), and the profile may hand out at most MAX_RUN_STEPS frames within duration_s.
-    Raises SteadystepError naming the value."""
+    max_step_s otherwise; under the fixed cut, its fixed_step_s), and the profile may hand out at most
+    MAX_RUN_FRAMES frames within duration_s. Raises SteadystepError naming the value."""
     duration_s = number("duration_s", duration_s, "s")
     if not math.isfinite(duration_s):
         raise SteadystepError("not finite", f"duration_s = {duration_s} s: must be a finite number of seconds")
@@ -182,9 +182,9 @@ def check_run_size(profile: str, duration_s: float, seed: int, stepping: dict) -
         raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: more than the bound of "
                               f"{MAX_RUN_STEPS} steps of {step_name} = {step_s:g} s per run")
     # A bad step length is left to the library, which names it; the frames are counted on the profile itself.
-    frames = frame_count(profile, duration_s, seed, MAX_RUN_STEPS)
-    if frames > MAX_RUN_STEPS:
-        raise SteadystepError("out of range", f"profile = {shown(profile)}: more than the bound of {MAX_RUN_STEPS} "
+    frames = frame_count(profile, duration_s, seed, MAX_RUN_FRAMES)
+    if frames > MAX_RUN_FRAMES:
+        raise SteadystepError("out of range", f"profile = {shown(profile)}: more than the bound of {MAX_RUN_FRAMES} "
                               f"frames per run within duration_s = {duration_s:g} s")
 
 
@@ -194,9 +194,9 @@ def run(scene: str, profile: str, policy: str, duration_s: float = 5.0, seed: in
 
     params changes fields of the scene's defaults (e.g. {"spring": {"stiffness": 80}}); stepping changes fields of
     make_stepping(policy). seed is an integer in [0, 2^64). A run is bounded (limits.py): duration_s / step at most
-    MAX_RUN_STEPS = 1e6 steps of the longest step allowed (max_step_s, or fixed_step_s under policy fixed), and at
-    most 1e6 frames of the profile. Raises SteadystepError naming the value for bad input or a run above the bound,
-    before anything runs; a blow-up is recorded in the result instead.
+    MAX_RUN_STEPS = 1e7 steps of the longest step allowed (max_step_s, or fixed_step_s under policy fixed), and at
+    most MAX_RUN_FRAMES = 1e7 frames of the profile. Raises SteadystepError naming the value for bad input or a run
+    above the bound, before anything runs; a blow-up is recorded in the result instead.
     """
     scene_c = ffi.new("char[]", c_string("scene", scene))
     profile_c = ffi.new("char[]", c_string("profile", profile))
