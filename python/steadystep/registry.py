@@ -39,7 +39,7 @@ class ApplyReport:
     rows_written: int         # joint parameter sets brought up to date, plus 1 for a bound world
     rows_over_nyquist: int    # rows whose natural frequency exceeds half the step rate, 1/(2h)
     rows_exact_fallback: int  # EXACT rows this step length could not serve: matched was used
-    rows_spring_fallback: int  # MATCHED or EXACT rows served by the implicit-Euler mapping for this step
+    rows_implicit_euler_fallback: int  # MATCHED or EXACT rows served by the implicit-Euler mapping
 
 
 @dataclass(frozen=True)

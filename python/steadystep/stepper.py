@@ -53,7 +53,7 @@ class FrameReport:
     interpolation: float         # FIXED: accumulator / fixed_step_s in [0, 1), to blend the last two states
     apply: ApplyReport = field(metadata={"struct": ApplyReport})  # summed over the frame's steps
     contacts_softened: int       # contacts softened with soften_contact
-    contacts_spring_fallback: int  # of those, served by the implicit-Euler mapping
+    contacts_implicit_euler_fallback: int  # of those, served by the implicit-Euler mapping
     failed_body: int = field(metadata={"convert": lambda body: int(ffi.cast("uintptr_t", body))})
     # the address of the body that blew up or ran too fast, else 0 (compare with ctypes.cast(body, c_void_p).value)
 
