@@ -48,9 +48,9 @@ def run_csv(build: pathlib.Path, program: str, variant: str, profile: str, seed:
             extra: list[str] | None = None) -> dict[str, np.ndarray]:
     """Runs one example and returns its CSV columns. variant: "own" or a policy name."""
     if variant == "own":
-        command = [str(build / f"{program}_ode")]
+        command = [str(build / f"steadystep_example_{program}_ode")]
     else:
-        command = [str(build / f"{program}_steadystep"), "--policy", variant]
+        command = [str(build / f"steadystep_example_{program}_steadystep"), "--policy", variant]
     command += ["--profile", profile, "--seed", str(seed), "--seconds", str(SECONDS)] + (extra or [])
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
@@ -92,9 +92,9 @@ def frame_rate_tables(build: pathlib.Path) -> None:
 def loop_seconds(build: pathlib.Path, variant: str, boxes: int, seconds: float) -> tuple[float, float]:
     """The stepping loop's (wall, CPU) seconds of one stack run at fixed:60."""
     if variant == "own":
-        command = [str(build / "stack_ode")]
+        command = [str(build / "steadystep_example_stack_ode")]
     else:
-        command = [str(build / "stack_steadystep"), "--policy", "implicit-euler", "--max-step", "1"]
+        command = [str(build / "steadystep_example_stack_steadystep"), "--policy", "implicit-euler", "--max-step", "1"]
     command += ["--profile", "fixed:60", "--seconds", str(seconds), "--boxes", str(boxes), "--quiet"]
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include <steadystep/lab/profile.h>
 #include <steadystep/steadystep.h>
 
 enum { kChains = 50, kLinks = 20, kBlock = 20 }; /* 1000 bodies, 1000 hinges, 2000 soft parameter sets with the motors */

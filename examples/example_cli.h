@@ -23,7 +23,7 @@
 #include <string.h>
 #include <time.h>
 
-#include <steadystep/profile.h>
+#include <steadystep/lab/profile.h>
 
 enum { EXAMPLE_FLAGS_STEPPER = 1, EXAMPLE_FLAGS_BOXES = 2 };
 

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <steadystep/lab/profile.h>
 #include <steadystep/steadystep.h>
 
 typedef struct Options {

@@ -11,6 +11,7 @@
 #include "joint_rows.h"
 #include "registry_internal.h"
 #include "row_law.h"
+#include "steadystep/adopt.h"
 #include "steadystep/registry.h"
 
 typedef struct JointBinding {

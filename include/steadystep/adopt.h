@@ -28,6 +28,7 @@
 
 #include <ode/ode.h>
 
+#include "steadystep/export.h"
 #include "steadystep/registry.h"
 
 #ifdef __cplusplus
@@ -54,26 +55,26 @@ typedef struct ssAdoptReport {
  *  Errors: SS_ERROR_OUT_OF_RANGE (registry or space NULL, tuned_step_s <= 0, a tuned value outside its range,
  *  named with its joint or body, e.g. erp > 1 or cfm < 0, or a tuned step different from an earlier adoption's);
  *  SS_ERROR_NOT_FINITE; SS_ERROR_UNSUPPORTED (a joint of a type ODE 0.16 does not know); SS_ERROR_OUT_OF_MEMORY. */
-ssStatus ssRegistry_Adopt(ssRegistry* registry, double tuned_step_s, dSpaceID space, ssAdoptReport* report);
+SS_API ssStatus ssRegistry_Adopt(ssRegistry* registry, double tuned_step_s, dSpaceID space, ssAdoptReport* report);
 
 /** Adopts the world's ERP/CFM and its damping and auto-disable defaults only (a program without a space, whose
  *  bodies are then adopted with ssRegistry_AdoptBody). Errors as ssRegistry_Adopt. */
-ssStatus ssRegistry_AdoptWorld(ssRegistry* registry, double tuned_step_s, ssAdoptReport* report);
+SS_API ssStatus ssRegistry_AdoptWorld(ssRegistry* registry, double tuned_step_s, ssAdoptReport* report);
 
 /** Adopts everything reachable from space, at the registry's tuned step.
  *  Errors as ssRegistry_Adopt; SS_ERROR_OUT_OF_RANGE when the world was not adopted first. */
-ssStatus ssRegistry_AdoptSpace(ssRegistry* registry, dSpaceID space, ssAdoptReport* report);
+SS_API ssStatus ssRegistry_AdoptSpace(ssRegistry* registry, dSpaceID space, ssAdoptReport* report);
 
 /** Adopts a body and everything reachable from it through joints, at the registry's tuned step.
  *  Errors as ssRegistry_AdoptSpace. */
-ssStatus ssRegistry_AdoptBody(ssRegistry* registry, dBodyID body, ssAdoptReport* report);
+SS_API ssStatus ssRegistry_AdoptBody(ssRegistry* registry, dBodyID body, ssAdoptReport* report);
 
 /** Adopts one joint's soft rows and its bodies (not what lies beyond them), at the registry's tuned step.
  *  Errors as ssRegistry_AdoptSpace. */
-ssStatus ssRegistry_AdoptJoint(ssRegistry* registry, dJointID joint, ssAdoptReport* report);
+SS_API ssStatus ssRegistry_AdoptJoint(ssRegistry* registry, dJointID joint, ssAdoptReport* report);
 
 /** The step length the registry's adopted values were tuned at (s); 0 before any adoption. */
-double ssRegistry_TunedStep(const ssRegistry* registry);
+SS_API double ssRegistry_TunedStep(const ssRegistry* registry);
 
 #ifdef __cplusplus
 }

@@ -17,6 +17,7 @@
 
 #include <ode/ode.h>
 
+#include "steadystep/export.h"
 #include "steadystep/spring.h"
 
 #ifdef __cplusplus
@@ -52,15 +53,15 @@ typedef struct ssApplyReport {
 } ssApplyReport;
 
 /** Creates an empty registry for world. Returns NULL when out of memory. */
-ssRegistry* ssRegistry_Create(dWorldID world);
+SS_API ssRegistry* ssRegistry_Create(dWorldID world);
 
 /** Destroys the registry. ODE objects are left as they are. NULL is a no-op. */
-void ssRegistry_Destroy(ssRegistry* registry);
+SS_API void ssRegistry_Destroy(ssRegistry* registry);
 
 /** Binds the world's ERP and CFM (they soften the non-limit rows of hinge-like joints, and contacts that have no
  *  soft mode). effective_mass (kg, > 0) is needed only by the matched and exact mappings; pass 0 to use 1 kg.
  *  Errors: those of ssValidateSpring; SS_ERROR_OUT_OF_RANGE for a negative or non-finite effective_mass. */
-ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effective_mass);
+SS_API ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effective_mass);
 
 /** Binds one soft parameter set of a joint on one axis (1, 2 or 3, as ODE's dParamGroup1..3; SS_PARAM_JOINT and
  *  SS_PARAM_SUSPENSION have axis 1 only). Binding the same joint, param and axis again replaces the first binding.
@@ -69,8 +70,8 @@ ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effe
  *  Errors: SS_ERROR_UNSUPPORTED when the joint's type has no such parameter on that axis (ODE itself would ignore
  *  it silently), or for an unknown param; those of ssValidateSpring; SS_ERROR_OUT_OF_RANGE for effective_mass < 0;
  *  SS_ERROR_OUT_OF_MEMORY. */
-ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssSpring spring,
-                              double effective_mass);
+SS_API ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis,
+                                     ssSpring spring, double effective_mass);
 
 /** Declares the steady load a bound row carries: a force (N) along a linear row or a torque (N·m) about an angular
  *  one, as it acts on the joint's first body in the axis' positive direction (a 1 kg body hanging on an upward
@@ -84,18 +85,19 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
  *  Errors: SS_ERROR_NOT_FINITE; SS_ERROR_OUT_OF_RANGE for |load| > SS_MAX_FORCE_N (limits.h), or a NULL registry;
  *  SS_ERROR_NOT_FOUND when that row is not bound; SS_ERROR_UNSUPPORTED for SS_PARAM_JOINT rows, which have no
  *  single direction. Apply refuses a step whose correction would exceed SS_MAX_FORCE_N. */
-ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, double load);
+SS_API ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointParam param, int axis,
+                                        double load);
 
 /** Removes every binding of joint. Call it before dJointDestroy. Errors: SS_ERROR_NOT_FOUND. */
-ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint);
+SS_API ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint);
 
 /** Binds velocity damping as rates (1/s, >= 0): ODE multiplies velocity by (1 - scale) once per step, so the
  *  registry writes scale = 1 - exp(-rate·h), which removes the same fraction of velocity per second at every step
  *  length. body = NULL binds the world's default damping (dWorldSetLinearDamping/AngularDamping), which ODE copies
  *  into a body when the body is created: bind existing bodies one by one.
  *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE, SS_ERROR_OUT_OF_MEMORY. */
-ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linear_rate_per_s,
-                                double angular_rate_per_s);
+SS_API ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linear_rate_per_s,
+                                       double angular_rate_per_s);
 
 /** Binds auto-disable in seconds: a body at rest for idle_time_s (> 0) is disabled, with its velocity averaged over
  *  average_window_s (>= 0; 0 = the current step only). ODE counts steps, so the registry writes
@@ -104,10 +106,11 @@ ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linea
  *  only when it changes, because ODE restarts a body's velocity average whenever it is set. Enabling auto-disable
  *  and its thresholds stay the program's own choice.
  *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE, SS_ERROR_OUT_OF_MEMORY. */
-ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double idle_time_s, double average_window_s);
+SS_API ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double idle_time_s,
+                                           double average_window_s);
 
 /** Removes the damping and auto-disable bindings of body. Call it before dBodyDestroy. Errors: SS_ERROR_NOT_FOUND. */
-ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body);
+SS_API ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body);
 
 /** Writes every binding for a step of step_s (s, > 0) with the mapping. previous_step_s is the length of the step
  *  before (0 when there is none or after a teleport); only SS_MAPPING_EXACT reads it. Either everything is written
@@ -115,23 +118,24 @@ ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body);
  *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (step_s, previous_step_s); SS_ERROR_NO_FINITE_MAPPING when a
  *  binding has no softness under that mapping (c = 0 with matched or exact), naming the joint; SS_ERROR_UNSUPPORTED
  *  for an unknown mapping. */
-ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
-                          ssApplyReport* report);
+SS_API ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
+                                 ssApplyReport* report);
 
 /** Number of bound joint parameter sets (not counting the world). */
-int ssRegistry_JointBindingCount(const ssRegistry* registry);
+SS_API int ssRegistry_JointBindingCount(const ssRegistry* registry);
 
 /** Calls visit for every distinct body attached to a bound joint or bound for damping/auto-disable. */
-void ssRegistry_VisitBodies(const ssRegistry* registry, void (*visit)(void* context, dBodyID body), void* context);
+SS_API void ssRegistry_VisitBodies(const ssRegistry* registry, void (*visit)(void* context, dBodyID body),
+                                   void* context);
 
 /** Whether the joint's type has that parameter set on that axis in ODE 0.16. */
-int ssJointSupports(dJointID joint, ssJointParam param, int axis);
+SS_API int ssJointSupports(dJointID joint, ssJointParam param, int axis);
 
 /** The effective mass (kg) or inertia (kg·m²) of a joint row: 1 / (J M⁻¹ Jᵀ) from the attached bodies' current
  *  mass and world-frame inertia, for the row that param/axis drives (slider and piston: translation along the axis;
  *  hinge, universal, angular motor: rotation about the axis; hinge-2 suspension: translation along axis 1).
  *  Errors: SS_ERROR_UNSUPPORTED (as ssRegistry_BindJoint), SS_ERROR_OUT_OF_RANGE when no dynamic body is attached. */
-ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, double* mass);
+SS_API ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, double* mass);
 
 /** Fills contact->surface.soft_erp and soft_cfm from spring for a step of step_s and sets dContactSoftERP and
  *  dContactSoftCFM in surface.mode. The effective mass along the contact normal is computed from body1, body2
@@ -139,8 +143,8 @@ ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, doub
  *  Call it in the near callback that ssStepper hands the step length to.
  *  Errors: those of ssSoftnessFor; SS_ERROR_OUT_OF_RANGE when neither body is dynamic and the mapping needs a mass.
  *  On error contact is unchanged. */
-ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpring spring, ssMapping mapping,
-                         double step_s, double previous_step_s);
+SS_API ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpring spring, ssMapping mapping,
+                                double step_s, double previous_step_s);
 
 #ifdef __cplusplus
 }

@@ -19,6 +19,7 @@
 #ifndef STEADYSTEP_SPRING_H
 #define STEADYSTEP_SPRING_H
 
+#include "steadystep/export.h"
 #include "steadystep/limits.h"
 #include "steadystep/status.h"
 
@@ -52,7 +53,7 @@ typedef enum ssMapping {
  *  Errors (out untouched): SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (k < 0, c < 0, step_s outside its range,
  *  out = NULL), SS_ERROR_NO_SPRING (k = c = 0), SS_ERROR_NO_FINITE_MAPPING (h·k + c overflows, or is below
  *  1/SS_MAX_CFM so that cfm would exceed SS_MAX_CFM). */
-ssStatus ssSoftnessFromSpring(ssSpring spring, double step_s, ssSoftness* out);
+SS_API ssStatus ssSoftnessFromSpring(ssSpring spring, double step_s, ssSoftness* out);
 
 /** The inverse: the spring that erp, cfm tuned at a fixed step step_s stand for: k = erp/(h·cfm), c = (1-erp)/cfm.
  *  erp in [0, 1] (0 is a pure damper: k = 0, c = 1/cfm), cfm in (0, SS_MAX_CFM], step_s in [SS_MIN_STEP_S,
@@ -60,21 +61,21 @@ ssStatus ssSoftnessFromSpring(ssSpring spring, double step_s, ssSoftness* out);
  *  erp, cfm back.
  *  Errors (out untouched): SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (erp, cfm or step_s outside those ranges,
  *  out = NULL), SS_ERROR_NO_FINITE_MAPPING (extreme values whose k or c over- or underflows). */
-ssStatus ssSpringFromSoftness(ssSoftness softness, double step_s, ssSpring* out);
+SS_API ssStatus ssSpringFromSoftness(ssSoftness softness, double step_s, ssSpring* out);
 
 /** A spring from its undamped natural frequency (Hz, > 0), damping ratio (>= 0, finite, 1 = critical) and the
  *  effective mass it moves (kg or kg·m², > 0): k = m·w², c = 2·zeta·m·w with w = 2π·f, as Jolt's SpringSettings
  *  does. On success k is a finite normal number and c is 0 exactly when zeta is.
  *  Errors (out untouched): SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (a value <= 0 or < 0, out = NULL),
  *  SS_ERROR_NO_FINITE_MAPPING (k or c over- or underflows, e.g. frequency_hz = 1e200). */
-ssStatus ssSpringFromFrequency(double frequency_hz, double damping_ratio, double mass, ssSpring* out);
+SS_API ssStatus ssSpringFromFrequency(double frequency_hz, double damping_ratio, double mass, ssSpring* out);
 
 /** The undamped natural frequency (Hz) and damping ratio of a spring with k > 0 acting on mass (kg, > 0). On
  *  success both are finite and the frequency is > 0.
  *  Errors (outputs untouched): SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (mass <= 0, a NULL output),
  *  SS_ERROR_NO_SPRING, SS_ERROR_NO_FINITE_MAPPING (a pure damper, k = 0: no natural frequency and an infinite
  *  damping ratio; or a frequency or ratio that over- or underflows). */
-ssStatus ssFrequencyFromSpring(ssSpring spring, double mass, double* frequency_hz, double* damping_ratio);
+SS_API ssStatus ssFrequencyFromSpring(ssSpring spring, double mass, double* frequency_hz, double* damping_ratio);
 
 /** The matched mapping for a row of effective mass `mass` (kg or kg·m², > 0) at step_s. With the discrete poles
  *  z1, z2 = exp(s1·h), exp(s2·h): P = z1·z2 = exp(-c·h/m), S = z1 + z2, erp = (1 + P - S)/(1 - P),
@@ -83,7 +84,7 @@ ssStatus ssFrequencyFromSpring(ssSpring spring, double mass, double* frequency_h
  *  Errors (out untouched): as ssSoftnessFromSpring, SS_ERROR_OUT_OF_RANGE for mass <= 0,
  *  SS_ERROR_NO_FINITE_MAPPING for c = 0 (an undamped spring has poles on the unit circle: cfm would be infinite)
  *  and for springs whose erp or cfm falls outside that range at this step. */
-ssStatus ssMatchedSoftness(ssSpring spring, double mass, double step_s, ssSoftness* out);
+SS_API ssStatus ssMatchedSoftness(ssSpring spring, double mass, double step_s, ssSoftness* out);
 
 /** The exact mapping: erp, cfm such that ODE's step from x_(n-1), x_n (previous step previous_step_s) lands on the
  *  exact solution's sample x_(n+1) after step_s. previous_step_s = 0 means there is no usable history (the first
@@ -92,19 +93,19 @@ ssStatus ssMatchedSoftness(ssSpring spring, double mass, double step_s, ssSoftne
  *  [SS_MIN_STEP_S, SS_MAX_STEP_S];
  *  SS_ERROR_NO_FINITE_MAPPING when this pair of step lengths would need cfm <= 0 (a much shorter step after a
  *  long one on a lightly damped spring): the caller may fall back to the matched mapping for that step. */
-ssStatus ssExactSoftness(ssSpring spring, double mass, double step_s, double previous_step_s, ssSoftness* out);
+SS_API ssStatus ssExactSoftness(ssSpring spring, double mass, double step_s, double previous_step_s, ssSoftness* out);
 
 /** One entry point for all mappings: mass is ignored by SS_MAPPING_IMPLICIT_EULER, previous_step_s by all but EXACT.
  *  Errors (out untouched): those of the chosen mapping, SS_ERROR_UNSUPPORTED for an unknown mapping value,
  *  SS_ERROR_OUT_OF_RANGE for out = NULL. */
-ssStatus ssSoftnessFor(ssMapping mapping, ssSpring spring, double mass, double step_s, double previous_step_s,
-                       ssSoftness* out);
+SS_API ssStatus ssSoftnessFor(ssMapping mapping, ssSpring spring, double mass, double step_s, double previous_step_s,
+                              ssSoftness* out);
 
 /** The mapping's name: "implicit-euler", "matched", "exact"; NULL for an unknown value. */
-const char* ssMappingName(ssMapping mapping);
+SS_API const char* ssMappingName(ssMapping mapping);
 
 /** Checks a spring: finite, k >= 0, c >= 0, not both 0. Errors as ssSoftnessFromSpring. */
-ssStatus ssValidateSpring(ssSpring spring);
+SS_API ssStatus ssValidateSpring(ssSpring spring);
 
 #ifdef __cplusplus
 }

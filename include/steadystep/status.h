@@ -7,6 +7,8 @@
 #ifndef STEADYSTEP_STATUS_H
 #define STEADYSTEP_STATUS_H
 
+#include "steadystep/export.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -28,10 +30,10 @@ typedef enum ssStatus {
 } ssStatus;
 
 /** The enum's name without prefix, e.g. "out of range". Never NULL. */
-const char* ssStatusName(ssStatus status);
+SS_API const char* ssStatusName(ssStatus status);
 
 /** The message of the last failure on this thread: one line naming the value at fault. "" when none. */
-const char* ssLastError(void);
+SS_API const char* ssLastError(void);
 
 #ifdef __cplusplus
 }

@@ -35,6 +35,7 @@
 
 #include <ode/ode.h>
 
+#include "steadystep/export.h"
 #include "steadystep/limits.h"
 #include "steadystep/registry.h"
 #include "steadystep/stepping.h"
@@ -101,15 +102,15 @@ typedef struct ssFrameReport {
 #define SS_MAX_FRAME_S SS_MAX_STEP_S
 
 /** The defaults listed at each field. */
-ssStepperDef ssDefaultStepperDef(void);
+SS_API ssStepperDef ssDefaultStepperDef(void);
 
 /** Makes a stepper. The registry and the world are borrowed: they must outlive it.
  *  Errors: SS_ERROR_OUT_OF_RANGE (def or out NULL, no world, or a field outside its range, named),
  *  SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED (those of ssValidateStepping), SS_ERROR_OUT_OF_MEMORY. */
-ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out);
+SS_API ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out);
 
 /** Destroys the stepper. NULL is a no-op. */
-void ssStepper_Destroy(ssStepper* stepper);
+SS_API void ssStepper_Destroy(ssStepper* stepper);
 
 /** Advances the world by one frame of frame_s seconds (0 <= frame_s <= SS_MAX_FRAME_S; 0 does nothing). report may
  *  be NULL.
@@ -123,15 +124,15 @@ void ssStepper_Destroy(ssStepper* stepper);
  *  Errors after stepping: SS_ERROR_BLOWUP (a known body's position or velocity is not finite) and
  *  SS_ERROR_SPEED_LIMIT (faster than max_speed or max_angular_speed): the frame stops at that step,
  *  report->failed_body names the body, and the stepper refuses every later frame until ssStepper_Reset. */
-ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* report);
+SS_API ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* report);
 
 /** After a failure, once the program has repaired or restored its bodies: accepts frames again. Also forgets the
  *  step history, the FIXED accumulator and the momentum carried for the next frame. NULL is a no-op. */
-void ssStepper_Reset(ssStepper* stepper);
+SS_API void ssStepper_Reset(ssStepper* stepper);
 
 /** The step about to be taken. Meaningful inside before_step and collide; between frames it describes the next
  *  step of the default length. stepper must not be NULL. */
-ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
+SS_API ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
 
 /** In the program's near callback: turns the contact's tuned softness into the softness for the step about to be
  *  taken. The contact's soft_erp/soft_cfm (where surface.mode has dContactSoftERP/dContactSoftCFM), or else the
@@ -142,14 +143,14 @@ ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
  *  cfm = 0 stays hard (erp follows h as for adopted hard rows).
  *  Errors, with the contact unchanged: SS_ERROR_OUT_OF_RANGE (stepper or contact NULL, no tuned step: adopt
  *  first, or a tuned erp outside [0, 1] or cfm < 0); SS_ERROR_NOT_FINITE. */
-ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2);
+SS_API ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2);
 
 /** Adds a body to the known bodies: forces kept for the whole frame and checks after each step.
  *  Errors: SS_ERROR_OUT_OF_RANGE (NULL), SS_ERROR_OUT_OF_MEMORY. */
-ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body);
+SS_API ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body);
 
 /** Stops watching a body; call it before dBodyDestroy. Errors: SS_ERROR_OUT_OF_RANGE (NULL), SS_ERROR_NOT_FOUND. */
-ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body);
+SS_API ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body);
 
 /** Destroys a body safely: stops watching it, removes its damping and auto-disable bindings from the registry,
  *  then calls dBodyDestroy. Use it instead of dBodyDestroy for any body the stepper knows: ODE gives no way to tell
@@ -157,23 +158,23 @@ ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body);
  *  stops there with a report). The registry's bindings of the joints attached to it are removed too: ODE leaves
  *  those joints detached on one side, where some of its getters assert.
  *  Errors, with nothing destroyed: SS_ERROR_OUT_OF_RANGE (stepper or body NULL). */
-ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body);
+SS_API ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body);
 
 /** Destroys a joint safely: removes its bindings from the registry, then calls dJointDestroy. Use it instead of
  *  dJointDestroy for a bound or adopted joint (contact joints in the contact group need nothing).
  *  Errors, with nothing destroyed: SS_ERROR_OUT_OF_RANGE (stepper or joint NULL). */
-ssStatus ssStepper_DestroyJoint(ssStepper* stepper, dJointID joint);
+SS_API ssStatus ssStepper_DestroyJoint(ssStepper* stepper, dJointID joint);
 
 /** Forgets the previous step length, so the next step of SS_MAPPING_EXACT maps the bodies' true velocities. Call it
  *  after teleporting a body or setting its velocity. NULL is a no-op. */
-void ssStepper_ResetHistory(ssStepper* stepper);
+SS_API void ssStepper_ResetHistory(ssStepper* stepper);
 
 /** Changes how frames become steps, between frames (resets the history and the FIXED accumulator).
  *  Errors, with nothing changed: those of ssValidateStepping; SS_ERROR_OUT_OF_RANGE for a NULL stepper. */
-ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping);
+SS_API ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping);
 
 /** The stepper's stepping. stepper must not be NULL. */
-ssStepping ssStepper_Stepping(const ssStepper* stepper);
+SS_API ssStepping ssStepper_Stepping(const ssStepper* stepper);
 
 #ifdef __cplusplus
 }

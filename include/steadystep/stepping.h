@@ -11,6 +11,7 @@
 #ifndef STEADYSTEP_STEPPING_H
 #define STEADYSTEP_STEPPING_H
 
+#include "steadystep/export.h"
 #include "steadystep/spring.h"
 #include "steadystep/status.h"
 
@@ -55,15 +56,15 @@ typedef struct ssStepping {
 } ssStepping;
 
 /** The defaults listed at each field. */
-ssStepping ssDefaultStepping(void);
+SS_API ssStepping ssDefaultStepping(void);
 
 /** Checks every field, naming the first one out of range.
  *  Errors: SS_ERROR_OUT_OF_RANGE (NULL, or a field outside its range), SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED
  *  (an unknown cut, mapping or solver). */
-ssStatus ssValidateStepping(const ssStepping* stepping);
+SS_API ssStatus ssValidateStepping(const ssStepping* stepping);
 
 /** The cut's name: "whole-frame", "substeps", "fixed"; NULL for an unknown value. */
-const char* ssFrameCutName(ssFrameCut cut);
+SS_API const char* ssFrameCutName(ssFrameCut cut);
 
 /** The lab's policies, named presets of (cut, mapping, frozen step), in the order the lab reports them:
  *    naive           whole frame, implicit Euler frozen at the reference step: the problem the article fixes
@@ -73,20 +74,20 @@ const char* ssFrameCutName(ssFrameCut cut);
  *    fixed           fixed steps, implicit Euler
  *    fixed-matched   fixed steps, matched
  *    fixed-exact     fixed steps, exact */
-int ssPolicyCount(void);
+SS_API int ssPolicyCount(void);
 
 /** The name of policy index (0 <= index < ssPolicyCount()), or NULL. */
-const char* ssPolicyNameAt(int index);
+SS_API const char* ssPolicyNameAt(int index);
 
 /** Sets stepping's cut, mapping and frozen step to the policy's (the other fields are kept). reference_step_s (s,
  *  in the step range) is the length naive freezes its softness at, e.g. the step a program was tuned for.
  *  Errors, with stepping unchanged: SS_ERROR_PARSE for an unknown name (named, with the known ones);
  *  SS_ERROR_OUT_OF_RANGE for NULL or a reference_step_s out of range; SS_ERROR_NOT_FINITE. */
-ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssStepping* stepping);
+SS_API ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssStepping* stepping);
 
 /** The name of the policy stepping is (cut, mapping and whether the softness is frozen), or NULL when it is no
  *  preset (e.g. whole frame with matched). */
-const char* ssSteppingPolicyName(const ssStepping* stepping);
+SS_API const char* ssSteppingPolicyName(const ssStepping* stepping);
 
 #ifdef __cplusplus
 }

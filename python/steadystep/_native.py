@@ -16,12 +16,15 @@ import cffi
 
 _HERE = Path(__file__).resolve().parent / "_native"
 INCLUDE_DIR = _HERE / "include" / "steadystep"
-LIBRARY_PATH = _HERE / "libsteadystep.so"
+# The lab library: the core and the lab in one shared object (the core alone, libsteadystep, is for C programs).
+LIBRARY_PATH = _HERE / "libsteadystep_lab.so"
 
 # The headers cffi reads whole, in dependency order.
-_WHOLE_HEADERS = ("status.h", "spring.h", "stepping.h", "profile.h", "scene.h")
+_WHOLE_HEADERS = ("status.h", "spring.h", "stepping.h", "lab/profile.h", "lab/scene.h")
 
 _INTEGER_DEFINE = re.compile(r"^\s*#\s*define\s+(\w+)\s+(\d+)\s*$")
+# The export marks (steadystep/export.h, steadystep/lab/export.h) expand to attributes cffi does not parse.
+_EXPORT_MARK = re.compile(r"\bSS_(?:LAB_)?API\b")
 
 
 def _strip_comments(text: str) -> str:
@@ -30,9 +33,9 @@ def _strip_comments(text: str) -> str:
 
 def _declarations(text: str) -> str:
     """The header's C declarations: integer #defines kept (cffi understands them), other preprocessor lines and
-    the extern "C" wrapper dropped."""
+    the extern "C" wrapper and the export marks dropped."""
     kept = []
-    for line in _strip_comments(text).splitlines():
+    for line in _EXPORT_MARK.sub("", _strip_comments(text)).splitlines():
         define = _INTEGER_DEFINE.match(line)
         if define:
             kept.append(f"#define {define.group(1)} {define.group(2)}")

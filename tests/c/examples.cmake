@@ -1,4 +1,5 @@
-# The example programs end to end (examples/*_ode.c and their steadystep adoptions), included from CMakeLists.txt.
+# The example programs end to end (examples/*_ode.c and their steadystep adoptions, targets steadystep_example_*),
+# included from CMakeLists.txt.
 #  - Each adopted program runs 10 s of 15-45 fps frames under every policy and exits 0: every frame stepped.
 #  - Each plain program runs the same frames and exits 0.
 #  - Adopted with the naive policy (one step a frame, the numbers as tuned at 60 fps), a program moves as its own
@@ -11,10 +12,11 @@ set(STEADYSTEP_EXAMPLE_POLICIES naive implicit-euler matched exact fixed fixed-m
 
 foreach(program ${STEADYSTEP_EXAMPLE_PROGRAMS})
   add_test(NAME example_${program}_ode_uniform
-           COMMAND ${program}_ode --profile uniform:15:45 --seconds 10 --seed 1 --quiet)
+           COMMAND steadystep_example_${program}_ode --profile uniform:15:45 --seconds 10 --seed 1 --quiet)
   foreach(policy ${STEADYSTEP_EXAMPLE_POLICIES})
     add_test(NAME example_${program}_steadystep_${policy}_uniform
-             COMMAND ${program}_steadystep --policy ${policy} --profile uniform:15:45 --seconds 10 --seed 1 --quiet)
+             COMMAND steadystep_example_${program}_steadystep --policy ${policy} --profile uniform:15:45 --seconds 10
+                     --seed 1 --quiet)
   endforeach()
 
   # Naive adoption against the program's own stepping, 2 s of 15-45 fps: every value within 1e-6 of the plain run's
@@ -25,20 +27,23 @@ foreach(program ${STEADYSTEP_EXAMPLE_PROGRAMS})
 paste -d, \"$3.ode.csv\" \"$3.naive.csv\" | awk -F, 'NR == 1 { n = NF / 2; next } \
 { for (i = 1; i <= n; ++i) { d = $i - $(i + n); if (d < 0) d = -d; if (d > worst) worst = d } rows++ } \
 END { printf \"rows %d, largest difference %g\\n\", rows, worst; exit !(rows > 20 && worst <= 1e-6) }'"
-                   sh $<TARGET_FILE:${program}_ode> $<TARGET_FILE:${program}_steadystep>
+                   sh $<TARGET_FILE:steadystep_example_${program}_ode>
+                   $<TARGET_FILE:steadystep_example_${program}_steadystep>
                    ${CMAKE_CURRENT_BINARY_DIR}/example_${program}_naive)
 
   # A pass expression overrides the exit code, so the code is printed and matched too.
   add_test(NAME example_${program}_bad_policy
            COMMAND sh -c "\"$1\" --policy sideways --seconds 1 2>&1; echo exit $?"
-                   sh $<TARGET_FILE:${program}_steadystep>)
+                   sh $<TARGET_FILE:steadystep_example_${program}_steadystep>)
   set_tests_properties(example_${program}_bad_policy PROPERTIES PASS_REGULAR_EXPRESSION
                        "--policy sideways: [^\n]*\nexit 2\n")
   add_test(NAME example_${program}_bad_profile
-           COMMAND sh -c "\"$1\" --profile uniform:45:15 2>&1; echo exit $?" sh $<TARGET_FILE:${program}_ode>)
+           COMMAND sh -c "\"$1\" --profile uniform:45:15 2>&1; echo exit $?"
+                   sh $<TARGET_FILE:steadystep_example_${program}_ode>)
   set_tests_properties(example_${program}_bad_profile PROPERTIES PASS_REGULAR_EXPRESSION
                        "--profile uniform:45:15: [^\n]*\nexit 2\n")
-  add_test(NAME example_${program}_csv_header COMMAND ${program}_steadystep --profile fixed:30 --seconds 0.1)
+  add_test(NAME example_${program}_csv_header
+           COMMAND steadystep_example_${program}_steadystep --profile fixed:30 --seconds 0.1)
 endforeach()
 
 set_tests_properties(example_vehicle_csv_header PROPERTIES PASS_REGULAR_EXPRESSION
@@ -48,5 +53,5 @@ set_tests_properties(example_chain_csv_header PROPERTIES PASS_REGULAR_EXPRESSION
 set_tests_properties(example_stack_csv_header PROPERTIES PASS_REGULAR_EXPRESSION
                      "^t_s,top_z_m,ground_force_N\n0,[^\n]+\n0\\.0333")
 add_test(NAME example_stack_bad_boxes
-         COMMAND sh -c "\"$1\" --boxes 0 2>&1; echo exit $?" sh $<TARGET_FILE:stack_steadystep>)
+         COMMAND sh -c "\"$1\" --boxes 0 2>&1; echo exit $?" sh $<TARGET_FILE:steadystep_example_stack_steadystep>)
 set_tests_properties(example_stack_bad_boxes PROPERTIES PASS_REGULAR_EXPRESSION "--boxes 0: [^\n]*\nexit 2\n")

@@ -8,6 +8,7 @@
 
 #include <ode/ode.h>
 
+#include "steadystep/lab/profile.h"
 #include "steadystep/steadystep.h"
 
 struct OscillatorRig {

@@ -14,7 +14,7 @@
 #include <random>
 
 #include "steadystep/limits.h"
-#include "steadystep/profile.h"
+#include "steadystep/lab/profile.h"
 
 namespace {
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "steadystep/lab/scene.h"
 #include "steadystep/steadystep.h"
 
 namespace {

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the build into a fresh prefix and builds a consumer twice: with find_package(steadystep) and with
-# pkg-config. Usage: check.sh BUILD_DIR WORK_DIR
+# pkg-config. Then compares what the installed library exports with what its installed headers declare: the same
+# function names, and none of the lab's (scenes, runs, profiles). Usage: check.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 build=$1 work=$2 here=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$work" && mkdir -p "$work"
@@ -12,3 +13,30 @@ pc_path=$(dirname "$(find "$work/prefix" -name steadystep.pc)")
 cc "$here/consumer.c" -o "$work/consumer-pc" $(PKG_CONFIG_PATH=$pc_path pkg-config --cflags --libs steadystep) \
   -Wl,-rpath,"$(PKG_CONFIG_PATH=$pc_path pkg-config --variable=libdir steadystep)"
 "$work/consumer-pc"
+
+library=$(find "$work/prefix" -name 'libsteadystep.so' | head -n 1)
+if [ -z "$library" ]; then
+  echo "a static build: no exported symbols to compare"
+  exit 0
+fi
+# The functions the installed headers declare: the names before "(" in the headers without comments, function
+# types (typedef) left out.
+for header in "$work"/prefix/include/steadystep/*.h; do
+  cc -fpreprocessed -dD -E -P "$header" 2>/dev/null
+done | grep -v '^\s*#' | tr '\n' ' ' | tr ';' '\n' | grep -v '^\s*typedef' \
+  | grep -oE '\bss[A-Za-z0-9_]*\s*\(' | tr -d ' (' | sort -u > "$work/declared.txt"
+nm -D --defined-only "$library" | awk '{print $3}' | sort -u > "$work/exported.txt"
+if ! diff -u "$work/declared.txt" "$work/exported.txt" > "$work/difference.txt"; then
+  echo "declared (-) and exported (+) differ:"
+  grep '^[-+]ss' "$work/difference.txt"
+  exit 1
+fi
+if grep -E 'Scene|Run_|Profile|Lab|Boxes|Rng' "$work/exported.txt"; then
+  echo "the core exports the lab's functions above"
+  exit 1
+fi
+if ls "$work"/prefix/include/steadystep | grep -E 'scene|profile|lab'; then
+  echo "the lab's headers are installed"
+  exit 1
+fi
+echo "exports $(wc -l < "$work/exported.txt") functions, all declared"

@@ -5,7 +5,7 @@
  * out lies in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S] (limits.h): the spec is refused when its frames could leave it.
  * Specs, paths and trace lines are quoted in messages with every byte outside printable ASCII written as \xNN, so
  * a message is ASCII whatever bytes came in (Python decodes it as text). */
-#include "steadystep/profile.h"
+#include "steadystep/lab/profile.h"
 
 #include <ctype.h>
 #include <errno.h>

@@ -25,6 +25,7 @@
 
 #include <stdint.h>
 
+#include "steadystep/lab/export.h"
 #include "steadystep/limits.h"
 #include "steadystep/status.h"
 
@@ -48,20 +49,20 @@ typedef struct ssProfile ssProfile;
  *  SS_ERROR_PARSE for a malformed trace line (with its number: not a number, a NUL byte, too long),
  *  SS_ERROR_OUT_OF_RANGE for a trace duration outside the frame range or more than SS_MAX_TRACE_FRAMES of them,
  *  SS_ERROR_OUT_OF_MEMORY. */
-ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out);
+SS_LAB_API ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out);
 
 /** Destroys the profile. NULL is a no-op. */
-void ssProfile_Destroy(ssProfile* profile);
+SS_LAB_API void ssProfile_Destroy(ssProfile* profile);
 
 /** The next frame duration (s), finite and in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S].
  *  profile = NULL: returns NaN (which every consumer refuses) and records "profile = NULL: ..." for ssLastError(). */
-double ssProfile_Next(ssProfile* profile);
+SS_LAB_API double ssProfile_Next(ssProfile* profile);
 
 /** Restarts the sequence from its seed. profile = NULL: does nothing and records "profile = NULL: ...". */
-void ssProfile_Reset(ssProfile* profile);
+SS_LAB_API void ssProfile_Reset(ssProfile* profile);
 
 /** The profile's specification as given. profile = NULL: returns "" and records "profile = NULL: ...". */
-const char* ssProfile_Spec(const ssProfile* profile);
+SS_LAB_API const char* ssProfile_Spec(const ssProfile* profile);
 
 #ifdef __cplusplus
 }

@@ -14,7 +14,7 @@
 #include "profile_internal.h"
 #include "scene_internal.h"
 #include "steadystep/limits.h"
-#include "steadystep/profile.h"
+#include "steadystep/lab/profile.h"
 #include "steadystep/stepper.h"
 
 struct ssRun {

@@ -1,16 +1,17 @@
 /* Internal: what a scene is made of, shared by scene.c (the table and the runner of frames), the scene files in
- * src/scenes/ and run.c (which records every physics step).
+ * lab/src/scenes/ and run.c (which records every physics step).
  *
  * A scene is data plus a builder. scene.c owns the ODE world, its collision space, the contact group, the registry
  * and the stepper; a scene's build function only fills the world with bodies, joints and geoms, binds its soft
- * parts in the registry and returns its own state. Adding a scene is one file in src/scenes/ and one table line. */
+ * parts in the registry and returns its own state. Adding a scene is one file in lab/src/scenes/, its name in the
+ * lab's source list (CMakeLists.txt) and one table line. */
 #ifndef STEADYSTEP_SCENE_INTERNAL_H
 #define STEADYSTEP_SCENE_INTERNAL_H
 
 #include <ode/ode.h>
 
 #include "steadystep/registry.h"
-#include "steadystep/scene.h"
+#include "steadystep/lab/scene.h"
 #include "steadystep/stepper.h"
 
 /* What a builder gets to fill. */
@@ -41,7 +42,7 @@ typedef struct ssSceneDesc {
   void (*destroy)(void* state);
 } ssSceneDesc;
 
-/* The scenes, each defined in its own file under src/scenes/. */
+/* The scenes, each defined in its own file under lab/src/scenes/. */
 extern const ssSceneDesc ssOscillatorScene;
 extern const ssSceneDesc ssBuggyScene;
 extern const ssSceneDesc ssDropScene;

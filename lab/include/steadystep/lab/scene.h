@@ -19,6 +19,7 @@
 
 #include <stdint.h>
 
+#include "steadystep/lab/export.h"
 #include "steadystep/limits.h"
 #include "steadystep/spring.h"
 #include "steadystep/status.h"
@@ -57,27 +58,27 @@ typedef struct ssSceneInfo {
 } ssSceneInfo;
 
 /** The number of scenes, and each scene's description (NULL past the end). */
-int ssSceneCount(void);
-const ssSceneInfo* ssSceneInfoAt(int index);
+SS_LAB_API int ssSceneCount(void);
+SS_LAB_API const ssSceneInfo* ssSceneInfoAt(int index);
 /** The scene called name, or NULL (also for name = NULL). */
-const ssSceneInfo* ssSceneFind(const char* name);
+SS_LAB_API const ssSceneInfo* ssSceneFind(const char* name);
 
 /** The default parameters of a scene. Errors (*out untouched): SS_ERROR_NOT_FOUND for an unknown scene (named),
  *  SS_ERROR_OUT_OF_RANGE for name = NULL or out = NULL. */
-ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
+SS_LAB_API ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
 
 /** The naive policy's reference step in the lab (s): the scenes' softness frozen as if tuned at 30 fps. */
 #define SS_LAB_NAIVE_REFERENCE_STEP_S (1.0 / 30.0)
 
 /** The stepping of a policy in the lab: ssDefaultStepping() with the policy's cut and mapping (stepping.h), naive
  *  frozen at SS_LAB_NAIVE_REFERENCE_STEP_S. Errors: those of ssSteppingForPolicy. */
-ssStatus ssLabStepping(const char* policy, ssStepping* out);
+SS_LAB_API ssStatus ssLabStepping(const char* policy, ssStepping* out);
 
 /** The stepping of a reference run: implicit Euler with substeps of at most step_s (s, in the step range; e.g.
  *  1/1000), fixed_step_s also step_s, the other fields as ssDefaultStepping. Run it under the profile "fixed:N"
  *  with N = 1/step_s (e.g. "fixed:1000") so that every frame is one step. step_s is not checked here:
  *  ssScene_Create refuses a bad one. */
-ssStepping ssReferenceStepping(double step_s);
+SS_LAB_API ssStepping ssReferenceStepping(double step_s);
 
 typedef struct ssScene ssScene;
 
@@ -86,10 +87,11 @@ typedef struct ssScene ssScene;
  *  gravity beyond their bounds above, body_count < 0 or above the scene's maximum, a step length outside
  *  [SS_MIN_STEP_S, SS_MAX_STEP_S], another stepping field out of range), SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED
  *  (unknown policy or solver), SS_ERROR_OUT_OF_MEMORY. */
-ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssStepping* stepping, ssScene** out);
+SS_LAB_API ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssStepping* stepping,
+                                   ssScene** out);
 
 /** Destroys the scene and its ODE world. NULL is a no-op. */
-void ssScene_Destroy(ssScene* scene);
+SS_LAB_API void ssScene_Destroy(ssScene* scene);
 
 /** Advances one frame of frame_s seconds through the scene's stepper. steps (may be NULL) receives the physics
  *  steps taken. Every body is watched, with a speed limit of 100 m/s (no scene moves anything near that fast).
@@ -97,14 +99,14 @@ void ssScene_Destroy(ssScene* scene);
  *  it), so a run does not depend on what else ran in the process; step scenes from one thread at a time.
  *  Errors: those of ssStepper_Step (SS_ERROR_BLOWUP, SS_ERROR_SPEED_LIMIT when the scene explodes),
  *  SS_ERROR_OUT_OF_RANGE for scene = NULL. */
-ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps);
+SS_LAB_API ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps);
 
 /** The followed quantities now, quantity_count of them, into out. scene or out NULL: writes nothing and records
  *  "scene = NULL: ..." (or out) for ssLastError(). */
-void ssScene_Sample(const ssScene* scene, double* out);
+SS_LAB_API void ssScene_Sample(const ssScene* scene, double* out);
 
 /** The scene's simulated time (s). scene = NULL: NaN, and records "scene = NULL: ..." for ssLastError(). */
-double ssScene_Time(const ssScene* scene);
+SS_LAB_API double ssScene_Time(const ssScene* scene);
 
 /** A run: a scene under a profile for duration_s, one record after every physics step. */
 typedef struct ssRunDef {
@@ -125,27 +127,27 @@ typedef struct ssRun ssRun;
  *  Errors (*out untouched): those of ssScene_Create and ssProfile_Create; SS_ERROR_OUT_OF_RANGE for def, out,
  *  def->scene or def->profile NULL, for duration_s outside (0, SS_MAX_RUN_DURATION_S] and for the bounds above;
  *  SS_ERROR_NOT_FINITE for duration_s. */
-ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out);
+SS_LAB_API ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out);
 
 /** Destroys the run. NULL is a no-op. */
-void ssRun_Destroy(ssRun* run);
+SS_LAB_API void ssRun_Destroy(ssRun* run);
 
 /** Records: one per physics step, time (s) after the step, the step's length (s), and each quantity (NULL for an
  *  index outside [0, quantity_count)). The arrays belong to the run.
  *  Every ssRun_ accessor given run = NULL records "run = NULL: ..." for ssLastError() and returns 0, NULL, "" or
  *  (ssRun_Status) SS_ERROR_OUT_OF_RANGE. */
-int ssRun_StepCount(const ssRun* run);
-const double* ssRun_Times(const ssRun* run);
-const double* ssRun_StepLengths(const ssRun* run);
-const double* ssRun_Quantity(const ssRun* run, int index);
+SS_LAB_API int ssRun_StepCount(const ssRun* run);
+SS_LAB_API const double* ssRun_Times(const ssRun* run);
+SS_LAB_API const double* ssRun_StepLengths(const ssRun* run);
+SS_LAB_API const double* ssRun_Quantity(const ssRun* run, int index);
 
 /** Frames rendered, and the wall-clock seconds the stepping took (scene building excluded). */
-int ssRun_FrameCount(const ssRun* run);
-double ssRun_WallSeconds(const ssRun* run);
+SS_LAB_API int ssRun_FrameCount(const ssRun* run);
+SS_LAB_API double ssRun_WallSeconds(const ssRun* run);
 
 /** SS_OK, or the blow-up status that ended the run early; its message. */
-ssStatus ssRun_Status(const ssRun* run);
-const char* ssRun_Message(const ssRun* run);
+SS_LAB_API ssStatus ssRun_Status(const ssRun* run);
+SS_LAB_API const char* ssRun_Message(const ssRun* run);
 
 #ifdef __cplusplus
 }
