@@ -16,7 +16,11 @@ cc "$here/consumer.c" -o "$work/consumer-pc" $(PKG_CONFIG_PATH=$pc_path pkg-conf
 
 library=$(find "$work/prefix" -name 'libsteadystep.so' | head -n 1)
 if [ -z "$library" ]; then
-  echo "a static build: no exported symbols to compare"
+  # A static core (SS_STATIC) marks nothing for export: linked into a game's shared object, it stays hidden there.
+  archive=$(find "$work/prefix" -name 'libsteadystep.a' | head -n 1)
+  visible=$(readelf -s --wide "$archive" | awk '$5 == "GLOBAL" && $6 == "DEFAULT" && $7 != "UND"' | wc -l)
+  [ "$visible" = 0 ] || { echo "the static library has $visible symbols of default visibility"; exit 1; }
+  echo "a static library: every symbol hidden"
   exit 0
 fi
 # The functions the installed headers declare: the names before "(" in the headers without comments, function
