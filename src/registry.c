@@ -407,10 +407,15 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
       /* the step's static stiffness is k' = erp/(h·cfm): this force puts the rest position back at load/k */
       double static_stiffness = binding->pending.erp / (step_s * binding->pending.cfm);
       double correction = binding->load * (static_stiffness / spring->stiffness - 1);
-      if (!(fabs(correction) <= SS_MAX_FORCE_N))
-        return failBinding(ssFail(SS_ERROR_OUT_OF_RANGE, "load correction %g N or N·m: beyond SS_MAX_FORCE_N = %g",
-                                  correction, SS_MAX_FORCE_N),
-                           binding);
+      if (!(fabs(correction) <= SS_MAX_FORCE_N)) {
+        /* an accurate softness this far from the spring's static stiffness cannot carry the load: implicit Euler,
+         * whose static stiffness is k itself, serves the row (as for every row an accurate mapping cannot) */
+        status = ssSoftnessFromSpring(*spring, step_s, &binding->pending);
+        if (status != SS_OK) return failBinding(status, binding);
+        binding->computed_fallback = (ssRowFallback){0, 1};
+        counts.rows_implicit_euler_fallback += 1;
+        correction = 0;
+      }
       binding->load_correction = correction;
     }
   }

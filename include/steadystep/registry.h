@@ -84,7 +84,8 @@ SS_API ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJoi
  *  once per step (the stepper does), since the force is added each time. Binding the row again clears the load.
  *  Errors: SS_ERROR_NOT_FINITE; SS_ERROR_OUT_OF_RANGE for |load| > SS_MAX_FORCE_N (limits.h), or a NULL registry;
  *  SS_ERROR_NOT_FOUND when that row is not bound; SS_ERROR_UNSUPPORTED for SS_PARAM_JOINT rows, which have no
- *  single direction. Apply refuses a step whose correction would exceed SS_MAX_FORCE_N. */
+ *  single direction. A row whose correction would exceed SS_MAX_FORCE_N at some step gets implicit Euler there
+ *  (static stiffness k, no correction), counted as a fallback. */
 SS_API ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointParam param, int axis,
                                         double load);
 

@@ -119,7 +119,8 @@ SS_API void ssStepper_Destroy(ssStepper* stepper);
  *  that the frame's steps deliver the momentum F·frame_s (carried to the next frame when this one takes no step).
  *  Errors, with the world left as it was: SS_ERROR_OUT_OF_RANGE (stepper NULL, frame_s out of range, a force or
  *  torque on a known body beyond SS_MAX_FORCE_N, named with its body), SS_ERROR_NOT_FINITE (frame_s, a force);
- *  errors of ssRegistry_Apply (checked before the first step touches the world);
+ *  errors of ssRegistry_Apply (found at the frame's first step: what can fail depends on the step length and the
+ *  bound springs alone, and every row an accurate mapping cannot serve falls back to implicit Euler);
  *  SS_ERROR_FAILED when an earlier frame failed and ssStepper_Reset has not been called.
  *  Errors after stepping: SS_ERROR_BLOWUP (a known body's position or velocity is not finite) and
  *  SS_ERROR_SPEED_LIMIT (faster than max_speed or max_angular_speed): the frame stops at that step,
