@@ -47,6 +47,12 @@ struct ssRegistry {
   ssBodyBinding* bodies;
   int body_count, body_capacity;
   unsigned generation; /* changes whenever the set of bound joints or bodies does */
+  unsigned revision;   /* changes whenever any binding does */
+  /* the last Apply: under implicit Euler, the same step with the same bindings writes nothing new */
+  unsigned applied_revision;
+  double applied_step_s;
+  ssMapping applied_mapping;
+  ssApplyReport applied_counts;
 };
 
 #define REQUIRE_REGISTRY(registry) \
@@ -64,6 +70,7 @@ ssRegistry* ssRegistry_Create(dWorldID world) {
   }
   registry->world = world;
   registry->world_written = (ssSoftness){NAN, NAN};
+  registry->applied_step_s = NAN;
   return registry;
 }
 
@@ -75,6 +82,7 @@ void ssRegistry_Destroy(ssRegistry* registry) {
 }
 
 void ssRegistryBindWorldLaw(ssRegistry* registry, ssRowLaw law, double effective_mass) {
+  registry->revision += 1;
   registry->world_bound = 1;
   registry->world_law = law;
   registry->world_mass = effective_mass > 0 ? effective_mass : 1.0;
@@ -109,6 +117,7 @@ int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam par
 
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass) {
+  registry->revision += 1;
   JointBinding binding = {joint, param, axis, law, effective_mass, {0, 0}, {NAN, NAN}, 0, 0, NAN, 0,
                           SS_MAPPING_IMPLICIT_EULER, NAN, NAN, NAN, {0, 0}};
   JointBinding* existing = findJoint(registry, joint, param, axis);
@@ -151,6 +160,7 @@ ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointPa
     return ssFail(SS_ERROR_UNSUPPORTED, "a %s joint's %s rows have no single direction to carry a load",
                   ssJointTypeName(joint), ssJointParamName(param));
   binding->load = load;
+  registry->revision += 1;
   return SS_OK;
 }
 
@@ -162,6 +172,7 @@ ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
   if (kept == registry->joint_count) return ssFail(SS_ERROR_NOT_FOUND, "joint %p: not bound", (void*)joint);
   registry->joint_count = kept;
   registry->generation += 1;
+  registry->revision += 1;
   return SS_OK;
 }
 
@@ -181,6 +192,7 @@ static ssBodyBinding* bodyBinding(ssRegistry* registry, dBodyID body) {
     return NULL;
   binding = &registry->bodies[registry->body_count++];
   registry->generation += 1;
+  registry->revision += 1;
   memset(binding, 0, sizeof *binding);
   binding->body = body;
   binding->written_step_s = NAN;
@@ -204,6 +216,7 @@ ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linea
   binding->linear_rate_per_s = linear_rate_per_s;
   binding->angular_rate_per_s = angular_rate_per_s;
   binding->written_step_s = NAN;
+  registry->revision += 1;
   return SS_OK;
 }
 
@@ -219,6 +232,7 @@ ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double i
   binding->average_window_s = average_window_s;
   binding->average_samples_written = 0;
   binding->written_step_s = NAN;
+  registry->revision += 1;
   return SS_OK;
 }
 
@@ -228,6 +242,7 @@ ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body) {
     if (registry->bodies[i].body != body) continue;
     registry->bodies[i] = registry->bodies[--registry->body_count];
     registry->generation += 1;
+    registry->revision += 1;
     return SS_OK;
   }
   return ssFail(SS_ERROR_NOT_FOUND, "body %p: not bound", (void*)body);
@@ -339,6 +354,13 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   if (status != SS_OK) return status;
   if (ssMappingName(mapping) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "mapping = %d: unknown", (int)mapping);
 
+  /* implicit Euler depends on h alone: a step as long as the last one, with nothing rebound since, has every row
+   * written already (a program with constant frames pays nothing here) */
+  if (mapping == SS_MAPPING_IMPLICIT_EULER && registry->applied_mapping == mapping &&
+      registry->applied_step_s == step_s && registry->applied_revision == registry->revision) {
+    if (report != NULL) *report = registry->applied_counts;
+    return SS_OK;
+  }
   ssApplyReport counts = {0, 0, 0, 0};
   if (registry->world_bound) {
     ssRowFallback fallback;
@@ -445,6 +467,10 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     ssBodyBinding* binding = &registry->bodies[i];
     if (binding->written_step_s != step_s) writeBody(binding, registry->world, step_s);
   }
+  registry->applied_mapping = mapping;
+  registry->applied_step_s = step_s;
+  registry->applied_revision = registry->revision;
+  registry->applied_counts = counts;
   if (report != NULL) *report = counts;
   return SS_OK;
 }
@@ -474,11 +500,13 @@ ssStatus ssRegistryReserve(ssRegistry* registry, int more_joints, int more_bodie
 double ssRegistry_TunedStep(const ssRegistry* registry) { return registry != NULL ? registry->tuned_step_s : 0; }
 
 void ssRegistrySetTuned(ssRegistry* registry, double tuned_step_s, ssSoftness tuned_world) {
+  registry->revision += 1;
   registry->tuned_step_s = tuned_step_s;
   registry->tuned_world = tuned_world;
 }
 
 void ssRegistryForgetWorldAdoption(ssRegistry* registry) {
+  registry->revision += 1;
   registry->world_bound = 0;
   registry->tuned_step_s = 0;
   if (ssRegistryHasBody(registry, 0)) ssRegistry_UnbindBody(registry, 0);
