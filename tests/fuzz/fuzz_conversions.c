@@ -33,9 +33,23 @@ static void require_valid_spring(ssSpring spring, const char* what) {
                what, spring.stiffness, spring.damping, ssLastError(), call);
 }
 
+/* The bounds of what the library hands ODE (limits.h, where it exists; the same values otherwise). */
+#if __has_include("steadystep/limits.h")
+#include "steadystep/limits.h"
+#endif
+#ifndef SS_MAX_ERP
+#define SS_MAX_ERP 1e9
+#endif
+#ifndef SS_MAX_CFM
+#define SS_MAX_CFM 1e20
+#endif
+
+/* A softness returned OK: finite, cfm in (0, SS_MAX_CFM], |erp| <= SS_MAX_ERP; the spring mapping's erp in [0, 1]. */
 static void require_valid_softness(ssSoftness softness, const char* what, ssSpring spring, double mass, double h,
-                                   double previous) {
-  FUZZ_REQUIRE(isfinite(softness.erp) && softness.erp >= 0 && isfinite(softness.cfm) && softness.cfm > 0,
+                                   double previous, int spring_mapping) {
+  FUZZ_REQUIRE(isfinite(softness.erp) && fabs(softness.erp) <= SS_MAX_ERP && isfinite(softness.cfm) &&
+                   softness.cfm > 0 && softness.cfm <= SS_MAX_CFM &&
+                   (!spring_mapping || (softness.erp >= 0 && softness.erp <= 1)),
                "%s(k = %.17g, c = %.17g, mass = %.17g, h = %.17g, previous = %.17g) returned OK with erp = %g, "
                "cfm = %g",
                what, spring.stiffness, spring.damping, mass, h, previous, softness.erp, softness.cfm);
@@ -43,9 +57,9 @@ static void require_valid_softness(ssSoftness softness, const char* what, ssSpri
 
 /* The outcome of a softness call: checked whichever way it went. */
 static void check_softness(ssStatus status, const ssSoftness* out, const char* what, ssSpring spring, double mass,
-                           double h, double previous) {
+                           double h, double previous, int spring_mapping) {
   if (status == SS_OK)
-    require_valid_softness(*out, what, spring, mass, h, previous);
+    require_valid_softness(*out, what, spring, mass, h, previous, spring_mapping);
   else
     require_refused_cleanly(status, out, sizeof *out, what);
 }
@@ -62,7 +76,8 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   switch (which % 9) {
     case 0: {
       fill_canary(&softness, sizeof softness);
-      check_softness(ssSoftnessFromSpring(spring, a, &softness), &softness, "ssSoftnessFromSpring", spring, 0, a, 0);
+      check_softness(ssSoftnessFromSpring(spring, a, &softness), &softness, "ssSoftnessFromSpring", spring, 0, a, 0,
+                     1);
       break;
     }
     case 1: {
@@ -102,17 +117,19 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     case 4:
       fill_canary(&softness, sizeof softness);
-      check_softness(ssMatchedSoftness(spring, a, b, &softness), &softness, "ssMatchedSoftness", spring, a, b, 0);
+      check_softness(ssMatchedSoftness(spring, a, b, &softness), &softness, "ssMatchedSoftness", spring, a, b, 0,
+                     0);
       break;
     case 5:
       fill_canary(&softness, sizeof softness);
-      check_softness(ssExactSoftness(spring, a, b, c, &softness), &softness, "ssExactSoftness", spring, a, b, c);
+      check_softness(ssExactSoftness(spring, a, b, c, &softness), &softness, "ssExactSoftness", spring, a, b, c,
+                     0);
       break;
     case 6: {
       int mapping = fuzz_int(&in);
       fill_canary(&softness, sizeof softness);
       check_softness(ssSoftnessFor((ssMapping)mapping, spring, a, b, c, &softness), &softness, "ssSoftnessFor",
-                     spring, a, b, c);
+                     spring, a, b, c, mapping == SS_MAPPING_SPRING);
       const char* name = ssMappingName((ssMapping)mapping);
       FUZZ_REQUIRE((mapping >= 0 && mapping <= 2) == (name != NULL), "ssMappingName(%d) = %s", mapping,
                    name ? name : "NULL");
@@ -131,7 +148,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       /* A round trip: a spring accepted, turned into softness at h and back, is a valid spring again. */
       fill_canary(&softness, sizeof softness);
       ssStatus status = ssSoftnessFromSpring(spring, a, &softness);
-      check_softness(status, &softness, "ssSoftnessFromSpring", spring, 0, a, 0);
+      check_softness(status, &softness, "ssSoftnessFromSpring", spring, 0, a, 0, 1);
       if (status == SS_OK && softness.erp > 0) {
         fill_canary(&spring_out, sizeof spring_out);
         status = ssSpringFromSoftness(softness, a, &spring_out);

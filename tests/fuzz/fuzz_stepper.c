@@ -1,18 +1,22 @@
 /* Fuzz target: the registry and the stepper on a small world holding every ODE 0.16 joint type and contacts.
  *
  * The world is a row of islands, each one body (two for hinge-2 and the transmission) held to the static world by
- * one joint type, plus two free boxes that fall on a ground plane. Every soft row the library supports starts bound
- * to a default spring; the input then drives a sequence of operations: frames of any length (NaN, infinities,
- * negative, denormal, huge), policy changes (valid or not), rebinding rows with fuzzed springs and effective
- * masses, loads, damping, auto-disable, the world's ERP/CFM, the contact spring, body masses, and destroying an
- * island (unbinding first, as registry.h asks) and building it again.
+ * one joint type, plus two free boxes that fall on a ground plane. The soft rows come either from adoption
+ * (adopt.h: the world's and the joints' ERP/CFM as ODE holds them, tuned at a fuzzed step, and fuzzed tuned values
+ * on rebuilt joints) or from binding every supported row to a default spring (registry.h). The input then drives a
+ * sequence of operations: frames of any length (NaN, infinities, negative, denormal, huge), policy changes (valid
+ * or not), rebinding rows with fuzzed springs and effective masses, loads, damping, auto-disable, the world's
+ * ERP/CFM, the contact softness, body masses, resets, and destroying an island through the stepper
+ * (ssStepper_DestroyJoint/DestroyBody, in either order, with a frame in between or not) and building it again.
  *
  * Promises checked: the process never aborts; a refusal names something (ssLastError) and changes nothing (binding
  * count, body states for frame refusals); a frame reported OK leaves every body's state finite; a blow-up names the
- * body. Masses stay within [1e-3, 1e3] kg: the program, not the library, hands them to ODE. */
+ * body, and the stepper then refuses frames until ssStepper_Reset. Masses stay within [1e-3, 1e3] kg: the program,
+ * not the library, hands them to ODE. */
 #include <ode/ode.h>
 
 #include "fuzz_input.h"
+#include "steadystep/adopt.h"
 #include "steadystep/stepper.h"
 
 enum {
@@ -30,22 +34,29 @@ typedef struct Island {
   int joint_count;
 } Island;
 
-typedef struct World {
+typedef struct World World;
+struct World {
   dWorldID world;
   dSpaceID space;
   dJointGroupID contacts;
   ssRegistry* registry;
   ssStepper* stepper;
   Island islands[ISLAND_COUNT];
-  ssSpring contact_spring;
+  ssSpring contact_spring;   /* bind mode: the spring ssContactSoften gets */
+  double contact_erp, contact_cfm; /* adopt mode: the contact's tuned soft_erp/soft_cfm for ssStepper_SoftenContact */
+  int adopt;                 /* soft rows come from adoption rather than from binding */
+  struct World* self;        /* what the geoms' data points at, so that the near callback finds the world */
   ssPolicy policy;
   double max_step_s, fixed_step_s;
   int max_steps_per_frame;
-} World;
+};
 
 typedef struct BodyState {
   dReal position[3], quaternion[4], linear[3], angular[3];
 } BodyState;
+
+/* STEADYSTEP_FUZZ_VERBOSE=1 in the environment prints every operation: to read what a reproducer does. */
+static int verbose = -1;
 
 static const ssSpring DEFAULT_SPRING = {40.0, 0.5};
 
@@ -70,7 +81,13 @@ static void set_param(dJointID joint, int parameter, double value) {
     case dJointTypePR: dJointSetPRParam(joint, parameter, value); break;
     case dJointTypePU: dJointSetPUParam(joint, parameter, value); break;
     case dJointTypePiston: dJointSetPistonParam(joint, parameter, value); break;
-    default: abort();
+    case dJointTypeBall: dJointSetBallParam(joint, parameter, value); break;
+    case dJointTypeFixed: dJointSetFixedParam(joint, parameter, value); break;
+    case dJointTypeDBall: dJointSetDBallParam(joint, parameter, value); break;
+    case dJointTypeDHinge: dJointSetDHingeParam(joint, parameter, value); break;
+    case dJointTypeTransmission: dJointSetTransmissionParam(joint, parameter, value); break;
+    case dJointTypePlane2D: dJointSetPlane2DXParam(joint, parameter, value); break;
+    default: break; /* null: nothing to set */
   }
 }
 
@@ -97,7 +114,9 @@ static void bind_defaults(World* w, dJointID joint) {
       }
 }
 
-static void build_island(World* w, int kind) {
+/* Makes the island's bodies and joints. When tuned is given (adopt mode), the main joint's first soft row gets those
+ * tuned ERP/CFM before adoption: values the program set, which adoption must either take or refuse by name. */
+static void build_island(World* w, int kind, const double* tuned) {
   Island* island = &w->islands[kind];
   memset(island, 0, sizeof *island);
   double x = 2.0 * kind, z = 1.0;
@@ -253,71 +272,109 @@ static void build_island(World* w, int kind) {
       for (int i = 0; i < 2; ++i) {
         island->geoms[i] = dCreateBox(w->space, 0.2, 0.2, 0.2);
         dGeomSetBody(island->geoms[i], island->bodies[i]);
+        dGeomSetData(island->geoms[i], &w->self);
       }
       break;
     }
   }
   if (joint != 0) island->joints[island->joint_count++] = joint;
-  for (int i = 0; i < island->joint_count; ++i) bind_defaults(w, island->joints[i]);
+  if (!w->adopt) {
+    for (int i = 0; i < island->joint_count; ++i) bind_defaults(w, island->joints[i]);
+  } else {
+    if (tuned != NULL && joint != 0) {
+      int stop = ssJointSupports(joint, SS_PARAM_STOP, 1);
+      set_param(joint, stop ? dParamStopERP : dParamERP, tuned[0]);
+      set_param(joint, stop ? dParamStopCFM : dParamCFM, tuned[1]);
+    }
+    int bindings = ssRegistry_JointBindingCount(w->registry);
+    ssStatus status = ssRegistry_AdoptBody(w->registry, body, NULL);
+    if (verbose && tuned != NULL)
+      fprintf(stderr, "  AdoptBody(island %d, tuned erp %.17g, cfm %.17g) = %s %s\n", kind, tuned[0], tuned[1],
+              ssStatusName(status), status == SS_OK ? "" : ssLastError());
+    if (status != SS_OK) {
+      FUZZ_REQUIRE(tuned != NULL, "adopting island %d with ODE's own values: %s", kind, ssLastError());
+      FUZZ_REQUIRE(ssLastError()[0] != '\0' && ssRegistry_JointBindingCount(w->registry) == bindings,
+                   "AdoptBody refused (%s) but bound something or said nothing", ssStatusName(status));
+      /* Put ODE's defaults back, as a program would after the refusal, and adopt those. */
+      int stop = ssJointSupports(joint, SS_PARAM_STOP, 1);
+      set_param(joint, stop ? dParamStopERP : dParamERP, 0.2);
+      set_param(joint, stop ? dParamStopCFM : dParamCFM, 1e-5);
+      FUZZ_REQUIRE(ssRegistry_AdoptBody(w->registry, body, NULL) == SS_OK, "adopting defaults: %s", ssLastError());
+    }
+  }
   for (int i = 0; i < island->body_count; ++i)
     FUZZ_REQUIRE(ssStepper_WatchBody(w->stepper, island->bodies[i]) == SS_OK, "watch: %s", ssLastError());
 }
 
-/* The documented order: unbind, unwatch, then destroy. */
-static void destroy_island(World* w, int kind) {
+static int frame(World* w, double frame_s, int op);
+
+/* The documented way: ssStepper_DestroyJoint and ssStepper_DestroyBody, joints first or bodies first (ODE then
+ * detaches the joints, which stay bound until destroyed), with a frame in between when asked. */
+static int destroy_island(World* w, int kind, int bodies_first, int frame_between) {
   Island* island = &w->islands[kind];
-  for (int i = 0; i < island->joint_count; ++i) {
-    ssRegistry_UnbindJoint(w->registry, island->joints[i]); /* NOT_FOUND when nothing was bound: fine */
-    dJointDestroy(island->joints[i]);
-  }
-  for (int i = 0; i < island->body_count; ++i) {
-    ssRegistry_UnbindBody(w->registry, island->bodies[i]);
-    FUZZ_REQUIRE(ssStepper_UnwatchBody(w->stepper, island->bodies[i]) == SS_OK, "unwatch: %s", ssLastError());
-    if (island->geoms[i] != 0) dGeomDestroy(island->geoms[i]);
-    dBodyDestroy(island->bodies[i]);
+  int alive = 1;
+  for (int pass = 0; pass < 2; ++pass) {
+    if ((pass == 0) != (bodies_first != 0)) {
+      for (int i = 0; i < island->joint_count; ++i)
+        FUZZ_REQUIRE(ssStepper_DestroyJoint(w->stepper, island->joints[i]) == SS_OK, "DestroyJoint: %s",
+                     ssLastError());
+      island->joint_count = 0;
+    } else {
+      for (int i = 0; i < island->body_count; ++i) {
+        if (island->geoms[i] != 0) dGeomDestroy(island->geoms[i]);
+        FUZZ_REQUIRE(ssStepper_DestroyBody(w->stepper, island->bodies[i]) == SS_OK, "DestroyBody: %s",
+                     ssLastError());
+      }
+      island->body_count = 0;
+    }
+    if (pass == 0 && frame_between) alive = frame(w, 1.0 / 60, -1);
   }
   memset(island, 0, sizeof *island);
+  return alive;
 }
 
 /* ---- contacts ---- */
 
-typedef struct CollideCall {
-  World* w;
-  ssMapping mapping;
-  double step_s, previous_step_s;
-} CollideCall;
-
 static void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
-  CollideCall* call = data;
+  ssStepper* stepper = data;
+  World* w = *(World**)dGeomGetData(geom1);
   dBodyID body1 = dGeomGetBody(geom1), body2 = dGeomGetBody(geom2);
+  ssStepInfo step = ssStepper_CurrentStep(stepper);
   dContact contacts[4];
   int count = dCollide(geom1, geom2, 4, &contacts[0].geom, sizeof contacts[0]);
   for (int i = 0; i < count; ++i) {
     contacts[i].surface.mode = dContactApprox1;
     contacts[i].surface.mu = 0.8;
+    if (w->adopt) {
+      contacts[i].surface.mode |= dContactSoftERP | dContactSoftCFM;
+      contacts[i].surface.soft_erp = w->contact_erp;
+      contacts[i].surface.soft_cfm = w->contact_cfm;
+    }
     dContact before = contacts[i];
-    ssStatus status = ssContactSoften(&contacts[i], body1, body2, call->w->contact_spring, call->mapping,
-                                      call->step_s, call->previous_step_s);
+    ssStatus status = w->adopt ? ssStepper_SoftenContact(stepper, &contacts[i], body1, body2)
+                               : ssContactSoften(&contacts[i], body1, body2, w->contact_spring, step.mapping,
+                                                 step.softness_step_s, step.previous_step_s);
     if (status != SS_OK) {
-      FUZZ_REQUIRE(ssLastError()[0] != '\0', "ssContactSoften refused (%s) without a message", ssStatusName(status));
-      FUZZ_REQUIRE(memcmp(&before, &contacts[i], sizeof before) == 0, "ssContactSoften refused (%s) but changed the "
-                   "contact", ssLastError());
-      /* The program's choice when a contact cannot be softened: keep it, rigid (world ERP/CFM). */
+      FUZZ_REQUIRE(ssLastError()[0] != '\0', "softening a contact refused (%s) without a message",
+                   ssStatusName(status));
+      FUZZ_REQUIRE(memcmp(&before, &contacts[i], sizeof before) == 0, "softening a contact refused (%s) but changed "
+                   "the contact", ssLastError());
+      /* The program's choice when a contact cannot be softened: keep it with ODE's defaults (rigid). */
+      contacts[i].surface.mode = dContactApprox1;
     } else {
       FUZZ_REQUIRE(isfinite(contacts[i].surface.soft_erp) && isfinite(contacts[i].surface.soft_cfm) &&
-                       contacts[i].surface.soft_cfm > 0,
-                   "ssContactSoften OK with erp %g cfm %g", contacts[i].surface.soft_erp,
+                       contacts[i].surface.soft_cfm >= 0,
+                   "contact softened OK with erp %g cfm %g", contacts[i].surface.soft_erp,
                    contacts[i].surface.soft_cfm);
     }
-    dJointID joint = dJointCreateContact(call->w->world, call->w->contacts, &contacts[i]);
+    dJointID joint = dJointCreateContact(w->world, w->contacts, &contacts[i]);
     dJointAttach(joint, body1, body2);
   }
 }
 
-static void collide(void* context, ssMapping mapping, double step_s, double previous_step_s) {
+static void collide(void* context, ssStepper* stepper) {
   World* w = context;
-  CollideCall call = {w, mapping, step_s, previous_step_s};
-  dSpaceCollide(w->space, &call, near_callback);
+  dSpaceCollide(w->space, stepper, near_callback);
 }
 
 /* ---- states ---- */
@@ -361,8 +418,6 @@ static double steps_for(const World* w, double frame_s) {
   }
 }
 
-/* STEADYSTEP_FUZZ_VERBOSE=1 in the environment prints every frame: to read what a reproducer does. */
-static int verbose = -1;
 
 /* One frame; returns 0 when the run must end (the world blew up). */
 static int frame(World* w, double frame_s, int op) {
@@ -387,10 +442,17 @@ static int frame(World* w, double frame_s, int op) {
                    report.steps);
       return 1;
     case SS_ERROR_BLOWUP:
-    case SS_ERROR_SPEED_LIMIT:
+    case SS_ERROR_SPEED_LIMIT: {
       FUZZ_REQUIRE(ssLastError()[0] != '\0' && report.failed_body != 0, "op %d: %s without a message or a body", op,
                    ssStatusName(status));
+      /* Latched: the next frame is refused and changes nothing. The run ends: the world is the program's to repair. */
+      snapshot(w, before, CAPACITY);
+      status = ssStepper_Step(w->stepper, 1.0 / 60, &report);
+      snapshot(w, after, CAPACITY);
+      FUZZ_REQUIRE(status == SS_ERROR_FAILED && memcmp(before, after, count * sizeof before[0]) == 0,
+                   "op %d: the frame after a blow-up returned %s", op, ssStatusName(status));
       return 0;
+    }
     default:
       FUZZ_REQUIRE(ssLastError()[0] != '\0', "op %d: frame %.17g s refused (%s) without a message", op, frame_s,
                    ssStatusName(status));
@@ -445,7 +507,8 @@ static void make_world(World* w, FuzzInput* in) {
   w->world = dWorldCreate();
   dWorldSetGravity(w->world, 0, 0, -9.81);
   w->space = dSimpleSpaceCreate(0);
-  dCreatePlane(w->space, 0, 0, 1, 0);
+  w->self = w;
+  dGeomSetData(dCreatePlane(w->space, 0, 0, 1, 0), &w->self);
   w->contacts = dJointGroupCreate(0);
   w->registry = ssRegistry_Create(w->world);
   FUZZ_REQUIRE(w->registry != NULL, "out of memory");
@@ -458,7 +521,6 @@ static void make_world(World* w, FuzzInput* in) {
   def.collide = collide;
   def.collide_context = w;
   def.contact_group = w->contacts;
-  def.max_speed = 100;
   def.policy = (ssPolicy)(fuzz_byte(in) % 6); /* 5 is unknown */
   def.solver = (ssSolver)(fuzz_byte(in) % 3);
   uint8_t fields = fuzz_byte(in);
@@ -467,6 +529,11 @@ static void make_world(World* w, FuzzInput* in) {
   if (fields & 4) def.reference_step_s = fuzz_double(in);
   if (fields & 8) def.max_steps_per_frame = (int8_t)fuzz_byte(in);
   if (fields & 16) def.quick_iterations = (int8_t)fuzz_byte(in);
+  w->adopt = (fields & 32) != 0;
+  double world_erp = fields & 64 ? fuzz_double(in) : 0.2, world_cfm = fields & 64 ? fuzz_double(in) : 1e-10;
+  double tuned_step_s = fields & 128 ? fuzz_double(in) : 1.0 / 60;
+  w->contact_erp = 0.2;
+  w->contact_cfm = 1e-5;
   ssStepper* const canary = (ssStepper*)w;
   w->stepper = canary;
   ssStatus status = ssStepper_Create(&def, &w->stepper);
@@ -479,7 +546,6 @@ static void make_world(World* w, FuzzInput* in) {
     fallback.collide = def.collide;
     fallback.collide_context = def.collide_context;
     fallback.contact_group = def.contact_group;
-    fallback.max_speed = def.max_speed;
     def = fallback;
     FUZZ_REQUIRE(ssStepper_Create(&def, &w->stepper) == SS_OK, "default stepper: %s", ssLastError());
   }
@@ -487,7 +553,24 @@ static void make_world(World* w, FuzzInput* in) {
   w->max_step_s = def.max_step_s;
   w->fixed_step_s = def.fixed_step_s;
   w->max_steps_per_frame = def.max_steps_per_frame;
-  for (int kind = 0; kind < ISLAND_COUNT; ++kind) build_island(w, kind);
+  if (w->adopt) {
+    /* The program tuned the world (maybe badly) at a step (maybe bad): adopted, or refused by name with nothing
+     * bound; then ODE's defaults at 1/60 s. */
+    dWorldSetERP(w->world, world_erp);
+    dWorldSetCFM(w->world, world_cfm);
+    status = ssRegistry_AdoptWorld(w->registry, tuned_step_s, NULL);
+    if (verbose)
+      fprintf(stderr, "AdoptWorld(erp %.17g, cfm %.17g, tuned %.17g s) = %s %s\n", world_erp, world_cfm,
+              tuned_step_s, ssStatusName(status), status == SS_OK ? "" : ssLastError());
+    if (status != SS_OK) {
+      FUZZ_REQUIRE(ssLastError()[0] != '\0' && ssRegistry_TunedStep(w->registry) == 0,
+                   "AdoptWorld refused (%s) without a message or with a tuned step", ssStatusName(status));
+      dWorldSetERP(w->world, 0.2);
+      dWorldSetCFM(w->world, 1e-10);
+      FUZZ_REQUIRE(ssRegistry_AdoptWorld(w->registry, 1.0 / 60, NULL) == SS_OK, "AdoptWorld: %s", ssLastError());
+    }
+  }
+  for (int kind = 0; kind < ISLAND_COUNT; ++kind) build_island(w, kind, NULL);
 }
 
 static void destroy_world(World* w) {
@@ -511,9 +594,9 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   make_world(&w, &in);
   for (int op = 0; op < MAX_OPS && !fuzz_empty(&in); ++op) {
     uint8_t code = fuzz_byte(&in);
-    if (verbose) fprintf(stderr, "op %d: code %d\n", op, code % 13);
+    if (verbose) fprintf(stderr, "op %d: code %d\n", op, code % 14);
     int bindings = ssRegistry_JointBindingCount(w.registry);
-    switch (code % 13) {
+    switch (code % 14) {
       case 0:
         if (!frame(&w, fuzz_double(&in), op)) goto done;
         break;
@@ -562,9 +645,15 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         break;
       }
       case 5: {
-        int kind = fuzz_byte(&in) % ISLAND_COUNT;
-        destroy_island(&w, kind);
-        build_island(&w, kind);
+        uint8_t how = fuzz_byte(&in);
+        int kind = how % ISLAND_COUNT;
+        double tuned[2] = {0.2, 1e-5};
+        if (how & 0x80) {
+          tuned[0] = fuzz_double(&in);
+          tuned[1] = fuzz_double(&in);
+        }
+        if (!destroy_island(&w, kind, how & 0x20, how & 0x40)) goto done;
+        build_island(&w, kind, how & 0x80 ? tuned : NULL);
         break;
       }
       case 6: {
@@ -596,14 +685,23 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         check_registry_call(&w, status, bindings, "ssRegistry_BindWorld");
         break;
       }
-      case 9:
-        w.contact_spring.stiffness = fuzz_double(&in);
-        w.contact_spring.damping = fuzz_double(&in);
-        if (verbose)
-          fprintf(stderr, "  contact spring {%.17g, %.17g}\n", w.contact_spring.stiffness, w.contact_spring.damping);
+      case 9: {
+        double a = fuzz_double(&in), b = fuzz_double(&in);
+        if (w.adopt) {
+          w.contact_erp = a;
+          w.contact_cfm = b;
+        } else {
+          w.contact_spring.stiffness = a;
+          w.contact_spring.damping = b;
+        }
+        if (verbose) fprintf(stderr, "  contact %s {%.17g, %.17g}\n", w.adopt ? "erp, cfm" : "spring", a, b);
         break;
+      }
       case 10:
         ssStepper_ResetHistory(w.stepper);
+        break;
+      case 13:
+        ssStepper_Reset(w.stepper);
         break;
       case 11: {
         dBodyID body = pick_body(&w, fuzz_byte(&in));
