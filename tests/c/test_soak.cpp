@@ -1,5 +1,5 @@
-// Hostile-frame soak: every scene under every policy, fed frames from 1e-12 s to 10 s, hitches, runs of tiny frames
-// and frames that must be refused (NaN, infinities, negative). The promises checked:
+// Hostile-frame soak: every scene under every policy, fed frames from 1e-12 s to 10 s, hitches, runs of tiny frames,
+// a seeded random stretch, and frames that must be refused (NaN, infinities, negative). The promises checked:
 //  - nothing aborts: each scene/policy pair runs in a child process (a death-test style fork), so an abort inside
 //    ODE shows up as a failed test with the child's output, not as a crash of the test program;
 //  - a refused frame is refused by name ("frame_s" in ssLastError) and changes nothing (time and samples the same);
@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -46,6 +47,12 @@ std::vector<double> HostileFrames() {
   frames.push_back(0.0);
   frames.push_back(-std::numeric_limits<double>::denorm_min());
   for (int i = 0; i < 10; ++i) frames.push_back(1.0 / 30);
+  // Then a seeded random stretch: log-uniform in [1e-12, 10] s, with a hostile value one frame in twenty.
+  std::mt19937_64 random(20261125);
+  std::uniform_real_distribution<double> decade(-12, 1);
+  const double hostile[] = {kNan, kInf, -kInf, -1e-3, -10, -std::numeric_limits<double>::max()};
+  for (int i = 0; i < 200; ++i)
+    frames.push_back(random() % 20 == 0 ? hostile[random() % 6] : std::pow(10.0, decade(random)));
   return frames;
 }
 
@@ -70,7 +77,7 @@ std::string RunSoak(const char* scene_name, int policy, Tally* tally) {
   std::ostringstream problems;
   ssSceneParams params;
   if (ssDefaultSceneParams(scene_name, &params) != SS_OK) return std::string("params: ") + ssLastError() + "\n";
-  if (params.body_count > 6) params.body_count = 6;  // enough bodies to collide and pile; bounded time
+  if (params.body_count > 12) params.body_count = 12;  // enough bodies to collide and pile; bounded time
   ssStepping stepping = ssDefaultStepping();
   stepping.policy = policy;
   ssScene* scene = nullptr;
