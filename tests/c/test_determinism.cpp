@@ -1,4 +1,4 @@
-// Determinism, as Box2D pins it: a fixed scene run (chain and buggy, 2 s under fixed:60, the spring policy) is
+// Determinism, as Box2D pins it: a fixed scene run (chain and buggy, 2 s under fixed:60, implicit Euler) is
 // hashed (FNV-1a over the bytes of every record: time, step length and each quantity after every step) and compared
 // with a pinned value for each ODE solver. Any change of trajectory, however small, changes the hash.
 // When a change of trajectory is deliberate, the failure prints the new value: replace the pinned one in one edit.
@@ -28,8 +28,7 @@ uint64_t RunHash(const char* scene, ssSolver solver, int* steps_out) {
   ssRunDef def{};
   def.scene = scene;
   EXPECT_EQ(ssDefaultSceneParams(scene, &def.params), SS_OK) << ssLastError();
-  def.stepping = ssDefaultStepping();
-  def.stepping.policy = SS_POLICY_SPRING;
+  def.stepping = ssDefaultStepping();  // substeps of at most 1/60 s, implicit Euler at each step's length
   def.stepping.solver = solver;
   def.profile = "fixed:60";
   def.seed = 1;

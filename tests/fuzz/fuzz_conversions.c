@@ -129,7 +129,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       int mapping = fuzz_int(&in);
       fill_canary(&softness, sizeof softness);
       check_softness(ssSoftnessFor((ssMapping)mapping, spring, a, b, c, &softness), &softness, "ssSoftnessFor",
-                     spring, a, b, c, mapping == SS_MAPPING_SPRING);
+                     spring, a, b, c, mapping == SS_MAPPING_IMPLICIT_EULER);
       const char* name = ssMappingName((ssMapping)mapping);
       FUZZ_REQUIRE((mapping >= 0 && mapping <= 2) == (name != NULL), "ssMappingName(%d) = %s", mapping,
                    name ? name : "NULL");

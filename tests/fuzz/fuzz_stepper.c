@@ -4,10 +4,11 @@
  * one joint type, plus two free boxes that fall on a ground plane. The soft rows come either from adoption
  * (adopt.h: the world's and the joints' ERP/CFM as ODE holds them, tuned at a fuzzed step, and fuzzed tuned values
  * on rebuilt joints) or from binding every supported row to a default spring (registry.h). The input then drives a
- * sequence of operations: frames of any length (NaN, infinities, negative, denormal, huge), policy changes (valid
- * or not), rebinding rows with fuzzed springs and effective masses, loads, damping, auto-disable, the world's
- * ERP/CFM, the contact softness, body masses, resets, and destroying an island through the stepper
- * (ssStepper_DestroyJoint/DestroyBody, in either order, with a frame in between or not) and building it again.
+ * sequence of operations: frames of any length (NaN, infinities, negative, denormal, huge), stepping changes (lab
+ * policies, or cut, mapping, frozen step and limits fuzzed, valid or not), rebinding rows with fuzzed springs and
+ * effective masses, loads, damping, auto-disable, the world's ERP/CFM, the contact softness, body masses, resets,
+ * and destroying an island through the stepper (ssStepper_DestroyJoint/DestroyBody, in either order, with a frame in
+ * between or not) and building it again.
  *
  * Promises checked: the process never aborts; a refusal names something (ssLastError) and changes nothing (binding
  * count, body states for frame refusals); a frame reported OK leaves every body's state finite; a blow-up names the
@@ -46,14 +47,15 @@ struct World {
   double contact_erp, contact_cfm; /* adopt mode: the contact's tuned soft_erp/soft_cfm for ssStepper_SoftenContact */
   int adopt;                 /* soft rows come from adoption rather than from binding */
   struct World* self;        /* what the geoms' data points at, so that the near callback finds the world */
-  ssPolicy policy;
-  double max_step_s, fixed_step_s;
-  int max_steps_per_frame;
+  ssStepping stepping;       /* the stepper's, as last accepted */
 };
 
 typedef struct BodyState {
   dReal position[3], quaternion[4], linear[3], angular[3];
 } BodyState;
+
+/* A name for printing, whatever the enum value. */
+#define NAME_OR_UNKNOWN(name) ((name) != NULL ? (name) : "unknown")
 
 /* STEADYSTEP_FUZZ_VERBOSE=1 in the environment prints every operation: to read what a reproducer does. */
 static int verbose = -1;
@@ -411,10 +413,10 @@ static int all_finite(const BodyState* states, int count, int* which) {
 /* Physics steps the frame would take; frames that would take more are not stepped (they test the machine). */
 static double steps_for(const World* w, double frame_s) {
   if (!(frame_s > 0) || !isfinite(frame_s)) return 0;
-  switch (w->policy) {
-    case SS_POLICY_NAIVE: return 1;
-    case SS_POLICY_FIXED: return fmin(ceil(frame_s / w->fixed_step_s), w->max_steps_per_frame);
-    default: return ceil(frame_s / w->max_step_s);
+  switch (w->stepping.cut) {
+    case SS_CUT_WHOLE_FRAME: return 1;
+    case SS_CUT_FIXED: return fmin(ceil(frame_s / w->stepping.fixed_step_s), w->stepping.max_steps_per_frame);
+    default: return ceil(frame_s / w->stepping.max_step_s);
   }
 }
 
@@ -430,13 +432,14 @@ static int frame(World* w, double frame_s, int op) {
   ssStatus status = ssStepper_Step(w->stepper, frame_s, &report);
   snapshot(w, after, CAPACITY);
   if (verbose)
-    fprintf(stderr, "op %d: %s frame %.17g s: %s, %d steps, %s\n", op, ssPolicyName(w->policy), frame_s,
-            ssStatusName(status), report.steps, status == SS_OK ? "" : ssLastError());
+    fprintf(stderr, "op %d: %s/%s frame %.17g s: %s, %d steps, %s\n", op,
+            NAME_OR_UNKNOWN(ssFrameCutName(w->stepping.cut)), NAME_OR_UNKNOWN(ssMappingName(w->stepping.mapping)),
+            frame_s, ssStatusName(status), report.steps, status == SS_OK ? "" : ssLastError());
   int which = -1;
   switch (status) {
     case SS_OK:
       FUZZ_REQUIRE(all_finite(after, count, &which), "op %d: frame %.17g s under %s reported OK but body %d is not "
-                   "finite", op, frame_s, ssPolicyName(w->policy), which);
+                   "finite", op, frame_s, NAME_OR_UNKNOWN(ssMappingName(w->stepping.mapping)), which);
       FUZZ_REQUIRE(isfinite(report.simulated_s) && report.simulated_s >= 0 && report.steps >= 0,
                    "op %d: frame %.17g s: report simulated %g s in %d steps", op, frame_s, report.simulated_s,
                    report.steps);
@@ -521,14 +524,16 @@ static void make_world(World* w, FuzzInput* in) {
   def.collide = collide;
   def.collide_context = w;
   def.contact_group = w->contacts;
-  def.policy = (ssPolicy)(fuzz_byte(in) % 6); /* 5 is unknown */
-  def.solver = (ssSolver)(fuzz_byte(in) % 3);
+  uint8_t how = fuzz_byte(in);
+  def.stepping.cut = (ssFrameCut)(how % 4);           /* 3 is unknown */
+  def.stepping.mapping = (ssMapping)((how >> 2) % 4); /* 3 is unknown */
+  def.stepping.solver = (ssSolver)((how >> 4) % 3);   /* 2 is unknown */
   uint8_t fields = fuzz_byte(in);
-  if (fields & 1) def.max_step_s = fuzz_double(in);
-  if (fields & 2) def.fixed_step_s = fuzz_double(in);
-  if (fields & 4) def.reference_step_s = fuzz_double(in);
-  if (fields & 8) def.max_steps_per_frame = (int8_t)fuzz_byte(in);
-  if (fields & 16) def.quick_iterations = (int8_t)fuzz_byte(in);
+  if (fields & 1) def.stepping.max_step_s = fuzz_double(in);
+  if (fields & 2) def.stepping.fixed_step_s = fuzz_double(in);
+  if (fields & 4) def.stepping.frozen_step_s = fuzz_double(in);
+  if (fields & 8) def.stepping.max_steps_per_frame = (int8_t)fuzz_byte(in);
+  if (fields & 16) def.stepping.quick_iterations = (int8_t)fuzz_byte(in);
   w->adopt = (fields & 32) != 0;
   double world_erp = fields & 64 ? fuzz_double(in) : 0.2, world_cfm = fields & 64 ? fuzz_double(in) : 1e-10;
   double tuned_step_s = fields & 128 ? fuzz_double(in) : 1.0 / 60;
@@ -549,10 +554,9 @@ static void make_world(World* w, FuzzInput* in) {
     def = fallback;
     FUZZ_REQUIRE(ssStepper_Create(&def, &w->stepper) == SS_OK, "default stepper: %s", ssLastError());
   }
-  w->policy = def.policy;
-  w->max_step_s = def.max_step_s;
-  w->fixed_step_s = def.fixed_step_s;
-  w->max_steps_per_frame = def.max_steps_per_frame;
+  w->stepping = ssStepper_Stepping(w->stepper);
+  FUZZ_REQUIRE(memcmp(&w->stepping, &def.stepping, sizeof def.stepping) == 0, "the stepper's stepping is not the one "
+               "it was made with");
   if (w->adopt) {
     /* The program tuned the world (maybe badly) at a step (maybe bad): adopted, or refused by name with nothing
      * bound; then ODE's defaults at 1/60 s. */
@@ -608,14 +612,40 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         break;
       }
       case 2: {
-        int policy = (int8_t)fuzz_byte(&in);
-        ssStatus status = ssStepper_SetPolicy(w.stepper, (ssPolicy)policy);
-        if (status == SS_OK)
-          w.policy = (ssPolicy)policy;
-        else
-          FUZZ_REQUIRE(ssLastError()[0] != '\0', "SetPolicy(%d) refused without a message", policy);
-        FUZZ_REQUIRE((status == SS_OK) == (policy >= 0 && policy <= 4), "SetPolicy(%d) = %s", policy,
-                     ssStatusName(status));
+        /* A new stepping: a lab policy by index (0x80 clear) or fields fuzzed one by one. */
+        uint8_t which = fuzz_byte(&in);
+        ssStepping stepping = w.stepping;
+        if (!(which & 0x80)) {
+          const char* name = ssPolicyNameAt(which % (ssPolicyCount() + 1)); /* one past the end: NULL */
+          ssStatus status = ssSteppingForPolicy(name, fuzz_double(&in), &stepping);
+          if (status != SS_OK) {
+            FUZZ_REQUIRE(ssLastError()[0] != '\0' && memcmp(&stepping, &w.stepping, sizeof stepping) == 0,
+                         "ssSteppingForPolicy(%s) refused (%s) without a message or changed the stepping",
+                         name ? name : "NULL", ssStatusName(status));
+            break;
+          }
+        } else {
+          stepping.cut = (ssFrameCut)(int8_t)fuzz_byte(&in);
+          stepping.mapping = (ssMapping)(int8_t)fuzz_byte(&in);
+          stepping.frozen_step_s = which & 1 ? fuzz_double(&in) : 0;
+          if (which & 2) stepping.max_step_s = fuzz_double(&in);
+          if (which & 4) stepping.fixed_step_s = fuzz_double(&in);
+          if (which & 8) stepping.max_speed = fuzz_double(&in);
+          if (which & 16) stepping.max_angular_speed = fuzz_double(&in);
+        }
+        ssStatus status = ssStepper_SetStepping(w.stepper, &stepping);
+        ssStepping now = ssStepper_Stepping(w.stepper);
+        if (status == SS_OK) {
+          FUZZ_REQUIRE(memcmp(&now, &stepping, sizeof now) == 0, "SetStepping OK but the stepping differs");
+          w.stepping = now;
+        } else {
+          FUZZ_REQUIRE(ssLastError()[0] != '\0' && memcmp(&now, &w.stepping, sizeof now) == 0,
+                       "SetStepping refused (%s) without a message or changed the stepping", ssStatusName(status));
+        }
+        if (verbose)
+          fprintf(stderr, "  SetStepping(%s/%s frozen %.17g) = %s %s\n", NAME_OR_UNKNOWN(ssFrameCutName(stepping.cut)),
+                  NAME_OR_UNKNOWN(ssMappingName(stepping.mapping)), stepping.frozen_step_s, ssStatusName(status),
+                  status == SS_OK ? "" : ssLastError());
         break;
       }
       case 3: {
