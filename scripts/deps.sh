@@ -12,6 +12,12 @@ command -v pkg-config >/dev/null || missing+=(pkg-config)
 pkg-config --exists ode 2>/dev/null || missing+=(libode-dev)
 [ -f /usr/include/gtest/gtest.h ] || missing+=(libgtest-dev)
 python3 -c 'import ensurepip, venv' 2>/dev/null || missing+=(python3-venv)
+# Fuzzing (scripts/fuzz, run by the full scripts/test that CI runs): clang and its libFuzzer runtime.
+if [ "${STEADYSTEP_NEED_FUZZ:-0}" = 1 ]; then
+  command -v clang >/dev/null || missing+=(clang)
+  compgen -G "/usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a" >/dev/null ||
+    missing+=(libclang-rt-14-dev)
+fi
 if [ ${#missing[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ]; then
     echo "steadystep: installing Debian packages: ${missing[*]}"

@@ -1,0 +1,93 @@
+// Determinism, as Box2D pins it: a fixed scene run (chain and buggy, 2 s under fixed:60, implicit Euler) is
+// hashed (FNV-1a over the bytes of every record: time, step length and each quantity after every step) and compared
+// with a pinned value for each ODE solver. Any change of trajectory, however small, changes the hash.
+// When a change of trajectory is deliberate, the failure prints the new value: replace the pinned one in one edit.
+// Each case also runs twice in one process (nothing global leaks between runs). The pinned values are those of
+// Debian 12's libode 0.16 (double) on x86-64; the plain and the sanitizer builds give the same ones.
+#include <gtest/gtest.h>
+
+#include <cinttypes>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+
+#include "steadystep/steadystep.h"
+
+namespace {
+
+uint64_t Fnv1a(uint64_t hash, const void* data, size_t size) {
+  const unsigned char* bytes = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < size; ++i) {
+    hash ^= bytes[i];
+    hash *= 0x100000001b3ULL;
+  }
+  return hash;
+}
+
+uint64_t RunHash(const char* scene, ssSolver solver, int* steps_out) {
+  ssRunDef def{};
+  def.scene = scene;
+  EXPECT_EQ(ssDefaultSceneParams(scene, &def.params), SS_OK) << ssLastError();
+  def.stepping = ssDefaultStepping();  // substeps of at most 1/60 s, implicit Euler at each step's length
+  def.stepping.solver = solver;
+  def.profile = "fixed:60";
+  def.seed = 1;
+  def.duration_s = 2.0;
+  ssRun* run = nullptr;
+  EXPECT_EQ(ssRun_Execute(&def, &run), SS_OK) << ssLastError();
+  if (run == nullptr) return 0;
+  EXPECT_EQ(ssRun_Status(run), SS_OK) << ssRun_Message(run);
+  uint64_t hash = 0xcbf29ce484222325ULL;
+  const int steps = ssRun_StepCount(run);
+  const int quantities = ssSceneFind(scene)->quantity_count;
+  for (int i = 0; i < steps; ++i) {
+    hash = Fnv1a(hash, &ssRun_Times(run)[i], sizeof(double));
+    hash = Fnv1a(hash, &ssRun_StepLengths(run)[i], sizeof(double));
+    for (int q = 0; q < quantities; ++q) hash = Fnv1a(hash, &ssRun_Quantity(run, q)[i], sizeof(double));
+  }
+  *steps_out = steps;
+  ssRun_Destroy(run);
+  return hash;
+}
+
+struct Pinned {
+  const char* scene;
+  ssSolver solver;
+  uint64_t hash;
+};
+
+// The pinned trajectories. Update a value here when a trajectory change is deliberate (the failure prints it).
+const Pinned kPinned[] = {
+    {"chain", SS_SOLVER_QUICK, 0xeb18d208a81468aeULL},
+    {"chain", SS_SOLVER_STEP, 0x77d62c6d806702e9ULL},
+    {"buggy", SS_SOLVER_QUICK, 0x86d0c0ee60376a2fULL},
+    {"buggy", SS_SOLVER_STEP, 0x60dbe3f6626be7ebULL},
+};
+
+void PrintTo(const Pinned& pinned, std::ostream* out) {
+  *out << pinned.scene << (pinned.solver == SS_SOLVER_QUICK ? " quick" : " step");
+}
+
+class Determinism : public ::testing::TestWithParam<Pinned> {};
+
+TEST_P(Determinism, TrajectoryHashIsPinned) {
+  const Pinned& pinned = GetParam();
+  int steps = 0, steps_again = 0;
+  uint64_t hash = RunHash(pinned.scene, pinned.solver, &steps);
+  EXPECT_EQ(steps, 120) << "2 s at fixed:60 is 120 steps";
+  // The same run again in the same process: nothing global (ODE's random generator) leaks between runs.
+  EXPECT_EQ(RunHash(pinned.scene, pinned.solver, &steps_again), hash);
+  char printed[32];
+  std::snprintf(printed, sizeof printed, "0x%016" PRIx64 "ULL", hash);
+  EXPECT_EQ(hash, pinned.hash) << pinned.scene << " under " << (pinned.solver == SS_SOLVER_QUICK ? "quick" : "step")
+                               << ": the trajectory changed. If that is deliberate, pin the new hash in "
+                               << "tests/c/test_determinism.cpp: " << printed;
+}
+
+std::string CaseName(const ::testing::TestParamInfo<Pinned>& info) {
+  return std::string(info.param.scene) + (info.param.solver == SS_SOLVER_QUICK ? "_quick" : "_step");
+}
+
+INSTANTIATE_TEST_SUITE_P(FixedRuns, Determinism, ::testing::ValuesIn(kPinned), CaseName);
+
+}  // namespace
