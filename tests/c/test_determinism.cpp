@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "steadystep/lab/scene.h"
 #include "steadystep/steadystep.h"
 
 namespace {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "steadystep/lab/scene.h"
 #include "steadystep/steadystep.h"
 
 namespace {

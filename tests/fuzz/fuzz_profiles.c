@@ -4,7 +4,7 @@
 #include <unistd.h>
 
 #include "fuzz_input.h"
-#include "steadystep/profile.h"
+#include "steadystep/lab/profile.h"
 
 enum { FRAMES = 256 };
 
