@@ -38,11 +38,12 @@ static Propagator propagate(double sigma, double q, double t) {
   }
   if (q > 0) {
     double w = sqrt(q);
-    return (Propagator){decay * cos(w * t), decay * sin(w * t) / w, w / tan(w * t)};
+    double sine = sin(w * t), cosine = cos(w * t); /* one sincos */
+    return (Propagator){decay * cosine, decay * sine / w, w * cosine / sine};
   }
   double mu = sqrt(-q);
   double slow = exp((mu - sigma) * t), fast = exp(-(mu + sigma) * t);
-  return (Propagator){0.5 * (slow + fast), (slow - fast) / (2.0 * mu), mu / tanh(mu * t)};
+  return (Propagator){0.5 * (slow + fast), (slow - fast) / (2.0 * mu), mu * (slow + fast) / (slow - fast)};
 }
 
 static ssStatus validate(ssSpring spring, double mass, double step_s, const ssSoftness* out) {
