@@ -6,34 +6,13 @@
 #include <string>
 #include <vector>
 
+#include "joint_params.h"
 #include "ode_fixture.h"
 #include "steadystep/steadystep.h"
 
 namespace {
 
 const ssSpring kSpring = {400.0, 12.0};
-
-// ODE's getter for a joint's parameter number on an axis, written independently of the library's setter.
-double GetParam(dJointID joint, int param, int axis) {
-  int grouped = param + (axis - 1) * dParamGroup;
-  switch (dJointGetType(joint)) {
-    case dJointTypeBall: return dJointGetBallParam(joint, param);
-    case dJointTypeFixed: return dJointGetFixedParam(joint, param);
-    case dJointTypeDBall: return dJointGetDBallParam(joint, param);
-    case dJointTypeDHinge: return dJointGetDHingeParam(joint, param);
-    case dJointTypeTransmission: return dJointGetTransmissionParam(joint, param);
-    case dJointTypeHinge: return dJointGetHingeParam(joint, param);
-    case dJointTypeSlider: return dJointGetSliderParam(joint, param);
-    case dJointTypeUniversal: return dJointGetUniversalParam(joint, grouped);
-    case dJointTypeHinge2: return dJointGetHinge2Param(joint, grouped);
-    case dJointTypePR: return dJointGetPRParam(joint, grouped);
-    case dJointTypePU: return dJointGetPUParam(joint, grouped);
-    case dJointTypePiston: return dJointGetPistonParam(joint, grouped);
-    case dJointTypeAMotor: return dJointGetAMotorParam(joint, grouped);
-    case dJointTypeLMotor: return dJointGetLMotorParam(joint, grouped);
-    default: ADD_FAILURE() << "no getter for joint type " << dJointGetType(joint); return NAN;
-  }
-}
 
 struct Row {
   ssJointParam param;
