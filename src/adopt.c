@@ -186,6 +186,7 @@ static ssStatus planRow(Plan* plan, dJointID joint, ssJointParam param, int axis
     snprintf(what, sizeof what, "%s joint %p, %s axis %d", ssJointTypeName(joint), (void*)joint,
              ssJointParamName(param), axis);
     ssStatus status = ssRowLawFromTuned(what, erp, cfm, plan->tuned_step_s, &row.law);
+    if (status == SS_OK) status = ssCheckLawForEveryStep(what, &row.law);
     if (status != SS_OK) return status;
   }
   if (!ssReserveOne((void**)&plan->rows, plan->row_count, &plan->row_capacity, sizeof row)) return outOfMemory();
@@ -311,6 +312,7 @@ ssStatus ssRegistry_AdoptWorld(ssRegistry* registry, double tuned_step_s, ssAdop
   ssSoftness tuned = {dWorldGetERP(world), dWorldGetCFM(world)};
   ssRowLaw law;
   status = ssRowLawFromTuned("world", tuned.erp, tuned.cfm, tuned_step_s, &law);
+  if (status == SS_OK) status = ssCheckLawForEveryStep("world", &law);
   PlannedBody defaults = {0};
   if (status == SS_OK)
     status = dampingRate("world", dWorldGetLinearDamping(world), tuned_step_s, &defaults.linear_rate_per_s);

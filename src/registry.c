@@ -90,10 +90,12 @@ void ssRegistryBindWorldLaw(ssRegistry* registry, ssRowLaw law, double effective
 
 ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effective_mass) {
   REQUIRE_REGISTRY(registry);
+  ssRowLaw law = ssRowLawOfSpring(spring);
   ssStatus status = ssValidateSpring(spring);
+  if (status == SS_OK) status = ssCheckLawForEveryStep("world", &law);
   if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
   if (status != SS_OK) return status;
-  ssRegistryBindWorldLaw(registry, ssRowLawOfSpring(spring), effective_mass);
+  ssRegistryBindWorldLaw(registry, law, effective_mass);
   return SS_OK;
 }
 
@@ -140,10 +142,12 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
   if (!ssJointSupports(joint, param, axis))
     return ssFail(SS_ERROR_UNSUPPORTED, "axis = %d: a %s joint has no %s parameters on it", axis,
                   ssJointTypeName(joint), ssJointParamName(param));
+  ssRowLaw law = ssRowLawOfSpring(spring);
   ssStatus status = ssValidateSpring(spring);
+  if (status == SS_OK) status = ssCheckLawForEveryStep("joint", &law);
   if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
   if (status != SS_OK) return status;
-  return ssRegistryBindJointLaw(registry, joint, param, axis, ssRowLawOfSpring(spring), effective_mass);
+  return ssRegistryBindJointLaw(registry, joint, param, axis, law, effective_mass);
 }
 
 ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, double load) {

@@ -5,6 +5,7 @@
 #include <stddef.h>
 
 #include "error.h"
+#include "steadystep/limits.h"
 #include "matched_internal.h"
 
 ssRowLaw ssRowLawOfSpring(ssSpring spring) { return (ssRowLaw){.spring = spring, .hard = 0, .hard_rate_per_s = 0}; }
@@ -26,6 +27,17 @@ ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tune
   /* hard: the error is corrected at r = k/c = erp/(h0·(1 - erp)) per second, which stays finite as cfm -> 0 */
   double rate = erp == 1 ? INFINITY : erp / (tuned_step_s * (1.0 - erp));
   *out = (ssRowLaw){.spring = {0, 0}, .hard = 1, .hard_rate_per_s = rate};
+  return SS_OK;
+}
+
+ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law) {
+  if (law->hard) return SS_OK;
+  double k = law->spring.stiffness, c = law->spring.damping;
+  if (!isfinite(SS_MAX_STEP_S * k + c) || !(SS_MIN_STEP_S * k + c >= 1.0 / SS_MAX_CFM))
+    return ssFail(SS_ERROR_NO_FINITE_MAPPING,
+                  "%s: k = %g N/m, c = %g N*s/m: no softness ODE handles at every step from %g s to %g s "
+                  "(h*k + c must stay finite and at least 1/SS_MAX_CFM = %g)",
+                  what, k, c, SS_MIN_STEP_S, SS_MAX_STEP_S, 1.0 / SS_MAX_CFM);
   return SS_OK;
 }
 

@@ -26,6 +26,13 @@ ssRowLaw ssRowLawOfSpring(ssSpring spring);
  * Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (erp outside [0, 1], cfm < 0). */
 ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tuned_step_s, ssRowLaw* out);
 
+/* Whether the implicit-Euler mapping gives the law a softness ODE handles at every step length the library takes
+ * ([SS_MIN_STEP_S, SS_MAX_STEP_S]): h·k + c finite at the longest step and cfm = 1/(h·k + c) within SS_MAX_CFM at
+ * the shortest. Since every accurate mapping falls back to implicit Euler, a law that passes can always be
+ * written, so Apply never fails in the middle of a frame. Hard laws pass. what names the row in the message.
+ * Errors: SS_ERROR_NO_FINITE_MAPPING. */
+ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law);
+
 /* The softness of the row for a step of step_s under mapping. mass (kg or kg·m²) is read by the accurate mappings
  * only; pass NAN when the row has none. Where MATCHED or EXACT cannot serve the row (no mass, c = 0, natural
  * frequency above the step's Nyquist frequency, no finite softness) the implicit-Euler mapping serves it and

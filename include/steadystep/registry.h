@@ -60,7 +60,9 @@ SS_API void ssRegistry_Destroy(ssRegistry* registry);
 
 /** Binds the world's ERP and CFM (they soften the non-limit rows of hinge-like joints, and contacts that have no
  *  soft mode). effective_mass (kg, > 0) is needed only by the matched and exact mappings; pass 0 to use 1 kg.
- *  Errors: those of ssValidateSpring; SS_ERROR_OUT_OF_RANGE for a negative or non-finite effective_mass. */
+ *  Errors: those of ssValidateSpring; SS_ERROR_NO_FINITE_MAPPING when implicit Euler gives the spring no softness
+ *  ODE handles at some step in [SS_MIN_STEP_S, SS_MAX_STEP_S] (every mapping falls back to it, so a bound spring can
+ *  always be written); SS_ERROR_OUT_OF_RANGE for a negative or non-finite effective_mass. */
 SS_API ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effective_mass);
 
 /** Binds one soft parameter set of a joint on one axis (1, 2 or 3, as ODE's dParamGroup1..3; SS_PARAM_JOINT and
@@ -68,7 +70,8 @@ SS_API ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, doub
  *  effective_mass (kg, or kg·m² for an angular row) is what the matched and exact mappings need; pass 0 to have it
  *  computed at each Apply from the joint's bodies (ssJointEffectiveMass).
  *  Errors: SS_ERROR_UNSUPPORTED when the joint's type has no such parameter on that axis (ODE itself would ignore
- *  it silently), or for an unknown param; those of ssValidateSpring; SS_ERROR_OUT_OF_RANGE for effective_mass < 0;
+ *  it silently), or for an unknown param; those of ssValidateSpring; SS_ERROR_NO_FINITE_MAPPING as
+ *  ssRegistry_BindWorld; SS_ERROR_OUT_OF_RANGE for effective_mass < 0 or a NULL registry or joint;
  *  SS_ERROR_OUT_OF_MEMORY. */
 SS_API ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis,
                                      ssSpring spring, double effective_mass);
@@ -113,12 +116,14 @@ SS_API ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, d
 /** Removes the damping and auto-disable bindings of body. Call it before dBodyDestroy. Errors: SS_ERROR_NOT_FOUND. */
 SS_API ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body);
 
-/** Writes every binding for a step of step_s (s, > 0) with the mapping. previous_step_s is the length of the step
- *  before (0 when there is none or after a teleport); only SS_MAPPING_EXACT reads it. Either everything is written
- *  or, on an error, nothing is. report may be NULL.
- *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (step_s, previous_step_s); SS_ERROR_NO_FINITE_MAPPING when a
- *  binding has no softness under that mapping (c = 0 with matched or exact), naming the joint; SS_ERROR_UNSUPPORTED
- *  for an unknown mapping. */
+/** Writes every binding for a step of step_s (s, in [SS_MIN_STEP_S, SS_MAX_STEP_S]) with the mapping.
+ *  previous_step_s is the length of the step before (0 when there is none or after a teleport); only
+ *  SS_MAPPING_EXACT reads it. A row that matched or exact cannot serve at this step (no effective mass, c = 0, a
+ *  natural frequency above the step's Nyquist frequency, no finite softness, a load correction beyond
+ *  SS_MAX_FORCE_N) is written with implicit Euler and counted. Either everything is written or, on an error,
+ *  nothing is. report may be NULL.
+ *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (registry NULL, step_s, previous_step_s);
+ *  SS_ERROR_UNSUPPORTED for an unknown mapping. */
 SS_API ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
                                  ssApplyReport* report);
 
