@@ -3,7 +3,7 @@ quantities depend on the frame rate, how far they are from a fine-step reference
 
 Usage: .venv/bin/python bench/bench_examples.py [BUILD_DIR] [--repeats N] [--boxes N] [--cost-seconds S]
 
-1. Frame-rate spread. Every variant (the program's own stepping, and the adopted program under the policies spring,
+1. Frame-rate spread. Every variant (the program's own stepping, and the adopted program under the policies implicit-euler,
    matched, exact and fixed, max step 1/60 s) runs 10 s under the profiles fixed:60, fixed:30 and uniform:15:45
    (seeds 1, 2, 3). For each followed quantity q, every run is interpolated linearly onto the time grid of the
    variant's own fixed:60 run, and
@@ -12,11 +12,11 @@ Usage: .venv/bin/python bench/bench_examples.py [BUILD_DIR] [--repeats N] [--box
                      (q_run(t) - q_fixed60(t))^2) / A
 
    where A = max(q) - min(q) over the fine-step reference run (below), one scale per quantity shared by all variants.
-2. Accuracy. The fine-step reference is the adopted program under spring, fixed:1000, --max-step 0.001. For each
+2. Accuracy. The fine-step reference is the adopted program under implicit-euler, fixed:1000, --max-step 0.001. For each
    variant, over all five runs (fixed:60 included), error = RMS of (q_run(t) - q_reference(t)) on the reference's
    grid, divided by the same A.
 3. Cost. The stack with --boxes N (default 200) under fixed:60: its own stepping (one dWorldQuickStep a frame)
-   against the adopted program under spring with --max-step 1 (also one step a frame: the same step sequence). Each
+   against the adopted program under implicit-euler with --max-step 1 (also one step a frame: the same step sequence). Each
    program times its stepping loop alone (--quiet): wall clock and process CPU time. Runs alternate (own, adopted,
    adopted, own, ...) and the ratio adopted / own is taken per pair; printed: the median ratio over the pairs and its
    range, for both clocks (CPU time is the one a shared, busy machine disturbs least).

@@ -14,6 +14,7 @@
 #include "array.h"
 #include "error.h"
 #include "joint_rows.h"
+#include "ode_bounds.h"
 #include "registry_internal.h"
 #include "row_law.h"
 
@@ -300,7 +301,7 @@ static Plan startPlan(ssRegistry* registry) {
 
 ssStatus ssRegistry_AdoptWorld(ssRegistry* registry, double tuned_step_s, ssAdoptReport* report) {
   if (registry == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "registry = NULL: a registry is required");
-  ssStatus status = ssCheckPositive("tuned_step_s", "s", tuned_step_s);
+  ssStatus status = ssCheckStepLength("tuned_step_s", tuned_step_s);
   if (status != SS_OK) return status;
   double adopted_s = ssRegistry_TunedStep(registry);
   if (adopted_s != 0 && adopted_s != tuned_step_s)

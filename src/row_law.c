@@ -5,6 +5,7 @@
 #include <stddef.h>
 
 #include "error.h"
+#include "ode_bounds.h"
 #include "steadystep/limits.h"
 #include "matched_internal.h"
 
@@ -16,11 +17,14 @@ ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tune
   if (!(erp >= 0 && erp <= 1))
     return ssFail(SS_ERROR_OUT_OF_RANGE, "%s: erp = %g: must be in [0, 1] to stand for a spring", what, erp);
   if (cfm < 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "%s: cfm = %g: must not be negative", what, cfm);
-  ssStatus status = ssCheckPositive("tuned_step_s", "s", tuned_step_s);
+  ssStatus status = ssCheckStepLength("tuned_step_s", tuned_step_s);
   if (status != SS_OK) return status;
   /* k = erp/(h0·cfm), c = (1 - erp)/cfm; a cfm so small that they overflow is a hard row in all but name */
   double stiffness = erp / (tuned_step_s * cfm), damping = (1.0 - erp) / cfm;
-  if (cfm > 0 && isfinite(stiffness) && isfinite(damping) && (stiffness > 0 || damping > 0)) {
+  if (cfm > 0 && isfinite(stiffness) && isfinite(damping)) {
+    if (stiffness == 0 && damping == 0) /* a cfm so large that k and c underflow: no constraint at all */
+      return ssFail(SS_ERROR_OUT_OF_RANGE, "%s: erp = %g, cfm = %g at %g s: too soft to stand for a spring", what,
+                    erp, cfm, tuned_step_s);
     *out = ssRowLawOfSpring((ssSpring){stiffness, damping});
     return SS_OK;
   }

@@ -48,12 +48,14 @@ typedef struct ssAdoptReport {
   int skipped_joints;     /* contact, null and plane-2D joints */
 } ssAdoptReport;
 
-/** Adopts the world's ERP/CFM and its damping and auto-disable defaults, as tuned at tuned_step_s (s, > 0), and
- *  everything reachable from space (nested spaces included): the one call a program makes after building its
- *  world. Sets the registry's tuned step, which later adoption calls and ssStepper_SoftenContact use. report may be
- *  NULL. Either everything is bound or, on an error, nothing is.
- *  Errors: SS_ERROR_OUT_OF_RANGE (registry or space NULL, tuned_step_s <= 0, a tuned value outside its range,
- *  named with its joint or body, e.g. erp > 1 or cfm < 0, or a tuned step different from an earlier adoption's);
+/** Adopts the world's ERP/CFM and its damping and auto-disable defaults, as tuned at tuned_step_s (s, in
+ *  [SS_MIN_STEP_S, SS_MAX_STEP_S]), and everything reachable from space (nested spaces included): the one call a
+ *  program makes after building its world. Sets the registry's tuned step, which later adoption calls and
+ *  ssStepper_SoftenContact use. report may be NULL. Either everything is bound or, on an error, nothing is.
+ *  Errors: SS_ERROR_OUT_OF_RANGE (registry or space NULL, tuned_step_s out of range, a tuned value outside its range,
+ *  named with its joint or body, e.g. erp > 1, cfm < 0 or a cfm too large to stand for a spring, or a tuned step
+ *  different from an earlier adoption's); SS_ERROR_NO_FINITE_MAPPING (a tuned row that implicit Euler cannot
+ *  write at every step length, see ssRegistry_BindWorld);
  *  SS_ERROR_NOT_FINITE; SS_ERROR_UNSUPPORTED (a joint of a type ODE 0.16 does not know); SS_ERROR_OUT_OF_MEMORY. */
 SS_API ssStatus ssRegistry_Adopt(ssRegistry* registry, double tuned_step_s, dSpaceID space, ssAdoptReport* report);
 
