@@ -112,7 +112,7 @@ def cost_table(build: pathlib.Path, repeats: int, boxes: int, seconds: float) ->
     print(f"| stack, {boxes} boxes, {seconds:g} s at fixed:60, {repeats} interleaved pairs | wall clock | CPU time |")
     print("|---|---|---|")
     for label, variant in [("own stepping loop, median (s)", "own"),
-                           ("adopted stepping loop (spring, one step a frame), median (s)", "adopted")]:
+                           ("adopted stepping loop (implicit-euler, one step a frame), median (s)", "adopted")]:
         print(f"| {label} | " + " | ".join(f"{statistics.median(t[k] for t in times[variant]):.4f}" for k in (0, 1))
               + " |")
     ratios = [[a[k] / o[k] for a, o in zip(times["adopted"], times["own"])] for k in (0, 1)]
