@@ -278,6 +278,7 @@ static int rowGeometry(dJointID joint, ssJointParam param, int axis, dVector3 di
 
 ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, double* mass) {
   if (joint == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "joint = NULL: a joint is required");
+  if (mass == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "mass = NULL: needs somewhere to write the mass");
   if (!ssJointSupports(joint, param, axis))
     return ssFail(SS_ERROR_UNSUPPORTED, "a %s joint has no %s parameters on axis %d", ssJointTypeName(joint),
                   ssJointParamName(param) ? ssJointParamName(param) : "such", axis);

@@ -185,9 +185,17 @@ ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping) {
   return SS_OK;
 }
 
-ssStepping ssStepper_Stepping(const ssStepper* stepper) { return stepper->def.stepping; }
+ssStepping ssStepper_Stepping(const ssStepper* stepper) {
+  if (stepper != NULL) return stepper->def.stepping;
+  ssFail(SS_ERROR_OUT_OF_RANGE, "stepper = NULL: a stepper is required");
+  return ssDefaultStepping();
+}
 
-ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper) { return stepper->current; }
+ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper) {
+  if (stepper != NULL) return stepper->current;
+  ssFail(SS_ERROR_OUT_OF_RANGE, "stepper = NULL: a stepper is required");
+  return (ssStepInfo){SS_MAPPING_IMPLICIT_EULER, 0, 0, 0, 0, 0};
+}
 
 ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
   REQUIRE_STEPPER(stepper);

@@ -132,7 +132,8 @@ SS_API ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport
 SS_API void ssStepper_Reset(ssStepper* stepper);
 
 /** The step about to be taken. Meaningful inside before_step and collide; between frames it describes the next
- *  step of the default length. stepper must not be NULL. */
+ *  step of the default length. A NULL stepper gives an all-zero step and records SS_ERROR_OUT_OF_RANGE for
+ *  ssLastError. */
 SS_API ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
 
 /** In the program's near callback: turns the contact's tuned softness into the softness for the step about to be
@@ -174,7 +175,8 @@ SS_API void ssStepper_ResetHistory(ssStepper* stepper);
  *  Errors, with nothing changed: those of ssValidateStepping; SS_ERROR_OUT_OF_RANGE for a NULL stepper. */
 SS_API ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping);
 
-/** The stepper's stepping. stepper must not be NULL. */
+/** The stepper's stepping. A NULL stepper gives ssDefaultStepping() and records SS_ERROR_OUT_OF_RANGE for
+ *  ssLastError. */
 SS_API ssStepping ssStepper_Stepping(const ssStepper* stepper);
 
 #ifdef __cplusplus

@@ -326,3 +326,65 @@ TEST_F(DestroyTest, ForgettingItIsCaughtByTheSanitizer) {
 #endif
 
 }  // namespace
+
+namespace {
+
+class NullTest : public OdeTest {};
+
+TEST_F(NullTest, EveryCoreFunctionRefusesNullByName) {
+  auto named = [](const char* what) { return std::string(ssLastError()).find(what) != std::string::npos; };
+  ssSpring spring = {40, 1};
+  EXPECT_EQ(ssRegistry_BindWorld(nullptr, spring, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(named("registry = NULL"));
+  EXPECT_EQ(ssRegistry_BindJoint(nullptr, nullptr, SS_PARAM_STOP, 1, spring, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_SetJointLoad(nullptr, nullptr, SS_PARAM_STOP, 1, 1), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_UnbindJoint(nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_BindDamping(nullptr, nullptr, 1, 1), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_BindAutoDisable(nullptr, nullptr, 1, 0), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_UnbindBody(nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_Apply(nullptr, SS_MAPPING_IMPLICIT_EULER, 0.01, 0, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_AdoptWorld(nullptr, 0.01, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_AdoptBody(nullptr, nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_AdoptJoint(nullptr, nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_AdoptSpace(nullptr, nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssRegistry_Create(nullptr), nullptr);
+  EXPECT_TRUE(named("world = NULL"));
+  EXPECT_EQ(ssRegistry_JointBindingCount(nullptr), 0);
+  EXPECT_EQ(ssRegistry_TunedStep(nullptr), 0.0);
+  ssRegistry_VisitBodies(nullptr, [](void*, dBodyID) {}, nullptr);
+  ssRegistry_Destroy(nullptr);
+  double mass = 7;
+  EXPECT_EQ(ssJointEffectiveMass(nullptr, SS_PARAM_STOP, 1, &mass), SS_ERROR_OUT_OF_RANGE);
+  dJointID slider = dJointCreateSlider(world, 0);
+  dJointAttach(slider, MakeBody(1.0), 0);
+  EXPECT_EQ(ssJointEffectiveMass(slider, SS_PARAM_STOP, 1, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(named("mass = NULL"));
+  EXPECT_EQ(mass, 7);
+  EXPECT_EQ(ssContactSoften(nullptr, nullptr, nullptr, spring, SS_MAPPING_IMPLICIT_EULER, 0.01, 0),
+            SS_ERROR_OUT_OF_RANGE);
+  ssStepper* stepper = reinterpret_cast<ssStepper*>(0x1);  // must be left as it was
+  EXPECT_EQ(ssStepper_Create(nullptr, &stepper), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(stepper, reinterpret_cast<ssStepper*>(0x1));
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = world;
+  EXPECT_EQ(ssStepper_Create(&def, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(named("out = NULL"));
+  EXPECT_EQ(ssStepper_Step(nullptr, 0.01, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(named("stepper = NULL"));
+  EXPECT_EQ(ssStepper_WatchBody(nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssStepper_UnwatchBody(nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssStepper_SoftenContact(nullptr, nullptr, nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssStepper_DestroyBody(nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssStepper_DestroyJoint(nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssStepper_SetStepping(nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssStepper_CurrentStep(nullptr).step_s, 0.0);
+  EXPECT_TRUE(named("stepper = NULL"));
+  EXPECT_EQ(ssStepper_Stepping(nullptr).cut, ssDefaultStepping().cut);
+  EXPECT_EQ(ssValidateStepping(nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssSteppingForPolicy("naive", 1.0 / 60, nullptr), SS_ERROR_OUT_OF_RANGE);
+  ssStepper_Reset(nullptr);
+  ssStepper_ResetHistory(nullptr);
+  ssStepper_Destroy(nullptr);
+}
+
+}  // namespace
