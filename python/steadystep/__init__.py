@@ -26,4 +26,9 @@ __all__ = [
     "matched_softness", "policy_names", "softness_for", "softness_from_spring", "spring_from_frequency",
     "spring_from_softness",
 ]
-__version__ = "0.1.0"
+try:  # the installed package's version, which the build read from CMakeLists.txt's project()
+    from importlib.metadata import version as _version
+
+    __version__ = _version("steadystep")
+except Exception:  # a source tree without installed metadata
+    __version__ = "unknown"

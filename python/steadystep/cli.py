@@ -92,6 +92,9 @@ def build_parser() -> argparse.ArgumentParser:
                      "article's figure, comparisons on real ODE scenes, single runs and conversions.",
                      epilog="Exit codes: 0 done, 1 a run blew up, 2 refused (one line on stderr naming the value), "
                      "3 internal error. " + RUN_BOUND_HELP)
+    from steadystep import __version__
+
+    parser.add_argument("--version", action="version", version=f"steadystep {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     figure = commands.add_parser("figure", help="reproduce the article's figure (PNG and SVG)",

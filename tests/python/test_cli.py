@@ -138,3 +138,13 @@ def test_bad_arguments_exit_2_with_one_line(tmp_path, args):
     assert len(lines) == 1, (args, result.stderr)
     assert "Traceback" not in result.stderr and lines[0].startswith("steadystep")
     assert sorted(p.name for p in tmp_path.rglob("*")) == before  # nothing written, not even half
+
+
+def test_version_is_the_one_in_cmakelists():
+    import re
+
+    cmake = (Path(__file__).resolve().parents[2] / "CMakeLists.txt").read_text()
+    version = re.search(r"project\(steadystep VERSION ([0-9.]+)", cmake).group(1)
+    result = steadystep("--version")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == f"steadystep {version}"
