@@ -45,9 +45,6 @@ ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law) {
   return SS_OK;
 }
 
-int ssOverNyquist(ssSpring spring, double mass, double step_s) {
-  return spring.stiffness * step_s * step_s > M_PI * M_PI * mass;
-}
 
 ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
                        ssRowFallback* fallback, ssSoftness* out) {
