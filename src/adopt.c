@@ -202,8 +202,8 @@ static ssStatus planRow(Plan* plan, dJointID joint, ssJointParam param, int axis
   return SS_OK;
 }
 
-/* Plans the joint's rows and its bodies; walk says whether to go on from its bodies. */
-static ssStatus planJoint(Plan* plan, dJointID joint, int walk) {
+/* Plans the joint's rows and its bodies (queued in pending: walk() goes on from them, AdoptJoint does not). */
+static ssStatus planJoint(Plan* plan, dJointID joint) {
   int added = addSeen(&plan->seen, joint);
   if (added < 0) return outOfMemory();
   if (added == 0) return SS_OK;
@@ -227,7 +227,6 @@ static ssStatus planJoint(Plan* plan, dJointID joint, int walk) {
     dBodyID body = dJointGetBody(joint, side);
     if (body == 0) continue;
     status = planBody(plan, body);
-    if (!walk && status == SS_OK) plan->pending_count = 0;
   }
   return status;
 }
@@ -238,7 +237,7 @@ static ssStatus walk(Plan* plan) {
     dBodyID body = plan->pending[--plan->pending_count];
     int joints = dBodyGetNumJoints(body);
     for (int i = 0; i < joints; ++i) {
-      ssStatus status = planJoint(plan, dBodyGetJoint(body, i), 1);
+      ssStatus status = planJoint(plan, dBodyGetJoint(body, i));
       if (status != SS_OK) return status;
     }
   }
@@ -374,7 +373,7 @@ ssStatus ssRegistry_AdoptJoint(ssRegistry* registry, dJointID joint, ssAdoptRepo
   if (status != SS_OK) return status;
   if (joint == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "joint = NULL: a joint is required");
   Plan plan = startPlan(registry);
-  status = planJoint(&plan, joint, 0);
+  status = planJoint(&plan, joint);
   if (status == SS_OK) status = commit(&plan, report);
   freePlan(&plan);
   return status;

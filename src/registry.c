@@ -39,7 +39,6 @@ struct ssRegistry {
   ssRowLaw world_law;
   double world_mass;
   ssSoftness world_pending;
-  ssSoftness world_written; /* NAN until the registry first writes the world */
   double tuned_step_s;      /* adoption's tuned step; 0 before any */
   ssSoftness tuned_world;   /* the world's ERP/CFM as adopted (contacts without soft modes stand for these) */
   JointBinding* joints;
@@ -69,7 +68,6 @@ ssRegistry* ssRegistry_Create(dWorldID world) {
     return NULL;
   }
   registry->world = world;
-  registry->world_written = (ssSoftness){NAN, NAN};
   registry->applied_step_s = NAN;
   return registry;
 }
@@ -203,11 +201,6 @@ static ssBodyBinding* bodyBinding(ssRegistry* registry, dBodyID body) {
   return binding;
 }
 
-ssStatus ssRegistryKnowBody(ssRegistry* registry, dBodyID body) {
-  if (bodyBinding(registry, body) == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding a body");
-  return SS_OK;
-}
-
 ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linear_rate_per_s,
                                 double angular_rate_per_s) {
   REQUIRE_REGISTRY(registry);
@@ -265,7 +258,7 @@ static ssStatus failBinding(ssStatus status, const JointBinding* binding) {
 /* How many Applies of the implicit-Euler mapping reuse a computed effective mass for the Nyquist report. */
 enum { kReportMassRefresh = 16 };
 
-/* The softness of one row for this step, counting the fallbacks in the report. */
+/* Counts one row of this Apply in the report: how its softness was obtained, and whether it is above Nyquist. */
 static void countRow(const ssRowLaw* law, double mass, double step_s, const ssRowFallback* fallback,
                      ssApplyReport* report) {
   report->rows_exact_fallback += fallback->exact_to_matched;
@@ -390,9 +383,9 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     int hit = -1;
     for (int j = 0; j < cached && hit < 0; ++j)
       if (sameLaw(&cached_law[j], &binding->law)) hit = j;
-    if (hit >= 0) {
+    if (hit >= 0) { /* implicit Euler and hard rows never fall back */
       binding->pending = cached_softness[hit];
-      if (!binding->law.hard) counts.rows_over_nyquist += ssOverNyquist(binding->law.spring, mass, step_s);
+      countRow(&binding->law, mass, step_s, &(ssRowFallback){0, 0}, &counts);
       continue;
     }
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
@@ -450,7 +443,6 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   if (registry->world_bound) {
     dWorldSetERP(registry->world, registry->world_pending.erp);
     dWorldSetCFM(registry->world, registry->world_pending.cfm);
-    registry->world_written = registry->world_pending;
     counts.rows_written += 1;
   }
   for (int i = 0; i < registry->joint_count; ++i) {
@@ -522,8 +514,6 @@ int ssRegistryWorldBound(const ssRegistry* registry, ssRowLaw* law) {
   if (registry->world_bound && law != NULL) *law = registry->world_law;
   return registry->world_bound;
 }
-
-ssSoftness ssRegistryWorldWritten(const ssRegistry* registry) { return registry->world_written; }
 
 
 int ssRegistry_JointBindingCount(const ssRegistry* registry) { return registry != NULL ? registry->joint_count : 0; }

@@ -32,12 +32,9 @@ int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam par
 /* The body's binding (0: the world's defaults), or NULL. */
 ssBodyBinding* ssRegistryFindBody(ssRegistry* registry, dBodyID body);
 int ssRegistryHasBody(ssRegistry* registry, dBodyID body);
-/* Makes body known (listed for the stepper) without damping or auto-disable. */
-ssStatus ssRegistryKnowBody(ssRegistry* registry, dBodyID body);
 
-/* The world's law, when bound; and what the registry last wrote into the world (NAN before the first Apply). */
+/* The world's law, when bound. */
 int ssRegistryWorldBound(const ssRegistry* registry, ssRowLaw* law);
-ssSoftness ssRegistryWorldWritten(const ssRegistry* registry);
 
 /* The registry's world. */
 dWorldID ssRegistryWorld(const ssRegistry* registry);
