@@ -62,11 +62,16 @@ static ssStatus validateDef(const ssStepperDef* def) {
   return ssValidateStepping(&def->stepping);
 }
 
+/* The step length a step's softness is computed for: its own, or the frozen one. */
+static double softnessStep(const ssStepping* stepping, double step_s) {
+  return stepping->frozen_step_s > 0 ? stepping->frozen_step_s : step_s;
+}
+
 static void describeNextStep(ssStepper* stepper) {
   const ssStepping* stepping = &stepper->def.stepping;
   double step_s = stepping->cut == SS_CUT_FIXED ? stepping->fixed_step_s : stepping->max_step_s;
-  double softness_step_s = stepping->frozen_step_s > 0 ? stepping->frozen_step_s : step_s;
-  stepper->current = (ssStepInfo){stepping->mapping, step_s, softness_step_s, stepper->previous_step_s, 0, 1};
+  stepper->current =
+      (ssStepInfo){stepping->mapping, step_s, softnessStep(stepping, step_s), stepper->previous_step_s, 0, 1};
 }
 
 /* The speed guard: 0 stands for the bound ODE itself needs. */
@@ -379,38 +384,35 @@ static ssStatus apply(ssStepper* stepper, ssMapping mapping, double step_s, doub
   return SS_OK;
 }
 
-/* How a frame is cut: `steps` steps of step_s, softness for softness_step_s under mapping. */
-typedef struct FrameCut {
-  int steps;
-  double step_s;
-  double softness_step_s;
-  ssMapping mapping;
-  int apply_every_step; /* the accurate mappings depend on the history and the bodies; spring on h alone */
-  int use_history;
-} FrameCut;
-
-/* Takes the frame's steps. Errors of Apply leave the world as the previous step left it; a failed check latches. */
-static ssStatus takeSteps(ssStepper* stepper, const FrameCut* cut, double frame_s, ssFrameReport* report) {
+/* Takes a frame's `steps` steps of step_s: everything else about them (mapping, the softness' step, history)
+ * follows from the stepping. Errors of Apply leave the world as the previous step left it; a failed check
+ * latches. */
+static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double frame_s, ssFrameReport* report) {
   const ssStepperDef* def = &stepper->def;
   const ssStepping* stepping = &def->stepping;
+  ssMapping mapping = stepping->mapping;
+  double softness_step_s = softnessStep(stepping, step_s);
+  /* implicit Euler depends on h alone, equal for all the frame's steps; the accurate mappings on the bodies too */
+  int apply_every_step = mapping != SS_MAPPING_IMPLICIT_EULER;
+  int use_history = mapping == SS_MAPPING_EXACT && stepping->frozen_step_s == 0;
   if (stepping->quick_iterations > 0) dWorldSetQuickStepNumIterations(def->world, stepping->quick_iterations);
-  for (int i = 0; i < cut->steps; ++i) {
-    double previous_step_s = cut->use_history ? stepper->previous_step_s : 0;
-    putForces(stepper, frame_s, cut->steps, cut->step_s);
-    if (i == 0 || cut->apply_every_step) {
-      ssStatus status = apply(stepper, cut->mapping, cut->softness_step_s, previous_step_s, report);
+  for (int i = 0; i < steps; ++i) {
+    double previous_step_s = use_history ? stepper->previous_step_s : 0;
+    putForces(stepper, frame_s, steps, step_s);
+    if (i == 0 || apply_every_step) {
+      ssStatus status = apply(stepper, mapping, softness_step_s, previous_step_s, report);
       if (status != SS_OK) return status;
     }
-    stepper->current = (ssStepInfo){cut->mapping, cut->step_s, cut->softness_step_s, previous_step_s, i, cut->steps};
+    stepper->current = (ssStepInfo){mapping, step_s, softness_step_s, previous_step_s, i, steps};
     if (def->before_step) def->before_step(def->before_step_context, stepper);
     if (def->collide) def->collide(def->collide_context, stepper);
-    int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, cut->step_s)
-                                                : dWorldQuickStep(def->world, cut->step_s);
+    int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, step_s)
+                                                      : dWorldQuickStep(def->world, step_s);
     if (def->contact_group) dJointGroupEmpty(def->contact_group);
     if (!stepped) return latch(stepper, ssFail(SS_ERROR_OUT_OF_MEMORY, "ODE ran out of memory in its step"));
     report->steps += 1;
-    report->step_s = cut->step_s;
-    report->simulated_s += cut->step_s;
+    report->step_s = step_s;
+    report->simulated_s += step_s;
     for (int k = 0; k < stepper->known_count; ++k) {
       ssStatus status = checkBody(stepper, stepper->known[k].body);
       if (status != SS_OK) {
@@ -418,16 +420,10 @@ static ssStatus takeSteps(ssStepper* stepper, const FrameCut* cut, double frame_
         return latch(stepper, status);
       }
     }
-    stepper->previous_step_s = cut->use_history ? cut->step_s : 0;
-    if (def->step_done) def->step_done(def->step_done_context, cut->step_s);
+    stepper->previous_step_s = use_history ? step_s : 0;
+    if (def->step_done) def->step_done(def->step_done_context, step_s);
   }
   return SS_OK;
-}
-
-/* The softness step of a cut: the step's own length, or the frozen one. */
-static double softnessStep(const ssStepper* stepper, double step_s) {
-  double frozen_s = stepper->def.stepping.frozen_step_s;
-  return frozen_s > 0 ? frozen_s : step_s;
 }
 
 /* WHOLE_FRAME: one step of the frame. SUBSTEPS: n equal substeps no longer than max_step_s. A frame too short to
@@ -441,21 +437,16 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
     carryForces(stepper, frame_s);
     return SS_OK;
   }
-  FrameCut cut = {1, total_s, 0, stepping->mapping, 0, 0};
+  int steps = 1;
   if (stepping->cut == SS_CUT_SUBSTEPS) {
     double count = ceil(total_s / stepping->max_step_s - kStepCountSlack);
     if (count > (double)INT32_MAX) /* max_step_s >= SS_MIN_STEP_S and frame_s <= SS_MAX_FRAME_S: never */
       return ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: more than %d substeps of max_step_s = %g s", frame_s,
                     INT32_MAX, stepping->max_step_s);
-    cut.steps = count < 1 ? 1 : (int)count;
-    cut.step_s = total_s / cut.steps;
+    steps = count < 1 ? 1 : (int)count;
   }
-  cut.softness_step_s = softnessStep(stepper, cut.step_s);
-  /* implicit Euler depends on h alone, equal for all the frame's steps; the accurate mappings on the bodies too */
-  cut.apply_every_step = cut.mapping != SS_MAPPING_IMPLICIT_EULER;
-  cut.use_history = cut.mapping == SS_MAPPING_EXACT && stepping->frozen_step_s == 0;
   stepper->short_frame_s = 0;
-  ssStatus status = takeSteps(stepper, &cut, frame_s, report);
+  ssStatus status = takeSteps(stepper, steps, total_s / steps, frame_s, report);
   clearCarried(stepper);
   return status;
 }
@@ -472,14 +463,11 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
     accumulator_s -= report->dropped_s;
     due = cap;
   }
-  FrameCut cut = {(int)due, step_s, softnessStep(stepper, step_s), stepping->mapping,
-                  stepping->mapping != SS_MAPPING_IMPLICIT_EULER,
-                  stepping->mapping == SS_MAPPING_EXACT && stepping->frozen_step_s == 0};
   ssStatus status = SS_OK;
-  if (cut.steps == 0) {
+  if (due == 0) {
     carryForces(stepper, frame_s);
   } else {
-    status = takeSteps(stepper, &cut, frame_s, report);
+    status = takeSteps(stepper, (int)due, step_s, frame_s, report);
     clearCarried(stepper);
   }
   stepper->accumulator_s = fmax(accumulator_s - report->steps * step_s, 0);
