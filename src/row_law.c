@@ -45,7 +45,6 @@ ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law) {
   return SS_OK;
 }
 
-
 ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
                        ssRowFallback* fallback, ssSoftness* out) {
   ssRowFallback local;
@@ -61,13 +60,13 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
      * step can sample: a near-rigid row above Nyquist has poles that no (erp, cfm) of this step reproduces. */
     int servable = mass > 0 && isfinite(mass) && law->spring.damping > 0 && !ssOverNyquist(law->spring, mass, step_s);
     if (servable) {
-      /* the law, the mass and the step are valid here: the matched mapping needs no second check */
       /* A pure damper (k = 0) has no position to correct: its velocity decays by exp(-c·h/m) per step whatever the
-       * steps before, which the matched mapping reproduces exactly; the exact mapping's history adds nothing. */
+       * steps before, which the matched mapping reproduces exactly; the exact mapping's history adds nothing. The
+       * law, the mass and the step are valid here, so the matched mapping needs no second check. */
       int matched = mapping == SS_MAPPING_MATCHED || law->spring.stiffness == 0;
       ssStatus status = matched ? ssMatchedSoftnessUnchecked(law->spring, mass, step_s, out)
                                 : ssExactSoftness(law->spring, mass, step_s, previous_step_s, out);
-      if (status == SS_ERROR_NO_FINITE_MAPPING && mapping == SS_MAPPING_EXACT) {
+      if (status == SS_ERROR_NO_FINITE_MAPPING && !matched) {
         status = ssMatchedSoftnessUnchecked(law->spring, mass, step_s, out);
         fallback->exact_to_matched = status == SS_OK;
       }
