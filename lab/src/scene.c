@@ -64,8 +64,12 @@ static ssStatus find_or_fail(const char* name, const ssSceneDesc** out) {
   if (name == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "name = NULL: needs a scene name (oscillator, buggy, ...)");
   *out = find_desc(name);
   if (*out != NULL) return SS_OK;
-  return ssFail(SS_ERROR_NOT_FOUND, "scene = \"%s\": unknown (oscillator, buggy, drop, chain, pile)",
-                name != NULL ? name : "(null)");
+  char known[128] = ""; /* the table's names, so that a new scene is one line */
+  for (int i = 0; i < SCENE_COUNT; ++i) {
+    strncat(known, i ? ", " : "", sizeof known - strlen(known) - 1);
+    strncat(known, scenes[i]->info.name, sizeof known - strlen(known) - 1);
+  }
+  return ssFail(SS_ERROR_NOT_FOUND, "scene = \"%s\": unknown (%s)", name, known);
 }
 
 ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out) {
