@@ -105,6 +105,18 @@ static void setParam(dJointID joint, int axis, int param, double value) {
   }
 }
 
+/* ODE's parameter numbers of a set's erp and cfm; erp -1 for a motor row, which has no position error (its cfm
+ * alone is a damper toward the motor's speed). 0 for an unknown set. */
+static int softnessParams(ssJointParam param, int* erp_param, int* cfm_param) {
+  switch (param) {
+    case SS_PARAM_JOINT: *erp_param = dParamERP, *cfm_param = dParamCFM; return 1;
+    case SS_PARAM_STOP: *erp_param = dParamStopERP, *cfm_param = dParamStopCFM; return 1;
+    case SS_PARAM_MOTOR: *erp_param = -1, *cfm_param = dParamCFM; return 1;
+    case SS_PARAM_SUSPENSION: *erp_param = dParamSuspensionERP, *cfm_param = dParamSuspensionCFM; return 1;
+  }
+  return 0;
+}
+
 static double getParam(dJointID joint, int axis, int param) {
   switch (dJointGetType(joint)) {
     case dJointTypeBall: return dJointGetBallParam(joint, param);
@@ -126,45 +138,22 @@ static double getParam(dJointID joint, int axis, int param) {
 }
 
 void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* erp, double* cfm) {
-  switch (param) {
-    case SS_PARAM_JOINT:
-      *erp = getParam(joint, axis, dParamERP);
-      *cfm = getParam(joint, axis, dParamCFM);
-      return;
-    case SS_PARAM_STOP:
-      *erp = getParam(joint, axis, dParamStopERP);
-      *cfm = getParam(joint, axis, dParamStopCFM);
-      return;
-    case SS_PARAM_MOTOR: /* a motor row has no position error: its cfm alone is a damper toward the motor's speed */
-      *erp = 0;
-      *cfm = getParam(joint, axis, dParamCFM);
-      return;
-    case SS_PARAM_SUSPENSION:
-      *erp = getParam(joint, axis, dParamSuspensionERP);
-      *cfm = getParam(joint, axis, dParamSuspensionCFM);
-      return;
+  int erp_param, cfm_param;
+  if (!softnessParams(param, &erp_param, &cfm_param)) {
+    *erp = *cfm = NAN;
+    return;
   }
-  *erp = *cfm = NAN;
+  *erp = erp_param >= 0 ? getParam(joint, axis, erp_param) : 0;
+  *cfm = getParam(joint, axis, cfm_param);
 }
 
 int ssJointLimitAxisCount(dJointID joint) { return limitAxisCount(joint); }
 
 void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm) {
-  switch (param) {
-    case SS_PARAM_JOINT:
-      setParam(joint, axis, dParamERP, erp);
-      setParam(joint, axis, dParamCFM, cfm);
-      break;
-    case SS_PARAM_STOP:
-      setParam(joint, axis, dParamStopERP, erp);
-      setParam(joint, axis, dParamStopCFM, cfm);
-      break;
-    case SS_PARAM_MOTOR: setParam(joint, axis, dParamCFM, cfm); break;
-    case SS_PARAM_SUSPENSION:
-      setParam(joint, axis, dParamSuspensionERP, erp);
-      setParam(joint, axis, dParamSuspensionCFM, cfm);
-      break;
-  }
+  int erp_param, cfm_param;
+  if (!softnessParams(param, &erp_param, &cfm_param)) return;
+  if (erp_param >= 0) setParam(joint, axis, erp_param, erp);
+  setParam(joint, axis, cfm_param, cfm);
 }
 
 /* d·I⁻¹d for a body's world-frame inertia I = R I_body Rᵀ, solving I_body y = Rᵀd by Cramer's rule. */
