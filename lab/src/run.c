@@ -2,10 +2,14 @@
  *
  * Records come from the scene's step observer rather than after each frame, because a frame may hold several
  * substeps (or, for policy fixed, none) and the comparison between policies is about the physics, not the frames.
- * The last frame is shortened so that every run ends at duration_s of frame time exactly. A run is bounded
+ * The state before the first step is kept apart (initial), so that records and steps stay one to one.
+ * The last frame is shortened so that every run ends at duration_s of frame time exactly. A run ends early at the
+ * first step that blows up (the stepper's error) or leaves one of the scene's sanity bounds (broken: the step is
+ * recorded, the ones after it in its frame are not). A run is bounded
  * (limits.h): its duration, the frames it is expected to take (refused before it starts) and the frames and steps it
  * does take (stopped with an error when an unlucky random profile reaches them). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -22,10 +26,13 @@ struct ssRun {
   double* times_s;
   double* steps_s;
   double* quantities[SS_MAX_QUANTITIES];
+  double initial[SS_MAX_QUANTITIES];
   int quantity_count;
   int frame_count;
   double wall_s;
   ssStatus status;
+  ssRunOutcome outcome;
+  double bound_use;
   char message[256];
   int out_of_memory;
   int too_many_steps; /* a step past SS_MAX_RUN_STEPS was not recorded */
@@ -58,6 +65,7 @@ static int reserve(ssRun* run, int needed) {
 
 static void record(void* context, const ssScene* scene, double step_s) {
   ssRun* run = context;
+  if (run->outcome == SS_RUN_BROKEN) return; /* the rest of the frame in which it broke */
   if (run->count >= SS_MAX_RUN_STEPS) {
     run->too_many_steps = 1;
     return;
@@ -72,6 +80,11 @@ static void record(void* context, const ssScene* scene, double step_s) {
   run->steps_s[run->count] = step_s;
   for (int i = 0; i < run->quantity_count; ++i) run->quantities[i][run->count] = sample[i];
   ++run->count;
+  const char* broken = ssScene_Broken(scene);
+  if (broken != NULL) {
+    run->outcome = SS_RUN_BROKEN;
+    snprintf(run->message, sizeof run->message, "%s", broken);
+  }
 }
 
 static double now_s(void) {
@@ -95,12 +108,15 @@ static ssStatus play(ssRun* run, ssScene* scene, ssProfile* profile, double dura
     run->wall_s += now_s() - start_s;
     ++run->frame_count;
     elapsed_s += frame_s;
+    run->bound_use = ssScene_BoundUse(scene);
+    if (run->outcome == SS_RUN_BROKEN) return SS_OK; /* first: it came before anything later in its frame */
     if (run->out_of_memory) return ssFail(SS_ERROR_OUT_OF_MEMORY, "run: out of memory after %d steps", run->count);
     if (run->too_many_steps)
       return ssFail(SS_ERROR_OUT_OF_RANGE, "run: %d steps after %g s of duration_s = %g s: a run takes at most %d steps",
                     run->count, elapsed_s, duration_s, SS_MAX_RUN_STEPS);
     if (status == SS_ERROR_BLOWUP || status == SS_ERROR_SPEED_LIMIT) {
       run->status = status;
+      run->outcome = SS_RUN_BLEW_UP;
       strncpy(run->message, ssLastError(), sizeof run->message - 1);
       return SS_OK;
     }
@@ -160,6 +176,7 @@ ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
   if (status == SS_OK && run == NULL) status = ssFail(SS_ERROR_OUT_OF_MEMORY, "run: out of memory");
   if (status == SS_OK) {
     run->quantity_count = info->quantity_count;
+    ssScene_Sample(scene, run->initial);
     ssScene_SetStepObserver(scene, record, run);
     status = play(run, scene, profile, def->duration_s);
   }
@@ -189,7 +206,11 @@ const double* ssRun_Quantity(const ssRun* run, int index) {
   return run->quantities[index];
 }
 
+const double* ssRun_Initial(const ssRun* run) { return null_run(run, "an initial state") ? NULL : run->initial; }
+
 int ssRun_FrameCount(const ssRun* run) { return null_run(run, "a frame count") ? 0 : run->frame_count; }
 double ssRun_WallSeconds(const ssRun* run) { return null_run(run, "wall seconds") ? 0 : run->wall_s; }
 ssStatus ssRun_Status(const ssRun* run) { return null_run(run, "a status") ? SS_ERROR_OUT_OF_RANGE : run->status; }
+ssRunOutcome ssRun_Outcome(const ssRun* run) { return null_run(run, "an outcome") ? SS_RUN_NONE : run->outcome; }
+double ssRun_BoundUse(const ssRun* run) { return null_run(run, "a bound use") ? NAN : run->bound_use; }
 const char* ssRun_Message(const ssRun* run) { return null_run(run, "a message") ? "" : run->message; }

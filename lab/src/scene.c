@@ -5,6 +5,7 @@
  * SS_ERROR_SPEED_LIMIT instead of running on with nonsense. */
 #include <math.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -28,6 +29,9 @@ struct ssScene {
   unsigned long ode_random_seed; /* this scene's state of ODE's one global generator */
   ssSceneStepFn* observer;
   void* observer_context;
+  double bound_use;    /* the largest value/bound ratio of the sanity bounds so far */
+  int broken;          /* a step has left a sanity bound: broken_message says which */
+  char broken_message[256];
 };
 
 static pthread_once_t ode_once = PTHREAD_ONCE_INIT;
@@ -117,9 +121,23 @@ static ssStatus validate_params(const ssSceneDesc* desc, const ssSceneParams* pa
   return SS_OK;
 }
 
+/* After every step: the first step that leaves a bound is kept, with its time, for good. */
+static void check_bounds(ssScene* scene) {
+  if (scene->desc->check == NULL) return;
+  char worst[192] = "";
+  double use = scene->desc->check(scene->state, worst, sizeof worst);
+  if (use > scene->bound_use) scene->bound_use = use;
+  if (use > 1 && !scene->broken) {
+    scene->broken = 1;
+    snprintf(scene->broken_message, sizeof scene->broken_message, "t = %.9g s: %s %s", scene->time_s,
+             scene->desc->info.name, worst);
+  }
+}
+
 static void scene_step_done(void* context, double step_s) {
   ssScene* scene = context;
   scene->time_s += step_s;
+  check_bounds(scene);
   if (scene->observer != NULL) scene->observer(scene->observer_context, scene, step_s);
 }
 
@@ -229,4 +247,20 @@ double ssScene_Time(const ssScene* scene) {
 void ssScene_SetStepObserver(ssScene* scene, ssSceneStepFn* observer, void* context) {
   scene->observer = observer;
   scene->observer_context = context;
+}
+
+const char* ssScene_Broken(const ssScene* scene) {
+  if (scene == NULL) {
+    ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read the sanity bounds of");
+    return NULL;
+  }
+  return scene->broken ? scene->broken_message : NULL;
+}
+
+double ssScene_BoundUse(const ssScene* scene) {
+  if (scene == NULL) {
+    ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read the sanity bounds of");
+    return NAN;
+  }
+  return scene->bound_use;
 }

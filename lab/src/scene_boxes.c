@@ -1,5 +1,10 @@
 /* Boxes of one size on a ground plane with soft contacts: what the drop and pile scenes share. They differ only in
- * where the boxes start and what they sample. */
+ * where the boxes start and what they sample.
+ *
+ * Their sanity bound, a box's lowest corner below the floor, is checked here; each scene gives its depth bound (as a
+ * fraction of the box's half side) and the reason for it. */
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "error.h"
@@ -57,4 +62,28 @@ void ssBoxes_Destroy(void* state) {
   ssBoxes* boxes = state;
   free(boxes->bodies);
   free(boxes);
+}
+
+double ssBoxDepth(dBodyID box, double side_m) {
+  const dReal* position = dBodyGetPosition(box);
+  const dReal* rotation = dBodyGetRotation(box);
+  /* The half extents projected on world z: the third row of the rotation, weighted by the half side. */
+  return 0.5 * side_m * (fabs(rotation[8]) + fabs(rotation[9]) + fabs(rotation[10])) - position[2];
+}
+
+double ssBoxes_Check(const ssBoxes* boxes, double side_m, double of_half_side, char* worst, size_t size) {
+  const double bound_m = of_half_side * 0.5 * side_m;
+  double deepest_m = -INFINITY;
+  int deepest = 0;
+  for (int i = 0; i < boxes->count; ++i) {
+    double depth_m = ssBoxDepth(boxes->bodies[i], side_m);
+    if (depth_m > deepest_m) {
+      deepest_m = depth_m;
+      deepest = i;
+    }
+  }
+  if (boxes->count == 0) return 0;
+  snprintf(worst, size, "box %d: lowest corner %.6g m below the floor, bound %g m (%g times its %g m half side)",
+           deepest, deepest_m, bound_m, of_half_side, 0.5 * side_m);
+  return deepest_m / bound_m;
 }

@@ -38,6 +38,10 @@ typedef struct ssSceneDesc {
   ssStepCallback* collide;
   /* The followed quantities after a step, info.quantity_count of them. */
   void (*sample)(const void* state, double* out);
+  /* The scene's sanity bounds after a step (scene.h): returns the largest value/bound ratio over its bounds (above 1
+   * means one is left; NaN values must not count, a blow-up is the stepper's to report) and writes into worst one
+   * line naming the bound, the body or joint and the value that reached it. May be NULL: no bounds. */
+  double (*check)(const void* state, char* worst, size_t size);
   /* Frees the state (ODE objects go with the world). */
   void (*destroy)(void* state);
 } ssSceneDesc;
@@ -78,6 +82,12 @@ typedef struct ssBoxes {
   dBodyID* bodies;
   ssContactRecipe recipe;
 } ssBoxes;
+
+/* The sanity bound of a scene of boxes on the floor (scene.h): the largest ratio of a box's lowest corner below the
+ * floor to the bound, of_half_side times the box's half side; writes the deepest box into worst. */
+double ssBoxes_Check(const ssBoxes* boxes, double side_m, double of_half_side, char* worst, size_t size);
+/* How far the lowest corner of a box of side_m (m) is below z = 0 (m; negative when above). */
+double ssBoxDepth(dBodyID box, double side_m);
 
 /* Allocates room for params->body_count boxes, sets gravity along -z and makes the ground. scene names the scene
  * in the out-of-memory message. */

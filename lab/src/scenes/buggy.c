@@ -6,6 +6,7 @@
  * (the hinge-2 rigid rows) to a stiff spring too, so that policy naive freezes all of them and policy spring maps
  * all of them; nothing is left with a fixed ERP/CFM that would blur the comparison. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "error.h"
@@ -23,6 +24,17 @@
 #define BUGGY_MOTOR_TORQUE_NM 0.6  /* dParamFMax2 of each wheel motor */
 #define BUGGY_BUMP_COUNT 3
 
+/* Sanity bounds. The chassis rides about 0.2 m above the ground and never touches it in a correct run: its lowest
+ * corner more than half its half height (0.05 m) below the ground is a car sunk through the road. A wheel's hinge-2
+ * anchors move apart along axis 1 by the suspension's travel: the sag is 0.04 m, and the pitch of the start and
+ * the bumps take it to about 0.12 m in the fine-step reference. More than 0.28 m (the wheel centre's start 0.18 m
+ * below the chassis centre, plus the chassis' half height) is a wheel gone up through the chassis' roof, or as far
+ * down. Across axis 1 the rigid rows hold them together; more than a quarter of the wheel radius (0.045 m) is a
+ * wheel torn off. The margins of correct runs are measured in test_bounds.cpp. */
+#define BUGGY_MAX_SINK_OF_HALF_HEIGHT 0.5
+#define BUGGY_MAX_TRAVEL_M (BUGGY_CHASSIS_Z_M - BUGGY_WHEEL_RADIUS_M + 0.5 * BUGGY_HEIGHT_M)
+#define BUGGY_MAX_GAP_OF_RADIUS 0.25
+
 /* Ground contacts: stiff next to the suspension (about 50 Hz on a 0.2 kg wheel), well damped. */
 static const ssSpring buggy_ground_spring = {.stiffness = 2e4, .damping = 200};
 /* The hinge-2 rigid rows, as in chain.c: stiff and critically damped per kg. */
@@ -34,6 +46,7 @@ static const double bumps[BUGGY_BUMP_COUNT][3] = {{1.0, 0.3, 0.05}, {2.0, 0.2, 0
 typedef struct Buggy {
   dBodyID chassis;
   dBodyID wheels[4];
+  dJointID hinges[4];
   ssContactRecipe recipe;
 } Buggy;
 
@@ -49,10 +62,11 @@ static dBodyID make_wheel(const ssSceneWorld* world, double x, double y, double 
 }
 
 static ssStatus attach_wheel(const ssSceneWorld* world, const ssSceneParams* params, dBodyID chassis,
-                             dBodyID wheel) {
+                             dBodyID wheel, dJointID* out) {
   const dReal* at = dBodyGetPosition(wheel);
   dJointID joint = dJointCreateHinge2(world->world, 0);
   dJointAttach(joint, chassis, wheel);
+  *out = joint;
   dJointSetHinge2Anchor(joint, at[0], at[1], at[2]);
   const dReal steer_axis[3] = {0, 0, 1}, spin_axis[3] = {0, 1, 0};
   dJointSetHinge2Axes(joint, steer_axis, spin_axis);
@@ -94,7 +108,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
   for (int i = 0; status == SS_OK && i < 4; ++i) {
     double x = (i < 2 ? 1 : -1) * BUGGY_AXLE_X_M, y = (i % 2 == 0 ? 1 : -1) * BUGGY_TRACK_Y_M;
     buggy->wheels[i] = make_wheel(world, x, y, BUGGY_WHEEL_RADIUS_M);
-    status = attach_wheel(world, params, buggy->chassis, buggy->wheels[i]);
+    status = attach_wheel(world, params, buggy->chassis, buggy->wheels[i], &buggy->hinges[i]);
   }
   if (status != SS_OK) {
     free(buggy);
@@ -129,6 +143,42 @@ static void sample(const void* state, double* out) {
   out[1] = atan2(rotation[8], hypot(rotation[0], rotation[4]));
 }
 
+/* The largest of the three bounds' ratios; worst names the part that reached it. */
+static double check(const void* state, char* worst, size_t size) {
+  const Buggy* buggy = state;
+  const dReal* position = dBodyGetPosition(buggy->chassis);
+  const dReal* rotation = dBodyGetRotation(buggy->chassis);
+  double sink_m = 0.5 * (BUGGY_LENGTH_M * fabs(rotation[8]) + BUGGY_WIDTH_M * fabs(rotation[9]) +
+                         BUGGY_HEIGHT_M * fabs(rotation[10])) - position[2];
+  double sink_bound_m = BUGGY_MAX_SINK_OF_HALF_HEIGHT * 0.5 * BUGGY_HEIGHT_M;
+  double use = sink_m / sink_bound_m;
+  snprintf(worst, size, "chassis: lowest corner %.6g m below the ground, bound %g m (half of its %g m half height)",
+           sink_m, sink_bound_m, 0.5 * BUGGY_HEIGHT_M);
+  const double travel_bound_m = BUGGY_MAX_TRAVEL_M;
+  const double gap_bound_m = BUGGY_MAX_GAP_OF_RADIUS * BUGGY_WHEEL_RADIUS_M;
+  for (int i = 0; i < 4; ++i) {
+    dVector3 on_chassis, on_wheel, axis;
+    dJointGetHinge2Anchor(buggy->hinges[i], on_chassis);
+    dJointGetHinge2Anchor2(buggy->hinges[i], on_wheel);
+    dJointGetHinge2Axis1(buggy->hinges[i], axis);
+    double d[3] = {on_wheel[0] - on_chassis[0], on_wheel[1] - on_chassis[1], on_wheel[2] - on_chassis[2]};
+    double travel_m = d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2];
+    double across[3] = {d[0] - travel_m * axis[0], d[1] - travel_m * axis[1], d[2] - travel_m * axis[2]};
+    double gap_m = sqrt(across[0] * across[0] + across[1] * across[1] + across[2] * across[2]);
+    if (fabs(travel_m) / travel_bound_m > use) {
+      use = fabs(travel_m) / travel_bound_m;
+      snprintf(worst, size, "wheel %d hinge-2: anchors %.6g m apart along the suspension axis, bound %g m (the wheel "
+               "through the chassis)", i, fabs(travel_m), travel_bound_m);
+    }
+    if (gap_m / gap_bound_m > use) {
+      use = gap_m / gap_bound_m;
+      snprintf(worst, size, "wheel %d hinge-2: anchors %.6g m apart across the suspension axis, bound %g m (%g of "
+               "the wheel radius)", i, gap_m, gap_bound_m, BUGGY_MAX_GAP_OF_RADIUS);
+    }
+  }
+  return use;
+}
+
 static void destroy(void* state) { free(state); }
 
 const ssSceneDesc ssBuggyScene = {
@@ -146,5 +196,6 @@ const ssSceneDesc ssBuggyScene = {
     .watch = watch,
     .collide = collide,
     .sample = sample,
+    .check = check,
     .destroy = destroy,
 };

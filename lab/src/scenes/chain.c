@@ -5,6 +5,8 @@
  * soft with the scene's spring. A hinge's five rigid rows read the world's ERP/CFM at every step, so the world is
  * bound too, to a stiff spring: otherwise those rows would keep a fixed ERP/CFM and be the one part whose
  * stiffness still changed with the frame time. */
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "error.h"
@@ -14,6 +16,12 @@
 #define CHAIN_THICK_M 0.04        /* link cross-section */
 #define CHAIN_LIMIT_RAD 0.4
 #define CHAIN_PIVOT_HEIGHT_M 2.5  /* higher than the hanging chain is long at the default count */
+/* Sanity bound: a hinge's two anchors at most a fifth of a link (0.05 m) apart. The rigid rows are a stiff spring
+ * (chain_world_spring), so they do open under the swing: by 5 mm in the fine-step reference and up to 2 cm under
+ * the mapped policies at 15-60 fps (measured in test_bounds.cpp). A fifth of a link is a hinge
+ * visibly torn open: policy naive, its softness frozen for 1/30 s, opens them beyond that at 30 fps, and under
+ * 2 s frames the chain falls apart. */
+#define CHAIN_MAX_GAP_OF_LINK 0.2
 
 /* The rigid rows: per kg about 50 Hz and critically damped, far stiffer than anything the scene moves at. */
 static const ssSpring chain_world_spring = {.stiffness = 1e5, .damping = 630};
@@ -21,24 +29,29 @@ static const ssSpring chain_world_spring = {.stiffness = 1e5, .damping = 630};
 typedef struct Chain {
   int count;
   dBodyID* links;
+  dJointID* hinges; /* hinges[i] holds links[i] to links[i - 1], hinges[0] to the world */
 } Chain;
 
 static void destroy(void* state) {
   Chain* chain = state;
   free(chain->links);
+  free(chain->hinges);
   free(chain);
 }
 
 static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, void** state) {
   Chain* chain = calloc(1, sizeof *chain);
   dBodyID* links = calloc((size_t)params->body_count, sizeof *links);
-  if (chain == NULL || links == NULL) {
+  dJointID* hinges = calloc((size_t)params->body_count, sizeof *hinges);
+  if (chain == NULL || links == NULL || hinges == NULL) {
     free(chain);
     free(links);
+    free(hinges);
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "chain: out of memory for %d links", params->body_count);
   }
   chain->count = params->body_count;
   chain->links = links;
+  chain->hinges = hinges;
   *state = chain;
   dWorldSetGravity(world->world, 0, 0, -params->gravity);
   ssStatus status = ssRegistry_BindWorld(world->registry, chain_world_spring, params->mass);
@@ -53,6 +66,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
     dJointAttach(hinge, link, i == 0 ? 0 : links[i - 1]);
     dJointSetHingeAnchor(hinge, i * CHAIN_LINK_M, 0, CHAIN_PIVOT_HEIGHT_M);
     dJointSetHingeAxis(hinge, 0, 1, 0);
+    hinges[i] = hinge;
     if (i == 0) continue;
     dJointSetHingeParam(hinge, dParamLoStop, -CHAIN_LIMIT_RAD);
     dJointSetHingeParam(hinge, dParamHiStop, CHAIN_LIMIT_RAD);
@@ -73,6 +87,29 @@ static void sample(const void* state, double* out) {
   out[1] = end[2];
 }
 
+/* The widest gap between a hinge's anchor on its link and its anchor on the previous link (or the world). */
+static double check(const void* state, char* worst, size_t size) {
+  const Chain* chain = state;
+  const double bound_m = CHAIN_MAX_GAP_OF_LINK * CHAIN_LINK_M;
+  double widest_m = -INFINITY;
+  int widest = 0;
+  for (int i = 0; i < chain->count; ++i) {
+    dVector3 on_link, on_previous;
+    dJointGetHingeAnchor(chain->hinges[i], on_link);
+    dJointGetHingeAnchor2(chain->hinges[i], on_previous);
+    double gap_m = sqrt((on_link[0] - on_previous[0]) * (on_link[0] - on_previous[0]) +
+                        (on_link[1] - on_previous[1]) * (on_link[1] - on_previous[1]) +
+                        (on_link[2] - on_previous[2]) * (on_link[2] - on_previous[2]));
+    if (gap_m > widest_m) {
+      widest_m = gap_m;
+      widest = i;
+    }
+  }
+  snprintf(worst, size, "hinge %d: anchors %.6g m apart, bound %g m (%g of a %g m link)", widest, widest_m, bound_m,
+           CHAIN_MAX_GAP_OF_LINK, CHAIN_LINK_M);
+  return widest_m / bound_m;
+}
+
 const ssSceneDesc ssChainScene = {
     .info = {.name = "chain",
              .description = "a chain on hinges with soft limits, released horizontal to swing down under gravity",
@@ -84,5 +121,6 @@ const ssSceneDesc ssChainScene = {
     .max_body_count = 1000,
     .build = build,
     .sample = sample,
+    .check = check,
     .destroy = destroy,
 };

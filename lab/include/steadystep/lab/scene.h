@@ -13,10 +13,30 @@
  *   chain       a chain of links on hinge joints with soft limits (+-0.4 rad), pinned at one end and released
  *               horizontal under gravity (end x m, end z m)
  *   pile        many boxes in a heap for timing (mean height m)
+ *
+ * Sanity bounds. Every scene declares bounds that a physically correct run never reaches, checked after every
+ * physics step (in the lab, not the core library: they are facts about these scenes, not about ODE). Leaving one
+ * means the run is finite but wrong: a torn joint, a box through the floor, a spring that made energy. Each scene's
+ * file gives the reasons for its numbers; tests/c/test_bounds.cpp measures how close correct runs come (at most
+ * 0.66 of a bound: pile's boxes landing at 30 fps) and shows wrong ones broken:
+ *   oscillator  energy above its rest state, (1/2) m v^2 + (1/2) k (x - x_rest)^2 with x_rest = -m g / k, at most
+ *               2 E0 + rounding (E0 its value at release): gravity is conservative and nothing drives the body, so
+ *               energy can only fall
+ *   buggy       the chassis' lowest corner at most 0.05 m (half its half height) below the ground; each wheel's
+ *               hinge-2 anchors at most 0.045 m (a quarter of the wheel radius) apart across the suspension axis,
+ *               and at most 0.28 m apart along it (the wheel up through the chassis' roof)
+ *   drop        each box's lowest corner at most 0.05 m (half its half side) below the floor
+ *   pile        each box's lowest corner at most 0.1 m (its half side) below the floor: its boxes fall from higher,
+ *               and a 1/60 s step finds their first contact deeper
+ *   chain       each hinge's two anchors (one on each link, or the world's) at most 0.05 m (a fifth of a link)
+ *               apart
+ * A run that leaves a bound ends there as broken (ssRun_Outcome), its message naming the time, the bound, the body
+ * or joint and the value.
  */
 #ifndef STEADYSTEP_SCENE_H
 #define STEADYSTEP_SCENE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "steadystep/lab/export.h"
@@ -63,6 +83,15 @@ SS_LAB_API const ssSceneInfo* ssSceneInfoAt(int index);
 /** The scene called name, or NULL (also for name = NULL). */
 SS_LAB_API const ssSceneInfo* ssSceneFind(const char* name);
 
+/** A quantity's column name in the lab's tables (the CSV of `steadystep run` and examples/oscillator.c, the JSON
+ *  columns): name, then '_' and unit, spelled with letters, digits and '_' only: '/' as "_per_", spaces, '*' and '-'
+ *  as '_', parentheses and '^' dropped; a dimensionless quantity (unit "") has no suffix. E.g. ("t", "s") "t_s",
+ *  ("v", "m/s") "v_m_per_s", ("cfm", "m/(N*s)") "cfm_m_per_N_s", ("chassis pitch", "rad") "chassis_pitch_rad",
+ *  ("erp", "") "erp". Writes at most size bytes into out, always NUL-terminated when size > 0, and returns the
+ *  length of the whole name (as snprintf: a return >= size means out was too small). Errors: -1, with
+ *  "name = NULL: ..." (or unit, or out with size > 0) for ssLastError(). */
+SS_LAB_API int ssColumnName(const char* name, const char* unit, char* out, size_t size);
+
 /** The default parameters of a scene. Errors (*out untouched): SS_ERROR_NOT_FOUND for an unknown scene (named),
  *  SS_ERROR_OUT_OF_RANGE for name = NULL or out = NULL. */
 SS_LAB_API ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
@@ -108,6 +137,18 @@ SS_LAB_API void ssScene_Sample(const ssScene* scene, double* out);
 /** The scene's simulated time (s). scene = NULL: NaN, and records "scene = NULL: ..." for ssLastError(). */
 SS_LAB_API double ssScene_Time(const ssScene* scene);
 
+/** NULL while every physics step so far kept the scene within its sanity bounds (above); after the first step that
+ *  left one, that violation for good: one line naming the time (s), the bound, the body or joint and the value, e.g.
+ *  "t = 1.5 s: chain hinge 3: anchors 0.31 m apart, bound 0.05 m (a fifth of a 0.25 m link)". Leaving a bound is
+ *  not an error: ssScene_Frame still returns SS_OK and the scene steps on; the caller decides. scene = NULL: NULL,
+ *  and records "scene = NULL: ..." for ssLastError(). */
+SS_LAB_API const char* ssScene_Broken(const ssScene* scene);
+
+/** How close the scene has come to its sanity bounds: the largest value/bound ratio over every bound and every
+ *  physics step so far (0 before the first step; above 1 once broken). A correct run stays well below 1; the tests
+ *  measure how far. scene = NULL: NaN, and records "scene = NULL: ..." for ssLastError(). */
+SS_LAB_API double ssScene_BoundUse(const ssScene* scene);
+
 /** A run: a scene under a profile for duration_s, one record after every physics step. */
 typedef struct ssRunDef {
   const char* scene;        /* scene name */
@@ -120,7 +161,20 @@ typedef struct ssRunDef {
 
 typedef struct ssRun ssRun;
 
-/** Runs def to the end, or to the first blow-up (which is recorded in the run, not an error).
+/** How a run ended. A lab-level outcome, not an ssStatus: status.h lists the library's own errors, and a broken run
+ *  is no error of the library (every step succeeded) but a fact about the scene's physics. */
+typedef enum ssRunOutcome {
+  SS_RUN_NONE = -1,      /* only for run = NULL */
+  SS_RUN_COMPLETED = 0,  /* ran for duration_s within every sanity bound */
+  SS_RUN_BLEW_UP = 1,    /* ended early by SS_ERROR_BLOWUP or SS_ERROR_SPEED_LIMIT (ssRun_Status says which):
+                          * the state became non-finite or absurdly fast */
+  SS_RUN_BROKEN = 2,     /* ended early at the first step outside a sanity bound (ssScene_Broken): finite but
+                          * physically wrong */
+} ssRunOutcome;
+
+/** Runs def to the end, or to the first blow-up or broken step (which is recorded in the run, not an error); the
+ *  records run up to and including the step that blew up or broke. Steps after it within the same frame are
+ *  simulated (the stepper finishes its frame) but not recorded.
  *  A run takes at most SS_MAX_RUN_FRAMES frames and SS_MAX_RUN_STEPS physics steps (limits.h). One expected to
  *  need more (duration_s over the profile's mean frame; steps from the policy's cut) is refused before it starts,
  *  naming duration_s; one that reaches a bound anyway (a random profile's draw) ends with SS_ERROR_OUT_OF_RANGE.
@@ -134,20 +188,28 @@ SS_LAB_API void ssRun_Destroy(ssRun* run);
 
 /** Records: one per physics step, time (s) after the step, the step's length (s), and each quantity (NULL for an
  *  index outside [0, quantity_count)). The arrays belong to the run.
- *  Every ssRun_ accessor given run = NULL records "run = NULL: ..." for ssLastError() and returns 0, NULL, "" or
- *  (ssRun_Status) SS_ERROR_OUT_OF_RANGE. */
+ *  Every ssRun_ accessor given run = NULL records "run = NULL: ..." for ssLastError() and returns 0, NULL, "",
+ *  NaN (ssRun_BoundUse), SS_RUN_NONE (ssRun_Outcome) or SS_ERROR_OUT_OF_RANGE (ssRun_Status). */
 SS_LAB_API int ssRun_StepCount(const ssRun* run);
 SS_LAB_API const double* ssRun_Times(const ssRun* run);
 SS_LAB_API const double* ssRun_StepLengths(const ssRun* run);
 SS_LAB_API const double* ssRun_Quantity(const ssRun* run, int index);
+/** The quantities before the first step (time 0), quantity_count of them: the first row of a trajectory, kept apart
+ *  from the records so that records and steps stay one to one. */
+SS_LAB_API const double* ssRun_Initial(const ssRun* run);
 
 /** Frames rendered, and the wall-clock seconds the stepping took (scene building excluded). */
 SS_LAB_API int ssRun_FrameCount(const ssRun* run);
 SS_LAB_API double ssRun_WallSeconds(const ssRun* run);
 
-/** SS_OK, or the blow-up status that ended the run early; its message. */
+/** SS_OK (completed or broken), or the blow-up status that ended the run early. */
 SS_LAB_API ssStatus ssRun_Status(const ssRun* run);
+/** How the run ended (SS_RUN_NONE for run = NULL). */
+SS_LAB_API ssRunOutcome ssRun_Outcome(const ssRun* run);
+/** "" for a completed run; the blow-up's message, or ssScene_Broken's for a broken run. */
 SS_LAB_API const char* ssRun_Message(const ssRun* run);
+/** ssScene_BoundUse at the run's end: the largest value/bound ratio over every sanity bound and step. */
+SS_LAB_API double ssRun_BoundUse(const ssRun* run);
 
 #ifdef __cplusplus
 }
