@@ -1,7 +1,7 @@
 """The `steadystep` command: figure, compare, run, probe, convert. A thin layer over the package.
 
-Whatever the arguments' bytes, the command never shows a traceback. Exit codes: 0 done; 1 a run blew up (its
-records are still written); 2 a refusal: bad arguments, every SteadystepError, a file that cannot be read or
+Whatever the arguments' bytes, the command never shows a traceback. Exit codes: 0 done; 1 a run blew up or broke
+(its records are still written); 2 a refusal: bad arguments, every SteadystepError, a file that cannot be read or
 written, a --json result that is not finite, with one line on stderr naming the value; 3 an internal error (a bug),
 with one line naming it; 130 interrupted; 141 stdout closed early (a pipe to `head`). Output files are written
 whole (temporary name, then rename). --json output is strict JSON (no NaN or Infinity).
@@ -25,7 +25,7 @@ import numpy as np
 from steadystep._native import SteadystepError, one_line, printable
 from steadystep.limits import MAX_RUN_STEPS, MIN_MEASURED_DURATION_S
 
-EXIT_BLOWUP = 1
+EXIT_FAILED_RUN = 1  # the run blew up or broke (its records are still written)
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
 EXIT_INTERRUPTED = 130
@@ -90,8 +90,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser = _Parser(prog="steadystep", description="Frame-rate independent constraint softness for ODE: the "
                      "article's figure, comparisons on real ODE scenes, single runs and conversions.",
-                     epilog="Exit codes: 0 done, 1 a run blew up, 2 refused (one line on stderr naming the value), "
-                     "3 internal error. " + RUN_BOUND_HELP)
+                     epilog="Exit codes: 0 done, 1 a run blew up or broke, 2 refused (one line on stderr naming the "
+                     "value), 3 internal error. " + RUN_BOUND_HELP)
     from steadystep import __version__
 
     parser.add_argument("--version", action="version", version=f"steadystep {__version__}")
@@ -123,8 +123,11 @@ def build_parser() -> argparse.ArgumentParser:
     compare.add_argument("--seed", type=_seed, default=1, metavar="N", help="profile seed (default 1)")
 
     run = commands.add_parser("run", help="one run of a scene; the trajectory as CSV or JSON",
-                              description="Runs SCENE under a frame-time profile and a policy and prints one record "
-                              "per physics step: t and the scene's quantities (oscillator: t,x,v,erp,cfm). "
+                              description="Runs SCENE under a frame-time profile and a policy and prints a row for "
+                              "t = 0, then one record per physics step: t and the scene's quantities, each column named "
+                              "with its unit (oscillator: t_s,x_m,v_m_per_s,erp,cfm_m_per_N_s). A run ends early, exit "
+                              "1, when it blows up or breaks: leaves one of the scene's sanity bounds (a torn joint, a "
+                              "box through the floor, energy made; the status and message say which). "
                               + RUN_BOUND_HELP)
     run.add_argument("scene", metavar="SCENE", help="oscillator, buggy, drop, chain or pile")
     run.add_argument("--profile", required=True, metavar="SPEC",
@@ -259,12 +262,14 @@ def _run(args, argv) -> int:
 
     stepping = {"max_step_s": args.max_step} if args.max_step else None
     result = runs.run(args.scene, args.profile, args.policy, args.duration, args.seed, stepping=stepping)
-    columns = {"t": result.times, **result.quantities}
+    columns = result.trajectory()
     if args.json:
+        units = {"t": "s", **result.units}
         summary = {"scene": result.scene, "profile": printable(result.profile), "policy": result.policy,
                    "seed": result.seed, "duration_s": result.duration_s, "status": result.status,
                    "message": result.message, "steps": result.step_count, "frames": result.frame_count,
-                   "units": {"t": "s", **result.units}}
+                   "bound_use": result.bound_use,
+                   "units": {runs.column_name(name, unit): unit for name, unit in units.items()}}
         print(_strict_json("run", summary, columns))
     else:
         # To a file whole (written aside, then renamed); to stdout row by row, so that a reader that stops early
@@ -276,9 +281,9 @@ def _run(args, argv) -> int:
             writer.writerow(f"{value:.17g}" for value in row)
         if args.csv:
             atomic_write_text(args.csv, buffer.getvalue())
-    if result.blew_up:
+    if result.failed:
         _complain(f"steadystep run: {result.status}: {result.message}")
-        return EXIT_BLOWUP
+        return EXIT_FAILED_RUN
     return 0
 
 

@@ -156,7 +156,7 @@ def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_d
             result = results.get((profile, policy))
             if result is None or result.step_count == 0:
                 continue
-            label = policy + (" (blew up)" if result.blew_up else "")
+            label = policy + (" (blew up)" if result.blew_up else " (broken)" if result.broken else "")
             # The article's method drawn on top: it is what the figure is about.
             on_top = policy == "implicit-euler"
             ax.plot(result.times, result.quantities[quantity], color=policy_color(policy), lw=1.5 if on_top else 1.1,

@@ -46,7 +46,7 @@ def _trial(scene: str, policy: str, step_s: float, duration_s: float, bounds: di
         if error.status != "no finite mapping":  # a mapping with nothing to offer at this step is a failure of it
             raise SteadystepError(error.status, f"{name} = {step_s:g} s: {error.message}", error.code) from None
         return f"{error.status}: {error.message}"
-    if result.blew_up:
+    if result.failed:  # blew up or broke
         return f"{result.status}: {result.message}"
     for name, (low, high) in bounds.items():
         values = result.quantities[name]

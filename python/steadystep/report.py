@@ -168,7 +168,7 @@ def _compare_scene(report: Report, scene: str, scene_params: dict | None, bar, f
 
 
 def _deviation(result: runs.RunResult, reference: runs.RunResult, quantity: str) -> float:
-    if result.blew_up or result.step_count == 0:
+    if result.failed or result.step_count == 0:
         return math.inf
     return metrics.rms_deviation(result.times, result.quantities[quantity], reference.times,
                                  reference.quantities[quantity])
@@ -185,8 +185,8 @@ def _exact_curve(params: dict, duration_s: float):
 
 def _rms_vs_exact(result: runs.RunResult) -> float:
     """The oscillator's RMS error against the exact solution over the run, relative to x0 (no gravity only)."""
-    if result.blew_up or result.params["gravity"] != 0.0:
-        return math.inf if result.blew_up else math.nan
+    if result.failed or result.params["gravity"] != 0.0:
+        return math.inf if result.failed else math.nan
     exact_x, _ = article.exact(_oscillator(result.params), result.params["x0"], 0.0, result.times)
     return metrics.rms_vs_exact(result.quantities["x"], exact_x, result.params["x0"])
 

@@ -36,6 +36,18 @@ class SceneInfo:
     units: tuple[str, ...]
 
 
+def column_name(name: str, unit: str) -> str:
+    """A quantity's column name in the lab's tables (scene.h, ssColumnName): "t", "s" gives "t_s", "v", "m/s" gives
+    "v_m_per_s", "erp", "" gives "erp". The one spelling the CSV, the JSON and examples/oscillator.c share."""
+    name_c, unit_c = c_string("name", name), c_string("unit", unit)
+    length = lib.ssColumnName(name_c, unit_c, ffi.NULL, 0)
+    if length < 0:
+        check(lib.SS_ERROR_OUT_OF_RANGE)
+    out = ffi.new("char[]", length + 1)
+    lib.ssColumnName(name_c, unit_c, out, length + 1)
+    return text(out)
+
+
 def _scene_info(info) -> SceneInfo:
     count = info.quantity_count
     return SceneInfo(text(info.name), text(info.description),
@@ -131,9 +143,17 @@ def reference_stepping() -> dict:
     return _as_dict(lib.ssReferenceStepping(REFERENCE_STEP_S))
 
 
+# How a run ends (RunResult.status): "ok" ran to the end within the scene's sanity bounds; "blow-up" and
+# "speed limit" ended early with a state that was not finite or absurdly fast; "broken" ended early, finite but
+# physically wrong: a step left one of the scene's sanity bounds (scene.h: a torn joint, a box through the floor,
+# energy made). Only "ok" is a run to measure: a report counts every other status as failed.
+BLOW_UP_STATUSES = frozenset({"blow-up", "speed limit"})
+BROKEN = "broken"
+
+
 @dataclass
 class RunResult:
-    """One run's records (one per physics step, after the step) and its summary."""
+    """One run's records (one per physics step, after the step), the state before the first step, and its summary."""
 
     scene: str
     profile: str
@@ -148,8 +168,10 @@ class RunResult:
     units: dict[str, str]
     frame_count: int
     wall_s: float                      # wall-clock seconds of stepping (scene building excluded)
-    status: str                        # "ok" or the blow-up status that ended the run early
-    message: str = ""
+    status: str                        # "ok", "broken", or the blow-up status ("blow-up", "speed limit")
+    message: str = ""                  # why a run that is not "ok" ended: the bound, body or joint, value, time
+    initial: dict[str, float] = field(default_factory=dict)  # the quantities before the first step (t = 0)
+    bound_use: float = 0.0             # the largest value/bound ratio of the scene's sanity bounds (> 1: broken)
     extra: dict = field(default_factory=dict)
 
     @property
@@ -157,8 +179,26 @@ class RunResult:
         return len(self.times)
 
     @property
-    def blew_up(self) -> bool:
+    def failed(self) -> bool:
+        """Not a run to measure: it blew up or broke."""
         return self.status != "ok"
+
+    @property
+    def blew_up(self) -> bool:
+        """Ended by a blow-up: a state that was not finite, or faster than the scene's speed limit."""
+        return self.status in BLOW_UP_STATUSES
+
+    @property
+    def broken(self) -> bool:
+        """Ended at the first step outside one of the scene's sanity bounds: finite, but physically wrong."""
+        return self.status == BROKEN
+
+    def trajectory(self) -> dict[str, np.ndarray]:
+        """The run as a table from t = 0, by column name with its unit (column_name: "t_s", "x_m", "v_m_per_s",
+        ...): the state before the first step, then one row per physics step."""
+        return {column_name("t", "s"): np.concatenate(([0.0], self.times)),
+                **{column_name(name, self.units[name]): np.concatenate(([self.initial[name]], values))
+                   for name, values in self.quantities.items()}}
 
     @property
     def simulated_s(self) -> float:
@@ -233,14 +273,18 @@ def _collect(handle, scene, profile, policy, seed, duration_s, params, stepping)
     info = scene_info(scene)
     count = max(0, int(lib.ssRun_StepCount(handle)))
     quantities = {name: _copy(lib.ssRun_Quantity(handle, i), count) for i, name in enumerate(info.quantities)}
+    initial = lib.ssRun_Initial(handle)
     status = int(lib.ssRun_Status(handle))
+    status_name = BROKEN if lib.ssRun_Outcome(handle) == lib.SS_RUN_BROKEN else text(lib.ssStatusName(status))
     return RunResult(
         scene=scene, profile=profile, policy=policy, seed=seed, duration_s=duration_s, params=params,
         stepping=stepping, times=_copy(lib.ssRun_Times(handle), count),
         step_lengths=_copy(lib.ssRun_StepLengths(handle), count), quantities=quantities,
         units=dict(zip(info.quantities, info.units)), frame_count=int(lib.ssRun_FrameCount(handle)),
         wall_s=float(lib.ssRun_WallSeconds(handle)),
-        status=text(lib.ssStatusName(status)), message=text(lib.ssRun_Message(handle)) or "")
+        status=status_name, message=text(lib.ssRun_Message(handle)) or "",
+        initial={name: float(initial[i]) for i, name in enumerate(info.quantities)},
+        bound_use=float(lib.ssRun_BoundUse(handle)))
 
 
 def reference_run(scene: str, duration_s: float = 5.0, params: dict | None = None) -> RunResult:
@@ -281,6 +325,18 @@ class Scene:
     @property
     def time_s(self) -> float:
         return lib.ssScene_Time(self._handle())
+
+    @property
+    def broken(self) -> str | None:
+        """None while every step kept the scene within its sanity bounds (scene.h); after the first step that left
+        one, its message (time, bound, body or joint, value). Stepping goes on either way: the caller decides."""
+        message = lib.ssScene_Broken(self._handle())
+        return None if message == ffi.NULL else text(message)
+
+    @property
+    def bound_use(self) -> float:
+        """The largest value/bound ratio of the scene's sanity bounds over the steps so far (above 1: broken)."""
+        return lib.ssScene_BoundUse(self._handle())
 
     def close(self) -> None:
         """Destroys the scene and its ODE world now rather than at garbage collection."""

@@ -4,10 +4,12 @@ ending with exit code 2, one line on stderr and no file written."""
 import csv
 import io
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from steadystep.convert import softness_from_spring, spring_from_frequency, spring_from_softness
@@ -59,14 +61,20 @@ def test_run_csv_on_stdout_and_to_a_file(tmp_path):
     result = steadystep("run", "oscillator", "--profile", "fixed:30", "--policy", "implicit-euler", "--duration", "0.5")
     assert result.returncode == 0, result.stderr
     rows = list(csv.reader(io.StringIO(result.stdout)))
-    assert rows[0] == ["t", "x", "v", "erp", "cfm"]
-    assert len(rows) == 1 + 30  # 15 frames of 1/30 s, two 1/60 s steps each
-    assert float(rows[1][0]) == pytest.approx(1 / 60)
+    assert rows[0] == ["t_s", "x_m", "v_m_per_s", "erp", "cfm_m_per_N_s"]
+    assert len(rows) == 1 + 1 + 30  # header, t = 0, then 15 frames of 1/30 s, two 1/60 s steps each
+    assert [float(v) for v in rows[1][:3]] == [0.0, 0.5, 0.0]  # released at rest from x0 = 0.5 m
+    assert float(rows[2][0]) == pytest.approx(1 / 60)
+    # Full precision: every step length recomputed from t is 1/60 s to the last bits of the sum.
+    t = np.array([float(row[0]) for row in rows[1:]])
+    assert np.allclose(np.diff(t), 1 / 60, rtol=0, atol=1e-15)
     out = tmp_path / "run.csv"
-    result = steadystep("run", "chain", "--profile", "uniform:15:45", "--policy", "naive", "--duration", "0.5",
+    result = steadystep("run", "chain", "--profile", "uniform:15:45", "--policy", "implicit-euler", "--duration", "0.5",
                         "--csv", out)
     assert result.returncode == 0, result.stderr
-    assert out.read_text().splitlines()[0] == "t,end x,end z"
+    lines = out.read_text().splitlines()
+    assert lines[0] == "t_s,end_x_m,end_z_m"
+    assert lines[1] == "0,2,2.5"  # the chain's end at the start: 8 links of 0.25 m, horizontal at 2.5 m
     assert no_temporaries(tmp_path)
 
 
@@ -75,8 +83,55 @@ def test_run_json():
                         "--json", "--max-step", "0.1")
     assert result.returncode == 0, result.stderr
     data = json.loads(result.stdout)
-    assert data["status"] == "ok" and data["frames"] == data["steps"]
-    assert list(data["columns"]) == ["t", "x", "v", "erp", "cfm"] and data["units"]["x"] == "m"
+    assert data["status"] == "ok" and data["message"] == "" and data["frames"] == data["steps"]
+    assert list(data["columns"]) == ["t_s", "x_m", "v_m_per_s", "erp", "cfm_m_per_N_s"]
+    assert data["units"] == {"t_s": "s", "x_m": "m", "v_m_per_s": "m/s", "erp": "", "cfm_m_per_N_s": "m/(N*s)"}
+    columns = data["columns"]
+    assert all(len(values) == data["steps"] + 1 for values in columns.values())  # the t = 0 sample, then each step
+    assert columns["t_s"][0] == 0.0 and columns["x_m"][0] == 0.5 and columns["v_m_per_s"][0] == 0.0
+    assert 0 < data["bound_use"] < 1
+
+
+def test_run_broken_chain_reports_and_exits_1():
+    # Issue 10: 2 s frames tear the naive chain apart. Its end, 2 m of chain from a pivot 2.5 m up, is recorded far
+    # beyond what the chain can reach: the JSON says broken, names the bound, and the records stop at that step.
+    result = steadystep("run", "chain", "--policy", "naive", "--profile", "fixed:0.5", "--json")
+    assert result.returncode == 1, result.stderr
+    data = json.loads(result.stdout)
+    assert data["status"] == "broken" and data["bound_use"] > 1
+    assert data["message"].startswith("t = 2 s: chain hinge ") and "bound 0.05 m" in data["message"]
+    assert data["steps"] == 1 and data["columns"]["t_s"] == [0.0, 2.0]
+    end_x, end_z = data["columns"]["end_x_m"][-1], data["columns"]["end_z_m"][-1]
+    assert math.hypot(end_x, end_z - 2.5) > 2.0
+    assert result.stderr.count("\n") == 1 and "broken: t = 2 s" in result.stderr
+    csv_result = steadystep("run", "chain", "--policy", "naive", "--profile", "fixed:0.5")
+    assert csv_result.returncode == 1 and len(csv_result.stdout.splitlines()) == 3  # header, t = 0, the step
+
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "build" / "steadystep_example_oscillator"
+
+
+@pytest.mark.parametrize("args", [
+    [],  # the defaults: implicit-euler, uniform:15:45, seed 1, 5 s
+    ["--policy", "naive", "--profile", "fixed:30", "--duration", "1"],
+    ["--policy", "exact", "--profile", "jitter:30:3", "--seed", "7", "--duration", "1.3", "--max-step", "0.01"],
+    ["--policy", "matched", "--profile", "hitch:60:30:0.1", "--seed", "3", "--duration", "2"],
+    ["--policy", "fixed", "--profile", "vsync:60:30", "--duration", "0.7"],
+])
+def test_c_example_prints_what_steadystep_run_prints(args):
+    # examples/oscillator.c is a plain ODE program, built by scripts/test (cmake) before pytest runs; with the same
+    # flags it must print the same CSV, byte for byte: header, t = 0 row, every step at full precision.
+    assert EXAMPLE.exists(), f"{EXAMPLE}: build the C side first (scripts/test, or cmake --build build)"
+    if not args:
+        cli_args = ["--policy", "implicit-euler", "--profile", "uniform:15:45"]
+    else:
+        cli_args = args
+    example = subprocess.run([str(EXAMPLE), *args], capture_output=True, text=True, timeout=60)
+    assert example.returncode == 0, example.stderr
+    cli = steadystep("run", "oscillator", *cli_args)
+    assert cli.returncode == 0, cli.stderr
+    assert len(example.stdout.splitlines()) > 20
+    assert example.stdout == cli.stdout
 
 
 def test_probe_prints_each_policy():

@@ -86,3 +86,51 @@ def test_spring_halves_the_spread_of_naive_in_every_soft_scene():
             spring = result.spreads[scene]["implicit-euler"][quantity]
             assert math.isfinite(spring), (scene, quantity)
             assert spring <= 0.5 * naive, (scene, quantity, spring, naive)
+
+
+def test_statuses_say_how_a_run_ended():
+    # Broken: 2 s frames tear the naive chain apart in its first step; finite, physically wrong, failed.
+    broken = runs.run("chain", "fixed:0.5", "naive", 5.0)
+    assert broken.status == "broken" and broken.broken and broken.failed and not broken.blew_up
+    assert broken.message.startswith("t = 2 s: chain hinge ") and "apart, bound 0.05 m" in broken.message
+    assert broken.step_count == 1 and broken.bound_use > 1
+    assert all(np.all(np.isfinite(values)) for values in broken.quantities.values())
+    # Blown up: gravity of 1e3 m/s^2 along the slider swings the body past the 100 m/s limit (test_scenes.cpp).
+    blown = runs.run("oscillator", "fixed:60", "implicit-euler", 5.0, params={"gravity": 1e3})
+    assert blown.status == "speed limit" and blown.blew_up and blown.failed and not blown.broken
+    ok = runs.run("chain", "fixed:30", "implicit-euler", 1.0)
+    assert ok.status == "ok" and not (ok.failed or ok.blew_up or ok.broken) and ok.message == ""
+    assert 0 < ok.bound_use < 1
+    # The report measures neither: a failed run's deviation is infinite, however close its records were.
+    reference = runs.reference_run("chain", 1.0)
+    assert math.isinf(report._deviation(broken, reference, "end x"))
+    assert math.isfinite(report._deviation(ok, reference, "end x"))
+
+
+def test_trajectory_starts_at_t0_with_unit_columns():
+    result = runs.run("oscillator", "fixed:30", "implicit-euler", 0.2, params={"x0": 0.25})
+    table = result.trajectory()
+    assert list(table) == ["t_s", "x_m", "v_m_per_s", "erp", "cfm_m_per_N_s"]
+    assert all(len(column) == result.step_count + 1 for column in table.values())
+    assert table["t_s"][0] == 0.0 and table["x_m"][0] == 0.25 and table["v_m_per_s"][0] == 0.0
+    assert result.initial["x"] == 0.25
+    assert np.array_equal(table["t_s"][1:], result.times) and np.array_equal(table["x_m"][1:], result.quantities["x"])
+    # The records stay one per step: the report's metrics and the probe read them as before.
+    assert np.all(result.step_lengths > 0) and result.step_count == len(result.times)
+    assert runs.column_name("chassis pitch", "rad") == "chassis_pitch_rad"
+    assert runs.column_name("erp", "") == "erp"
+
+
+def test_scene_reports_its_first_violation_and_steps_on():
+    scene = runs.Scene("chain", "naive")
+    scene.frame(1 / 60)
+    assert scene.broken is None and 0 < scene.bound_use < 1
+    scene.frame(2.0)  # leaving a bound is no error
+    first = scene.broken
+    assert first is not None and first.startswith("t = 2.01666667 s: chain hinge ")
+    # The next step pulls the torn hinge together at over 100 m/s: a blow-up, reported as one; the violation that
+    # came first stays the scene's.
+    with pytest.raises(SteadystepError, match="speed"):
+        scene.frame(1 / 60)
+    assert scene.broken == first and scene.bound_use > 1
+    scene.close()
