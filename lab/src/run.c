@@ -2,12 +2,12 @@
  *
  * Records come from the scene's step observer rather than after each frame, because a frame may hold several
  * substeps (or, for policy fixed, none) and the comparison between policies is about the physics, not the frames.
- * The state before the first step is kept apart (initial), so that records and steps stay one to one.
- * The last frame is shortened so that every run ends at duration_s of frame time exactly. A run ends early at the
- * first step that blows up (the stepper's error) or leaves one of the scene's sanity bounds (broken: the step is
- * recorded, the ones after it in its frame are not). A run is bounded
- * (limits.h): its duration, the frames it is expected to take (refused before it starts) and the frames and steps it
- * does take (stopped with an error when an unlucky random profile reaches them). */
+ * The state before the first step is kept apart (initial), so that records and steps stay one to one. The last frame
+ * is shortened so that every run ends at duration_s of frame time exactly. A run ends early at the first step that
+ * blows up (the stepper's error) or leaves one of the scene's sanity bounds (broken: that step is recorded, the ones
+ * after it in its frame are not). A run is bounded (limits.h): its duration, the frames it is expected to take
+ * (refused before it starts) and the frames and steps it does take (stopped with an error when an unlucky random
+ * profile reaches them). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

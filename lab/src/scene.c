@@ -2,7 +2,9 @@
  *
  * Everything a caller can get wrong is checked before ODE is touched, so a refused scene leaves no world behind
  * and the message names the value. The stepper gets a speed limit so that a scene that explodes ends its run with
- * SS_ERROR_SPEED_LIMIT instead of running on with nonsense. */
+ * SS_ERROR_SPEED_LIMIT instead of running on with nonsense. After every step the scene's sanity bounds are checked
+ * (scene.h): the first step outside one is kept, with its time, for the run to end on (a run that is finite but
+ * wrong is no error of the library, so it is not an ssStatus). */
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -121,7 +123,6 @@ static ssStatus validate_params(const ssSceneDesc* desc, const ssSceneParams* pa
   return SS_OK;
 }
 
-/* After every step: the first step that leaves a bound is kept, with its time, for good. */
 static void check_bounds(ssScene* scene) {
   if (scene->desc->check == NULL) return;
   char worst[192] = "";
