@@ -29,6 +29,7 @@ struct ssRun {
   char message[256];
   int out_of_memory;
   int too_many_steps; /* a step past SS_MAX_RUN_STEPS was not recorded */
+  ssSceneCounters counters;
 };
 
 void ssRun_Destroy(ssRun* run) {
@@ -162,6 +163,7 @@ ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
     run->quantity_count = info->quantity_count;
     ssScene_SetStepObserver(scene, record, run);
     status = play(run, scene, profile, def->duration_s);
+    run->counters = ssScene_Counters(scene);
   }
   ssScene_Destroy(scene);
   ssProfile_Destroy(profile);
@@ -193,3 +195,6 @@ int ssRun_FrameCount(const ssRun* run) { return null_run(run, "a frame count") ?
 double ssRun_WallSeconds(const ssRun* run) { return null_run(run, "wall seconds") ? 0 : run->wall_s; }
 ssStatus ssRun_Status(const ssRun* run) { return null_run(run, "a status") ? SS_ERROR_OUT_OF_RANGE : run->status; }
 const char* ssRun_Message(const ssRun* run) { return null_run(run, "a message") ? "" : run->message; }
+ssSceneCounters ssRun_Counters(const ssRun* run) {
+  return null_run(run, "counters") ? (ssSceneCounters){0} : run->counters;
+}

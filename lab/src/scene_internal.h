@@ -38,6 +38,9 @@ typedef struct ssSceneDesc {
   ssStepCallback* collide;
   /* The followed quantities after a step, info.quantity_count of them. */
   void (*sample)(const void* state, double* out);
+  /* The scene's drawing (ssScene_Points): writes at most capacity points (x y z) and returns how many it has.
+   * May be NULL (no drawing). */
+  int (*points)(const void* state, double* xyz, int capacity);
   /* Frees the state (ODE objects go with the world). */
   void (*destroy)(void* state);
 } ssSceneDesc;

@@ -73,6 +73,21 @@ static void sample(const void* state, double* out) {
   out[1] = end[2];
 }
 
+/* The pivot, then the far end of each link: the chain as a polyline. */
+static int points(const void* state, double* xyz, int capacity) {
+  const Chain* chain = state;
+  for (int i = 0; i <= chain->count && i < capacity; ++i) {
+    dVector3 point;
+    if (i == 0) {
+      dBodyGetRelPointPos(chain->links[0], -0.5 * CHAIN_LINK_M, 0, 0, point);
+    } else {
+      dBodyGetRelPointPos(chain->links[i - 1], 0.5 * CHAIN_LINK_M, 0, 0, point);
+    }
+    for (int k = 0; k < 3; ++k) xyz[3 * i + k] = point[k];
+  }
+  return chain->count + 1;
+}
+
 const ssSceneDesc ssChainScene = {
     .info = {.name = "chain",
              .description = "a chain on hinges with soft limits, released horizontal to swing down under gravity",
@@ -84,5 +99,6 @@ const ssSceneDesc ssChainScene = {
     .max_body_count = 1000,
     .build = build,
     .sample = sample,
+    .points = points,
     .destroy = destroy,
 };
