@@ -28,8 +28,8 @@ DEFAULT_PROFILE = "uniform:15:45"
 DEFAULT_REPEATS = 7
 # A block lasts about this long when stepped plain: long against the clock's resolution, short against the drift
 # of a shared machine.
-BLOCK_TARGET_S = 0.004
-MAX_BLOCK_FRAMES = 400
+BLOCK_TARGET_S = 0.01
+MAX_BLOCK_FRAMES = 2000
 
 
 @dataclass
