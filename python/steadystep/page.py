@@ -106,28 +106,33 @@ def _ranking(per_scene: dict[str, dict[str, float]]) -> list[tuple[str, float, i
     return sorted(scored, key=lambda item: (item[1], -item[2], item[0]))
 
 
+# Consistency at or below this (relative to the amplitude) is rounding: the runs are the same motion.
+IDENTICAL = 1e-9
+
+
 def _consistency(report) -> str | None:
     per_scene = {s: {p: report.consistency[s][p][_first(report, s)] for p in report.policies[s]}
                  for s in report.scenes if s in report.consistency}
-    ranking = _ranking(per_scene)
-    if not ranking or not math.isfinite(ranking[0][1]):
+    if not per_scene:
         return None
-    best, mean, wins = ranking[0]
-    ties = [p for p, m, _ in ranking if m == mean]
-    naive = [per_scene[s]["naive"] / per_scene[s][best] for s in per_scene
-             if "naive" in per_scene[s] and _finite(per_scene[s]["naive"]) and per_scene[s].get(best, 0) > 0]
-    who = " and ".join(f"<b>{html.escape(p)}</b>" for p in ties)
-    text = (f"{who}: the motion under every frame-time profile is the "
-            f"{'same' if mean == 1 and all(per_scene[s][best] == 0 for s in per_scene) else 'most alike'}"
-            f" (consistency best on {wins} of {len(per_scene)} scenes")
-    if mean > 1:
-        text += f", {_x(mean)} the best on average"
-    text += ")"
-    if naive:
-        text += f"; naive's differs {_x(statistics.median(naive))} more (median over scenes)"
-    elif any(per_scene[s].get(best) == 0 for s in per_scene):
-        text += "; its runs are identical whatever the frame rate, since every physics step has the same length"
-    return text + ". " + _link("consistency", "consistency table")
+    policies = list(dict.fromkeys(p for values in per_scene.values() for p in values))
+    same = [p for p in policies if all(_finite(v.get(p)) and v[p] <= IDENTICAL for v in per_scene.values())]
+    moving = {s: {p: v for p, v in values.items() if p not in same} for s, values in per_scene.items()}
+    ranking = _ranking(moving) if any(moving.values()) else []
+    parts = []
+    if same:
+        parts.append(" and ".join(f"<b>{html.escape(p)}</b>" for p in same)
+                     + f": the same motion under every frame-time profile on all {len(per_scene)} scenes "
+                     f"(consistency ≤ {IDENTICAL:g}): every physics step has the same length whatever the frames")
+    if ranking and math.isfinite(ranking[0][1]):
+        best = ranking[0][0]
+        medians = {p: statistics.median(values[p] for values in moving.values() if p in values)
+                   for p, _, _ in ranking if all(_finite(values.get(p)) for values in moving.values() if p in values)}
+        text = ", ".join(f"{html.escape(p)} {medians[p]:.2g}" for p, _, _ in ranking if p in medians)
+        lead = "among the policies whose steps follow the frames, " if same else ""
+        parts.append(f"{lead}<b>{html.escape(best)}</b> is the most alike across profiles (median consistency over "
+                     f"scenes: {text})")
+    return "; ".join(parts) + ". " + _link("consistency", "consistency table")
 
 
 def _accuracy_exact(report) -> str | None:
@@ -151,8 +156,13 @@ def _accuracy_reference(report) -> str | None:
     runner = [f"{html.escape(p)} {_x(m)}" for p, m, _ in ranking[1:4]]
     return (f"<b>{html.escape(best)}</b>: closest to the fine-step reference over all scenes: its deviation (RMS over "
             f"profiles) is {_x(mean)} the best policy's of each scene, as a geometric mean over the "
-            f"{len(per_scene)} scenes, and the lowest on {wins} of them (next: {', '.join(runner)}). "
+            f"{len(per_scene)} scenes, " + (f"and the lowest on {wins} of them" if wins else
+                                             "though the lowest on none of them alone")
+            + f" (next: {', '.join(runner)}). "
             + _link("deviation", "deviation table"))
+
+
+CHEAP_TIE = 0.1
 
 
 def _cost(report) -> str | None:
@@ -167,26 +177,48 @@ def _cost(report) -> str | None:
     accurate = [p for p in order if p != "naive"]
     text = ", ".join(f"{html.escape(p)} {_x(medians[p])}" for p in order)
     cheapest = accurate[0] if accurate else order[0]
+    # Medians within CHEAP_TIE of the cheapest are not told apart by one benchmark run.
+    alike = [p for p in accurate if medians[p] <= medians[cheapest] * (1 + CHEAP_TIE)] or [cheapest]
     profile = report.costs[0].profile
-    return (f"<b>{html.escape(cheapest)}</b>: the cheapest policy whose softness follows the step. Wall time per "
+    who = " and ".join(f"<b>{html.escape(p)}</b>" for p in alike)
+    return (f"{who}: the cheapest {'policy' if len(alike) == 1 else f'policies (within {CHEAP_TIE:.0%})'} whose "
+            f"softness follows the step. Wall time per "
             f"frame against plain ODE under {html.escape(profile)} frames, median over scenes: {text}; the cost is "
             f"mostly the substeps (steps per frame in the table). " + _link("cost", "cost table"))
 
 
 def _stable(report) -> str | None:
-    smallest: dict[str, float] = {}
+    """The policies stable up to the longest steps: best on the worst probed scene, then on the geometric mean over
+    the probed scenes; and where the others fall short of the best."""
+    by_policy: dict[str, dict[str, float]] = {}
     for scene, results in report.probes.items():
         for r in results:
-            smallest[r.policy] = min(smallest.get(r.policy, math.inf), r.stable_s)
-    if not smallest:
+            by_policy.setdefault(r.policy, {})[scene] = r.stable_s
+    if not by_policy:
         return None
-    order = sorted(smallest, key=lambda p: -smallest[p])
-    longest = smallest[order[0]]
-    best = [p for p in order if smallest[p] == longest]
-    others = ", ".join(f"{html.escape(p)} {_ms(smallest[p])}" for p in order if p not in best)
-    who = " and ".join(f"<b>{html.escape(p)}</b>" for p in best)
-    return (f"{who}: the longest step stable on every probed scene, {_ms(longest)} on the worst scene"
-            + (f" (then {others})" if others else "") + ". " + _link("stable", "largest stable step"))
+
+    def score(policy):
+        values = list(by_policy[policy].values())
+        worst = min(values)
+        mean = math.exp(statistics.fmean(math.log(max(v, 1e-9)) for v in values))
+        return worst, mean
+
+    best_score = max(score(p) for p in by_policy)
+    best = [p for p in by_policy if score(p) == best_score]
+    reference = by_policy[best[0]]
+    worst_scene = min(reference, key=reference.get)
+    text = (" and ".join(f"<b>{html.escape(p)}</b>" for p in best)
+            + f": stable up to the longest steps, {_ms(reference[worst_scene])} on the hardest scene ({worst_scene}), "
+            f"{_ms(best_score[1])} as the geometric mean over the {len(reference)} probed scenes")
+    shortfalls = []
+    for policy, values in by_policy.items():
+        short = [f"{scene} {_ms(v)} against {_ms(reference[scene])}" for scene, v in values.items()
+                 if scene in reference and v < reference[scene]]
+        if short and policy not in best:
+            shortfalls.append(f"{html.escape(policy)} is shorter on {', '.join(short)}")
+    if shortfalls:
+        text += "; " + "; ".join(shortfalls)
+    return text + ". " + _link("stable", "largest stable step")
 
 
 def _failures(report) -> str | None:

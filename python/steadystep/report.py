@@ -1,5 +1,6 @@
 """The comparison: scenes x frame-time profiles x policies on real ODE, measured against a reference run, written
-as an HTML report (report.html, figures embedded and also beside it), metrics.json and metrics.csv."""
+as an HTML report (report.html, figures embedded and also beside it), metrics.json and metrics.csv (their
+schema: docs/metrics.md)."""
 
 from __future__ import annotations
 
