@@ -16,6 +16,7 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from steadystep import article, runs
 from steadystep._native import SteadystepError, number, printable
@@ -175,9 +176,15 @@ def _draw_run(ax, t, y, color, style, low, high, failed: bool) -> dict:
     return drawn
 
 
-@_styled
 def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_dir: Path,
                  exact_curve=None) -> list[Path]:
+    """draw_scene_figure saved as out_dir/scene_<scene>_<quantity>.png and .svg."""
+    figure = draw_scene_figure(scene, quantity, unit, reference, results, exact_curve)
+    return save(figure, out_dir, f"scene_{scene}_{quantity}".replace(" ", "_"))
+
+
+@_styled
+def draw_scene_figure(scene: str, quantity: str, unit: str, reference, results, exact_curve=None) -> Figure:
     """Small multiples: one panel per policy, the quantity over time under every profile (line style and marker per
     profile, the policy's colour), over the reference (and the exact solution). Runs that leave the shared axes are
     marked where they leave (a triangle on the edge), failed runs where they end (a cross).
@@ -220,7 +227,6 @@ def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_d
     for index in range(len(policies), rows * columns):
         axes[index // columns][index % columns].set_visible(False)
     # The legend says what is drawn and nothing else.
-    from matplotlib.lines import Line2D
     handles = [Line2D([], [], color=REFERENCE_COLOR, lw=1.0, ls=(0, (2, 2)), label="reference (1/1000 s)")]
     if exact_curve is not None:
         handles.append(Line2D([], [], color=EXACT_COLOR, lw=3.0, alpha=0.35, label="exact solution"))
@@ -236,7 +242,7 @@ def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_d
     figure.legend(handles=handles, loc="outside lower center", ncol=min(5, len(handles)))
     figure.suptitle(f"{scene}: {quantity}, one panel per policy (colour), one line style per frame-time profile",
                     fontsize=11)
-    return save(figure, out_dir, f"scene_{scene}_{quantity}".replace(" ", "_"))
+    return figure
 
 
 def _limits(reference: np.ndarray, others: list[np.ndarray]) -> tuple[float, float]:
@@ -255,9 +261,14 @@ def _limits(reference: np.ndarray, others: list[np.ndarray]) -> tuple[float, flo
 HATCHES = ("", "//", "..", "\\\\", "oo", "--", "++")
 
 
-@_styled
 def deviation_figure(scene: str, quantity: str, deviations: dict, out_dir: Path,
                      statuses: dict | None = None) -> list[Path]:
+    """draw_deviation_figure saved as out_dir/deviation_<scene>.png and .svg."""
+    return save(draw_deviation_figure(scene, quantity, deviations, statuses), out_dir, f"deviation_{scene}")
+
+
+@_styled
+def draw_deviation_figure(scene: str, quantity: str, deviations: dict, statuses: dict | None = None) -> Figure:
     """Grouped bars: the deviation per profile (groups) and policy (colour and hatch), on a log scale.
 
     deviations: {(profile, policy): value}; statuses: {(profile, policy): status}. A failed run (inf, or a status
@@ -300,4 +311,4 @@ def deviation_figure(scene: str, quantity: str, deviations: dict, out_dir: Path,
                  + (" (✕, faded to the top: the run failed)" if any_failed else ""), loc="left", fontsize=10)
     figure.legend(*ax.get_legend_handles_labels(), ncol=min(7, len(policies)), loc="outside lower center",
                   fontsize=8)
-    return save(figure, out_dir, f"deviation_{scene}")
+    return figure

@@ -126,12 +126,10 @@ def _consistency(report) -> str | None:
                      f"(consistency ≤ {IDENTICAL:g}): every physics step has the same length whatever the frames")
     if ranking and math.isfinite(ranking[0][1]):
         best = ranking[0][0]
-        medians = {p: statistics.median(values[p] for values in moving.values() if p in values)
-                   for p, _, _ in ranking if all(_finite(values.get(p)) for values in moving.values() if p in values)}
-        text = ", ".join(f"{html.escape(p)} {medians[p]:.2g}" for p, _, _ in ranking if p in medians)
+        text = ", ".join(f"{html.escape(p)} {_x(m)}" for p, m, _ in ranking)
         lead = "among the policies whose steps follow the frames, " if same else ""
-        parts.append(f"{lead}<b>{html.escape(best)}</b> is the most alike across profiles (median consistency over "
-                     f"scenes: {text})")
+        parts.append(f"{lead}<b>{html.escape(best)}</b> is the most alike across profiles (consistency as a multiple "
+                     f"of each scene's best, geometric mean over scenes: {text})")
     return "; ".join(parts) + ". " + _link("consistency", "consistency table")
 
 

@@ -352,7 +352,7 @@ def _all_policies(report: Report) -> list[str]:
     return list(dict.fromkeys(p for s in report.scenes for p in report.policies[s]))
 
 
-def _by_scene(report: Report, values: dict, anchor: str, what: str) -> str:
+def _by_scene(report: Report, values: dict, anchor: str, what: str, zero: float = 0.0) -> str:
     """A scene x policy table of values[scene][policy][first motion quantity], the smallest of a row in bold."""
     policies = _all_policies(report)
     rows = []
@@ -361,6 +361,8 @@ def _by_scene(report: Report, values: dict, anchor: str, what: str) -> str:
             continue
         quantity = runs.motion_quantities(scene)[0]
         cells = {p: values[scene][p][quantity] for p in report.policies[scene] if p in values[scene]}
+        # At or below zero the numbers are rounding: shown as 0, all of them the best.
+        cells = {p: 0.0 if v is not None and math.isfinite(v) and v <= zero else v for p, v in cells.items()}
         finite = [v for v in cells.values() if math.isfinite(v)]
         best = min(finite) if finite else None
         row = [f"<a href='#{html.escape(scene)}'>{html.escape(scene)}</a>", html.escape(quantity)]
@@ -427,7 +429,8 @@ def _as_html(report: Report, command: str, article_paths: list[Path]) -> str:
               _by_scene(report, report.consistency, "consistency",
                         "Consistency: each run's followed quantity minus the mean over the profiles of the same "
                         "policy, RMS over profiles and time, divided by the reference's amplitude (max − min): 0 "
-                        "when the motion is the same at every frame rate."),
+                        "when the motion is the same at every frame rate (shown 0 at or below "
+                        f"{page.IDENTICAL:g}: rounding).", zero=page.IDENTICAL),
               "<h2>Deviation from the fine-step reference</h2>",
               _by_scene(report, report.spreads, "deviation",
                         "RMS over the profiles of each run's deviation: RMS of the followed quantity minus the "

@@ -107,3 +107,32 @@ def test_the_animation_renders_and_moves(written, tmp_path):
     assert changed.sum() > 200, changed.sum()
     # Only the animation moves: the changed pixels lie in one band of the page, not all over it.
     assert rows.max() - rows.min() < 500, (rows.min(), rows.max())
+
+
+def _legend(figure) -> list[str]:
+    return [text.get_text() for legend in figure.legends for text in legend.get_texts()]
+
+
+def test_a_run_that_leaves_the_axes_is_marked_and_the_legend_says_only_what_is_drawn():
+    from steadystep import figures, runs
+
+    reference = runs.reference_run("chain", 3.0)
+    # Naive under 2 s frames: the chain's end falls tens of metres, far below the reference's range.
+    results = {(profile, policy): runs.run("chain", profile, policy, 3.0)
+               for profile in ("fixed:2", "fixed:30") for policy in ("naive", "implicit-euler")}
+    assert results[("fixed:2", "naive")].quantities["end z"].min() < -10
+    figure = figures.draw_scene_figure("chain", "end z", "m", reference, results)
+    labels = _legend(figure)
+    assert "leaves the axes here" in labels and "fixed:2" in labels and "fixed:30" in labels
+    assert "exact solution" not in labels
+    if all(r.status == "ok" for r in results.values()):
+        assert not any("failed" in label for label in labels)
+    calm = {key: value for key, value in results.items() if key[0] == "fixed:30"}
+    assert "leaves the axes here" not in _legend(figures.draw_scene_figure("chain", "end z", "m", reference, calm))
+    bars = figures.draw_deviation_figure("chain", "end z", {("fixed:30", "naive"): 0.1,
+                                                            ("fixed:30", "implicit-euler"): 0.01})
+    assert "✕" not in bars.axes[0].get_title(loc="left") and "hatched" not in bars.axes[0].get_title(loc="left")
+    failed = figures.draw_deviation_figure("chain", "end z", {("fixed:30", "naive"): math.inf,
+                                                              ("fixed:30", "implicit-euler"): 0.01},
+                                           {("fixed:30", "naive"): "blow-up", ("fixed:30", "implicit-euler"): "ok"})
+    assert "the run failed" in failed.axes[0].get_title(loc="left")
