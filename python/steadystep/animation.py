@@ -94,7 +94,9 @@ def section(data: dict) -> str:
         svg_panels.append(
             f"<g transform='translate({x0},0)'><rect width='{width}' height='{height + 24}' fill='#fafafa' "
             f"stroke='#ccc'/><text x='8' y='{height + 17}' font-size='13'>{html.escape(panel['policy'] + status)}"
-            f"</text><polyline class='chain' data-panel='{i}' fill='none' stroke='#333' stroke-width='4' "
+            f"</text>" + ("" if i == 0 else f"<polyline class='ghost' data-panel='{i}' fill='none' stroke='#bbb' "
+                                       f"stroke-width='4' stroke-linejoin='round' points=''/>")
+            + f"<polyline class='chain' data-panel='{i}' fill='none' stroke='#333' stroke-width='4' "
             f"stroke-linejoin='round' points=''/><circle class='tip' data-panel='{i}' r='5' fill='#d62728'/></g>")
     total_width = len(panels) * (width + 10)
     script = _SCRIPT.replace("__DATA__", json.dumps(data, separators=(",", ":"), allow_nan=False))
@@ -108,7 +110,8 @@ def section(data: dict) -> str:
             f"<figcaption><button id='animation-toggle' type='button'>pause</button> "
             f"t = <span id='animation-time'>0.00</span> s of {data['duration_s']:g} s (looping). Each panel shows the "
             f"last frame its run rendered: the reference every 1/60 s of its 1 ms steps, naive and implicit-euler "
-            f"at their {html.escape(data['profile'])} frames (profile seed {data['seed']}).</figcaption>"
+            f"at their {html.escape(data['profile'])} frames (profile seed {data['seed']}); in grey behind them, "
+            f"the reference at the same time.</figcaption>"
             f"</figure><script>{script}</script>")
 
 
@@ -120,6 +123,7 @@ _SCRIPT = """
   const figure = document.getElementById('animation-player');
   const lines = figure.querySelectorAll('polyline.chain');
   const tips = figure.querySelectorAll('circle.tip');
+  const ghosts = figure.querySelectorAll('polyline.ghost');
   const clock = document.getElementById('animation-time');
   let tick = 0, playing = true;
   function shown(times, t) {
@@ -127,12 +131,20 @@ _SCRIPT = """
     while (lo < hi) { const mid = (lo + hi + 1) >> 1; if (times[mid] <= t) lo = mid; else hi = mid - 1; }
     return lo;
   }
+  function place(pts) {
+    return pts.map(function (p) { return [pad + (p[0] - lowX) * scale, pad + (highZ - p[1]) * scale]; });
+  }
+  function text(xy) {
+    return xy.map(function (p) { return p[0].toFixed(1) + ',' + p[1].toFixed(1); }).join(' ');
+  }
   function draw() {
     const t = (tick / hz) % data.duration_s;
+    const reference = data.panels[0];
+    const ghost = text(place(reference.points[shown(reference.t, t)]));
+    ghosts.forEach(function (line) { line.setAttribute('points', ghost); });
     data.panels.forEach(function (panel, i) {
-      const pts = panel.points[shown(panel.t, t)];
-      const xy = pts.map(function (p) { return [pad + (p[0] - lowX) * scale, pad + (highZ - p[1]) * scale]; });
-      lines[i].setAttribute('points', xy.map(function (p) { return p[0].toFixed(1) + ',' + p[1].toFixed(1); }).join(' '));
+      const xy = place(panel.points[shown(panel.t, t)]);
+      lines[i].setAttribute('points', text(xy));
       const tip = xy[xy.length - 1];
       tips[i].setAttribute('cx', tip[0].toFixed(1));
       tips[i].setAttribute('cy', tip[1].toFixed(1));
