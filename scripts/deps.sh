@@ -12,6 +12,7 @@ command -v pkg-config >/dev/null || missing+=(pkg-config)
 pkg-config --exists ode 2>/dev/null || missing+=(libode-dev)
 [ -f /usr/include/gtest/gtest.h ] || missing+=(libgtest-dev)
 python3 -c 'import ensurepip, venv' 2>/dev/null || missing+=(python3-venv)
+command -v chromium >/dev/null || [ "${0##*/}" = report ] || missing+=(chromium)  # tests/python/test_page.py
 # Fuzzing (scripts/fuzz, run by the full scripts/test that CI runs): clang and its libFuzzer runtime.
 if [ "${STEADYSTEP_NEED_FUZZ:-0}" = 1 ]; then
   command -v clang >/dev/null || missing+=(clang)

@@ -36,6 +36,7 @@ struct ssRun {
   char message[256];
   int out_of_memory;
   int too_many_steps; /* a step past SS_MAX_RUN_STEPS was not recorded */
+  ssSceneCounters counters;
 };
 
 void ssRun_Destroy(ssRun* run) {
@@ -179,6 +180,7 @@ ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
     ssScene_Sample(scene, run->initial);
     ssScene_SetStepObserver(scene, record, run);
     status = play(run, scene, profile, def->duration_s);
+    run->counters = ssScene_Counters(scene);
   }
   ssScene_Destroy(scene);
   ssProfile_Destroy(profile);
@@ -214,3 +216,6 @@ ssStatus ssRun_Status(const ssRun* run) { return null_run(run, "a status") ? SS_
 ssRunOutcome ssRun_Outcome(const ssRun* run) { return null_run(run, "an outcome") ? SS_RUN_NONE : run->outcome; }
 double ssRun_BoundUse(const ssRun* run) { return null_run(run, "a bound use") ? NAN : run->bound_use; }
 const char* ssRun_Message(const ssRun* run) { return null_run(run, "a message") ? "" : run->message; }
+ssSceneCounters ssRun_Counters(const ssRun* run) {
+  return null_run(run, "counters") ? (ssSceneCounters){0} : run->counters;
+}

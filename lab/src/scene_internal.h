@@ -42,6 +42,9 @@ typedef struct ssSceneDesc {
    * means one is left; NaN values must not count, a blow-up is the stepper's to report) and writes into worst one
    * line naming the bound, the body or joint and the value that reached it. May be NULL: no bounds. */
   double (*check)(const void* state, char* worst, size_t size);
+  /* The scene's drawing (ssScene_Points): writes at most capacity points (x y z) and returns how many it has.
+   * May be NULL (no drawing). */
+  int (*points)(const void* state, double* xyz, int capacity);
   /* Frees the state (ODE objects go with the world). */
   void (*destroy)(void* state);
 } ssSceneDesc;

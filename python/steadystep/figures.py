@@ -16,6 +16,7 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from steadystep import article, runs
 from steadystep._native import SteadystepError, number, printable
@@ -30,6 +31,8 @@ POLICY_COLORS = {
     "matched": "#8c6d31",  # brown
     "exact": "#17becf",    # cyan
     "fixed": "#636363",    # grey
+    "fixed-matched": "#d6616b",  # rose
+    "fixed-exact": "#31a354",    # green
 }
 REFERENCE_COLOR = "#000000"
 EXACT_COLOR = "#1f5fbf"      # the article's blue
@@ -131,58 +134,120 @@ def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> lis
     return save(figure, out_dir, "article_figure")
 
 
-@_styled
+# Profiles told apart by line style and marker, policies by panel and colour.
+PROFILE_STYLES = (("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"), ((0, (5, 1, 1, 1)), "v"), ((0, (1, 3)), "P"))
+MARKS_PER_CURVE = 12
+
+
+def profile_style(index: int) -> tuple:
+    return PROFILE_STYLES[index % len(PROFILE_STYLES)]
+
+
+def _off_scale(t: np.ndarray, y: np.ndarray, low: float, high: float):
+    """The first sample outside [low, high] (or not finite) as (t, edge value, 'above' or 'below'), else None."""
+    outside = ~np.isfinite(y) | (y < low) | (y > high)
+    if not np.any(outside):
+        return None
+    i = int(np.argmax(outside))
+    above = not np.isfinite(y[i]) or y[i] > high
+    return float(t[i]), high if above else low, "above" if above else "below"
+
+
+def _draw_run(ax, t, y, color, style, low, high, failed: bool) -> dict:
+    """One run's curve, clipped to the axes; marks where it leaves them (triangle at the edge) and where a failed
+    run ends (a cross). Returns which marks were drawn."""
+    drawn = {"off": False, "failed": False}
+    linestyle, marker = style
+    shown = np.clip(np.where(np.isfinite(y), y, np.nan), low, high)
+    ax.plot(t, shown, color=color, ls=linestyle, lw=1.2, marker=marker, ms=3.5,
+            markevery=max(1, len(t) // MARKS_PER_CURVE))
+    exit_point = _off_scale(t, y, low, high)
+    if exit_point is not None:
+        when, edge, side = exit_point
+        ax.plot([when], [edge], marker="^" if side == "above" else "v", ms=9, color=color, mec="black", mew=0.8,
+                ls="none", zorder=5, clip_on=False)
+        drawn["off"] = True
+    if failed and len(t):
+        finite = np.isfinite(y)
+        last = int(np.nonzero(finite)[0][-1]) if np.any(finite) else 0
+        ax.plot([t[last]], [float(np.clip(y[last], low, high)) if finite[last] else high], marker="X", ms=10,
+                color=color, mec="black", mew=0.9, ls="none", zorder=6, clip_on=False)
+        drawn["failed"] = True
+    return drawn
+
+
 def scene_figure(scene: str, quantity: str, unit: str, reference, results, out_dir: Path,
                  exact_curve=None) -> list[Path]:
-    """One panel per profile: the quantity over time for each policy, over the reference (and exact solution).
+    """draw_scene_figure saved as out_dir/scene_<scene>_<quantity>.png and .svg."""
+    figure = draw_scene_figure(scene, quantity, unit, reference, results, exact_curve)
+    return save(figure, out_dir, f"scene_{scene}_{quantity}".replace(" ", "_"))
+
+
+@_styled
+def draw_scene_figure(scene: str, quantity: str, unit: str, reference, results, exact_curve=None) -> Figure:
+    """Small multiples: one panel per policy, the quantity over time under every profile (line style and marker per
+    profile, the policy's colour), over the reference (and the exact solution). Runs that leave the shared axes are
+    marked where they leave (a triangle on the edge), failed runs where they end (a cross).
 
     results: {(profile, policy): RunResult}; reference: RunResult; exact_curve: (t, y) or None.
     """
     profiles = list(dict.fromkeys(profile for profile, _ in results))
     policies = list(dict.fromkeys(policy for _, policy in results))
-    columns = min(3, len(profiles))
-    rows = (len(profiles) + columns - 1) // columns
-    figure = Figure(figsize=(4.6 * columns, 3.1 * rows + 0.8), constrained_layout=True)
+    columns = min(4, len(policies))
+    rows = (len(policies) + columns - 1) // columns
+    figure = Figure(figsize=(4.2 * columns, 2.8 * rows + 1.0), constrained_layout=True)
     axes = figure.subplots(rows, columns, squeeze=False, sharex=True, sharey=True)
     low, high = _limits(reference.quantities[quantity],
                         [r.quantities[quantity] for r in results.values() if r.step_count])
-    for index, profile in enumerate(profiles):
+    marks = {"off": False, "failed": False}
+    for index, policy in enumerate(policies):
         ax = axes[index // columns][index % columns]
         if exact_curve is not None:
-            ax.plot(*exact_curve, color=EXACT_COLOR, lw=2.4, alpha=0.6, label="exact solution")
-        ax.plot(reference.times, reference.quantities[quantity], color=REFERENCE_COLOR, lw=1.0, ls="--",
-                label="reference (1/1000 s)")
-        for policy in policies:
+            ax.plot(*exact_curve, color=EXACT_COLOR, lw=3.0, alpha=0.35)
+        ax.plot(reference.times, reference.quantities[quantity], color=REFERENCE_COLOR, lw=1.0, ls=(0, (2, 2)),
+                alpha=0.8)
+        failures = []
+        for j, profile in enumerate(profiles):
             result = results.get((profile, policy))
             if result is None or result.step_count == 0:
                 continue
-            label = policy + (" (blew up)" if result.blew_up else " (broken)" if result.broken else "")
-            # The article's method drawn on top: it is what the figure is about.
-            on_top = policy == "implicit-euler"
-            ax.plot(result.times, result.quantities[quantity], color=policy_color(policy), lw=1.5 if on_top else 1.1,
-                    zorder=3 if on_top else 2, label=label)
-        ax.set_title(_label(profile), loc="left", fontsize=10)
+            drawn = _draw_run(ax, result.times, result.quantities[quantity], policy_color(policy), profile_style(j),
+                              low, high, result.status != "ok")
+            marks = {k: marks[k] or drawn[k] for k in marks}
+            if result.status != "ok":
+                failures.append(f"{_label(profile)}: {result.status}")
+        ax.set_title(policy + ("\n" + "; ".join(failures) if failures else ""), loc="left", fontsize=10,
+                     color=policy_color(policy) if not failures else "#b00000")
         ax.set_ylim(low, high)
         if index % columns == 0:
             ax.set_ylabel(f"{quantity} ({unit})" if unit else quantity)
-        if index // columns == rows - 1 or index + columns >= len(profiles):
+        if index // columns == rows - 1 or index + columns >= len(policies):
             ax.set_xlabel("time (s)")
             ax.tick_params(labelbottom=True)
-    for index in range(len(profiles), rows * columns):
+    for index in range(len(policies), rows * columns):
         axes[index // columns][index % columns].set_visible(False)
-    handles, labels = axes[0][0].get_legend_handles_labels()
-    seen = dict(zip(labels, handles))
-    for ax in axes.flat:
-        for handle, label in zip(*ax.get_legend_handles_labels()):
-            seen.setdefault(label, handle)
-    figure.legend(seen.values(), seen.keys(), loc="outside lower center", ncol=min(7, len(seen)))
-    figure.suptitle(f"{scene}: {quantity} under each frame-time profile", fontsize=11)
-    return save(figure, out_dir, f"scene_{scene}_{quantity}".replace(" ", "_"))
+    # The legend says what is drawn and nothing else.
+    handles = [Line2D([], [], color=REFERENCE_COLOR, lw=1.0, ls=(0, (2, 2)), label="reference (1/1000 s)")]
+    if exact_curve is not None:
+        handles.append(Line2D([], [], color=EXACT_COLOR, lw=3.0, alpha=0.35, label="exact solution"))
+    for j, profile in enumerate(profiles):
+        linestyle, marker = profile_style(j)
+        handles.append(Line2D([], [], color="#555555", ls=linestyle, marker=marker, ms=4, label=_label(profile)))
+    if marks["off"]:
+        handles.append(Line2D([], [], color="#555555", marker="^", mec="black", ls="none", ms=8,
+                              label="leaves the axes here"))
+    if marks["failed"]:
+        handles.append(Line2D([], [], color="#555555", marker="X", mec="black", ls="none", ms=9,
+                              label="run failed here (blew up / broke)"))
+    figure.legend(handles=handles, loc="outside lower center", ncol=min(5, len(handles)))
+    figure.suptitle(f"{scene}: {quantity}, one panel per policy (colour), one line style per frame-time profile",
+                    fontsize=11)
+    return figure
 
 
 def _limits(reference: np.ndarray, others: list[np.ndarray]) -> tuple[float, float]:
     """The y range: every curve's, but at most the reference's range widened by its span on each side, so that a
-    run gone wild does not flatten every other curve."""
+    run gone wild does not flatten every other curve (where one leaves this range, it is marked)."""
     finite = reference[np.isfinite(reference)]
     low, high = (float(finite.min()), float(finite.max())) if len(finite) else (-1.0, 1.0)
     span = high - low if high > low else max(abs(high), 1e-3)
@@ -193,39 +258,57 @@ def _limits(reference: np.ndarray, others: list[np.ndarray]) -> tuple[float, flo
     return low - margin, high + margin
 
 
-@_styled
-def deviation_figure(scene: str, quantity: str, deviations: dict, out_dir: Path) -> list[Path]:
-    """Grouped bars: the deviation per profile (groups) and policy (colours), on a log scale.
+HATCHES = ("", "//", "..", "\\\\", "oo", "--", "++")
 
-    deviations: {(profile, policy): value}; inf (a blow-up) is drawn as a hatched bar at the top."""
+
+def deviation_figure(scene: str, quantity: str, deviations: dict, out_dir: Path,
+                     statuses: dict | None = None) -> list[Path]:
+    """draw_deviation_figure saved as out_dir/deviation_<scene>.png and .svg."""
+    return save(draw_deviation_figure(scene, quantity, deviations, statuses), out_dir, f"deviation_{scene}")
+
+
+@_styled
+def draw_deviation_figure(scene: str, quantity: str, deviations: dict, statuses: dict | None = None) -> Figure:
+    """Grouped bars: the deviation per profile (groups) and policy (colour and hatch), on a log scale.
+
+    deviations: {(profile, policy): value}; statuses: {(profile, policy): status}. A failed run (inf, or a status
+    other than "ok") is drawn as a bar to the top, crossed out and labelled with its status; the legend mentions
+    failures only when there are some."""
+    statuses = statuses or {}
     profiles = list(dict.fromkeys(profile for profile, _ in deviations))
     policies = list(dict.fromkeys(policy for _, policy in deviations))
-    finite = [v for v in deviations.values() if np.isfinite(v) and v > 0]
+    finite = [v for k, v in deviations.items() if np.isfinite(v) and v > 0 and statuses.get(k, "ok") == "ok"]
     top = max(finite) * 3 if finite else 1.0
     bottom = min(finite) / 3 if finite else 1e-6
-    figure = Figure(figsize=(max(6.0, 1.3 * len(profiles) * max(1, len(policies)) / 2.5 + 2), 3.8),
+    figure = Figure(figsize=(min(16.0, max(9.0, 0.3 * len(profiles) * max(1, len(policies)) + 2.5)), 4.4),
                     constrained_layout=True)
     ax = figure.subplots()
     width = 0.8 / max(1, len(policies))
+    any_failed = False
     for j, policy in enumerate(policies):
-        positions, heights, hatched = [], [], []
+        positions, heights, failed = [], [], []
         for i, profile in enumerate(profiles):
             value = deviations.get((profile, policy))
             if value is None:
                 continue
+            bad = not np.isfinite(value) or statuses.get((profile, policy), "ok") != "ok"
             positions.append(i + (j - (len(policies) - 1) / 2) * width)
-            heights.append(value if np.isfinite(value) else top)
-            hatched.append(not np.isfinite(value))
-        bars = ax.bar(positions, heights, width, color=policy_color(policy), label=policy)
-        for bar, blown in zip(bars, hatched):
-            if blown:
-                bar.set_hatch("xx")
-                bar.set_edgecolor("white")
+            heights.append(top if bad else max(value, bottom))
+            failed.append(statuses.get((profile, policy), "blew up") if bad else None)
+        bars = ax.bar(positions, heights, width, color=policy_color(policy), hatch=HATCHES[j % len(HATCHES)],
+                      edgecolor="white", linewidth=0.4, label=policy)
+        for bar, status in zip(bars, failed):
+            if status:
+                any_failed = True
+                bar.set_alpha(0.35)
+                ax.text(bar.get_x() + bar.get_width() / 2, top, "✕", ha="center", va="bottom", fontsize=9,
+                        color="#b00000")
     ax.set_yscale("log")
-    ax.set_ylim(bottom, top * 1.5)
+    ax.set_ylim(bottom, top * 2.0)
     ax.set_xticks(range(len(profiles)), [_label(profile) for profile in profiles])
     ax.set_ylabel("RMS deviation / amplitude")
     ax.set_title(f"{scene}: deviation of {quantity} from the reference run, by profile and policy"
-                 " (hatched: blew up)", loc="left", fontsize=10)
-    ax.legend(ncol=len(policies), loc="upper left", fontsize=8)
-    return save(figure, out_dir, f"deviation_{scene}")
+                 + (" (✕, faded to the top: the run failed)" if any_failed else ""), loc="left", fontsize=10)
+    figure.legend(*ax.get_legend_handles_labels(), ncol=min(7, len(policies)), loc="outside lower center",
+                  fontsize=8)
+    return figure

@@ -1,10 +1,12 @@
 """The comparison: scenes x frame-time profiles x policies on real ODE, measured against a reference run, written
-as an HTML report (report.html, figures embedded and also beside it), metrics.json and metrics.csv."""
+as an HTML report (report.html, figures embedded and also beside it), metrics.json and metrics.csv (their
+schema: docs/metrics.md)."""
 
 from __future__ import annotations
 
 import base64
 import csv
+import dataclasses
 import html
 import io
 import json
@@ -17,14 +19,14 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from steadystep import article, figures, metrics, probe, runs
+from steadystep import animation, article, cost, figures, metrics, page, probe, runs
+from steadystep.consistency import consistency
 from steadystep._native import SteadystepError, number, printable
 from steadystep.files import atomic_write_text
 from steadystep.limits import MIN_MEASURED_DURATION_S
 from steadystep.profiles import DEFAULT_PROFILES, Profile, seed_value
 
-DEFAULT_POLICIES = ("naive", "implicit-euler", "fixed")
-OSCILLATOR_POLICIES = ("naive", "implicit-euler", "matched", "exact", "fixed")
+# Every scene runs every policy the library names (runs.policy_names()) unless told otherwise.
 SIDE_BY_SIDE_PROFILES = ("fixed:30", "uniform:15:45")
 # Quantities that are settings, not motion: they are plotted by `run`, never measured against a reference.
 # The pile is there for timing; the report keeps it small so that the whole report takes a few minutes.
@@ -46,6 +48,8 @@ class Row:
     wall_us_per_step: float
     status: str
     rms_vs_exact: float | None = None
+    rows_fallback: int = 0           # matched/exact rows the implicit-Euler mapping served (ssRun_Counters)
+    contacts_fallback: int = 0       # matched/exact contacts the implicit-Euler mapping served
 
 
 @dataclass
@@ -62,13 +66,17 @@ class Report:
     params: dict[str, dict] = field(default_factory=dict)
     figures: dict[str, list[Path]] = field(default_factory=dict)
     elapsed_s: float = 0.0
+    consistency: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)  # scene -> policy -> quantity
+    costs: list[cost.Cost] = field(default_factory=list)   # one per scene and policy, from one benchmark run
+    cost_wall_s: float = 0.0                                # the benchmark's wall time (s)
+    animation: dict | None = None                           # animation.record(): the chain to watch
 
 
 def policies_for(scene: str, policies) -> list[str]:
-    """The policies a scene runs: the given ones, or the defaults (all five for the oscillator)."""
+    """The policies a scene runs: the given ones, or every policy the library names (runs.policy_names())."""
     if policies:
         return list(policies)
-    return list(OSCILLATOR_POLICIES if scene == "oscillator" else DEFAULT_POLICIES)
+    return runs.policy_names()
 
 
 def validate(scenes, profiles, policies, duration_s: float = 5.0, seed: int = 1) -> list[str]:
@@ -112,13 +120,18 @@ def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: f
                 for s in scenes)
     oscillator = "oscillator" in scenes
     if oscillator:
-        total += len(SIDE_BY_SIDE_PROFILES) * len(OSCILLATOR_POLICIES)
+        total += len(SIDE_BY_SIDE_PROFILES) * len(runs.policy_names())
     bar = tqdm(total=total, desc="steadystep compare", unit="run", disable=None if progress is None else not progress)
     try:
         for scene in scenes:
             _compare_scene(report, scene, params.get(scene), bar, figure_dir)
         if oscillator:
             _side_by_side(report, params.get("oscillator"), bar)
+        bar.set_postfix_str("cost against plain ODE")
+        report.costs, report.cost_wall_s = cost.measure_all(scenes, report.policies, params=params, seed=seed)
+        if animation.SCENE in scenes:
+            bar.set_postfix_str("animation")
+            report.animation = animation.record(duration_s, seed, params.get(animation.SCENE))
     finally:
         bar.close()
     report.elapsed_s = time.perf_counter() - started
@@ -144,11 +157,16 @@ def _compare_scene(report: Report, scene: str, scene_params: dict | None, bar, f
                 metrics.steps_per_frame(result.step_count, result.frame_count),
                 metrics.steps_per_second(result.step_count, result.simulated_s),
                 1e6 * result.wall_s / result.step_count if result.step_count else math.nan,
-                result.status, _rms_vs_exact(result) if scene == "oscillator" else None))
+                result.status, _rms_vs_exact(result) if scene == "oscillator" else None,
+                result.counters.get("rows_implicit_euler_fallback", 0),
+                result.counters.get("contacts_implicit_euler_fallback", 0)))
     report.spreads[scene] = {
         policy: {q: metrics.spread(row.deviations[q] for row in report.rows
                                    if row.scene == scene and row.policy == policy) for q in quantities}
         for policy in report.policies[scene]}
+    report.consistency[scene] = {
+        policy: {q: consistency({pr: r for (pr, po), r in results.items() if po == policy}, reference, q)
+                 for q in quantities} for policy in report.policies[scene]}
     if scene not in NOT_PROBED:
         report.probes[scene] = []
         for policy in report.policies[scene]:
@@ -163,7 +181,8 @@ def _compare_scene(report: Report, scene: str, scene_params: dict | None, bar, f
                                           exact_curve if q == "x" else None)
         deviations = {(row.profile, row.policy): row.deviations[quantities[0]]
                       for row in report.rows if row.scene == scene}
-        paths += figures.deviation_figure(scene, quantities[0], deviations, figure_dir)
+        paths += figures.deviation_figure(scene, quantities[0], deviations, figure_dir,
+                                          {(r.profile, r.policy): r.status for r in report.rows if r.scene == scene})
         report.figures[scene] = paths
 
 
@@ -194,7 +213,7 @@ def _rms_vs_exact(result: runs.RunResult) -> float:
 def _side_by_side(report: Report, params: dict | None, bar) -> None:
     """Issue 4's table: the oscillator at 30 fps and 15-45 fps under every policy, against the exact solution."""
     for profile in SIDE_BY_SIDE_PROFILES:
-        for policy in OSCILLATOR_POLICIES:
+        for policy in runs.policy_names():
             bar.set_postfix_str(f"oscillator {profile} {policy} vs exact")
             result = runs.run("oscillator", profile, policy, report.duration_s, report.seed, params=params)
             bar.update()
@@ -250,31 +269,44 @@ def _finite_json(value):
 
 
 def _as_json(report: Report, command: str) -> dict:
+    """metrics.json; its schema is docs/metrics.md."""
     return {
         "command": command, "duration_s": report.duration_s, "seed": report.seed, "profiles": report.profiles,
         "policies": report.policies, "params": report.params, "elapsed_s": report.elapsed_s,
         "rows": [{"scene": r.scene, "profile": r.profile, "policy": r.policy, "status": r.status,
                   "deviation": dict(r.deviations),
                   "steps_per_frame": r.steps_per_frame, "steps_per_second": r.steps_per_second,
-                  "wall_us_per_step": r.wall_us_per_step, "rms_vs_exact": r.rms_vs_exact}
+                  "rms_vs_exact": r.rms_vs_exact, "rows_implicit_euler_fallback": r.rows_fallback,
+                  "contacts_implicit_euler_fallback": r.contacts_fallback}
                  for r in report.rows],
         "spread": report.spreads,
+        "consistency": report.consistency,
         "oscillator_side_by_side": report.side_by_side,
         "largest_stable_step": {s: [{"policy": r.policy, "stable_s": r.stable_s,
                                      "unstable_s": r.unstable_s, "reason": r.reason}
                                     for r in results] for s, results in report.probes.items()},
+        "cost": {"wall_s": report.cost_wall_s,
+                 "runs": [dataclasses.asdict(c) for c in report.costs]},
     }
 
 
+CSV_COLUMNS = ("scene", "profile", "policy", "quantity", "deviation_per_amplitude", "quantity_unit",
+               "rms_vs_exact_per_x0", "steps_per_frame", "steps_per_s", "rows_implicit_euler_fallback",
+               "contacts_implicit_euler_fallback", "status")
+
+
 def _as_csv(report: Report) -> str:
+    """metrics.csv: one line per run and motion quantity; columns CSV_COLUMNS, documented in docs/metrics.md."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(["scene", "profile", "policy", "quantity", "deviation", "steps_per_frame", "steps_per_second",
-                     "wall_us_per_step", "status"])
+    writer.writerow(CSV_COLUMNS)
     for r in report.rows:
+        units = dict(zip(runs.scene_info(r.scene).quantities, runs.scene_info(r.scene).units))
         for q, v in r.deviations.items():
-            writer.writerow([r.scene, r.profile, r.policy, q, f"{v:.6g}", f"{r.steps_per_frame:.6g}",
-                             f"{r.steps_per_second:.6g}", f"{r.wall_us_per_step:.6g}", r.status])
+            exact = "" if r.rms_vs_exact is None else f"{r.rms_vs_exact:.6g}"
+            writer.writerow([r.scene, r.profile, r.policy, q, f"{v:.6g}", units.get(q, ""), exact,
+                             f"{r.steps_per_frame:.6g}", f"{r.steps_per_second:.6g}", r.rows_fallback,
+                             r.contacts_fallback, r.status])
     return buffer.getvalue()
 
 
@@ -282,14 +314,27 @@ def _number(value, digits: int = 3) -> str:
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "-"
     if isinstance(value, float) and math.isinf(value):
-        return "blew up"
+        return "failed"
     return f"{value:.{digits}g}"
 
 
-def _table(header: list[str], rows: list[list[str]]) -> str:
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
+def _cell(value, status: str = "ok", digits: int = 3) -> str:
+    """A number, or the run's status when the run failed (blew up, ran away, broke)."""
+    if status != "ok":
+        return f"<span class=bad>{html.escape(status)}</span>"
+    return _number(value, digits)
+
+
+def _status(status: str) -> str:
+    """A run's status: ok, or what went wrong (blow-up, speed limit, broken) in red: a failure either way."""
+    return "ok" if status == "ok" else f"<span class=bad>{html.escape(status)}</span>"
+
+
+def _table(header: list[str], rows: list[list[str]], anchor: str | None = None) -> str:
+    head = "".join(f"<th>{h}</th>" for h in header)
     body = "".join("<tr>" + "".join(f"<td>{cell}</td>" for cell in row) + "</tr>" for row in rows)
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    where = f" id='{html.escape(anchor)}'" if anchor else ""
+    return f"<table{where}><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
 
 
 def _policy_cell(policy: str) -> str:
@@ -297,27 +342,114 @@ def _policy_cell(policy: str) -> str:
     return f'<span class="dot" style="background:{color}"></span>{html.escape(policy)}'
 
 
-def _embed(path: Path) -> str:
+def _embed(path: Path, anchor: str | None = None) -> str:
     data = base64.b64encode(Path(path).read_bytes()).decode()
-    return f'<img src="data:image/png;base64,{data}" alt="{html.escape(Path(path).name)}">'
+    where = f" id='{html.escape(anchor)}'" if anchor else ""
+    return f'<img{where} src="data:image/png;base64,{data}" alt="{html.escape(Path(path).name)}">'
+
+
+def _all_policies(report: Report) -> list[str]:
+    return list(dict.fromkeys(p for s in report.scenes for p in report.policies[s]))
+
+
+def _by_scene(report: Report, values: dict, anchor: str, what: str, zero: float = 0.0) -> str:
+    """A scene x policy table of values[scene][policy][first motion quantity], the smallest of a row in bold."""
+    policies = _all_policies(report)
+    rows = []
+    for scene in report.scenes:
+        if scene not in values:
+            continue
+        quantity = runs.motion_quantities(scene)[0]
+        cells = {p: values[scene][p][quantity] for p in report.policies[scene] if p in values[scene]}
+        # At or below zero the numbers are rounding: shown as 0, all of them the best.
+        cells = {p: 0.0 if v is not None and math.isfinite(v) and v <= zero else v for p, v in cells.items()}
+        finite = [v for v in cells.values() if math.isfinite(v)]
+        best = min(finite) if finite else None
+        row = [f"<a href='#{html.escape(scene)}'>{html.escape(scene)}</a>", html.escape(quantity)]
+        for p in policies:
+            text = _number(cells.get(p))
+            row.append(f"<b>{text}</b>" if best is not None and cells.get(p) == best else text)
+        rows.append(row)
+    return _table(["scene", "quantity"] + [_policy_cell(p) for p in policies], rows, anchor) + (
+        f"<p class=small>{what} Bold: the smallest of the row; failed: a run of that policy blew up or broke.</p>")
+
+
+def _cost_table(report: Report) -> str:
+    rows = []
+    for c in report.costs:
+        ok = c.status == "ok"
+        rows.append([html.escape(c.scene), _policy_cell(c.policy),
+                     f"×{_number(c.ratio_median)}" if ok else f"<span class=bad>{html.escape(c.status)}</span>",
+                     f"{_number(c.ratio_low)} – {_number(c.ratio_high)}" if ok else "-",
+                     _number(c.us_per_frame), _number(c.plain_us_per_frame), _number(c.steps_per_frame),
+                     f"×{_number(c.ratio_median / c.steps_per_frame)}" if ok and c.steps_per_frame else "-"])
+    profile = report.costs[0].profile if report.costs else "-"
+    repeats = report.costs[0].repeats if report.costs else 0
+    return (_table(["scene", "policy", "wall time / plain ODE (median)", "range over repeats", "µs / frame",
+                    "plain ODE µs / frame", "steps / frame", "per step / plain"], rows, "cost")
+            + f"<p class=small>One benchmark run of {report.cost_wall_s:.1f} s: each policy and plain ODE on the same "
+            f"scene with the same {html.escape(profile)} frames, in {repeats} alternating blocks (order rotating); "
+            "the ratio is taken per block pair, its median and range shown. Plain ODE: collide, one dWorldQuickStep "
+            "of the whole frame, softness as tuned once for 30 fps (what a program without the library does). "
+            "The timing loop runs in C (ssScene_TimeFrames).</p>")
+
+
+def _stable_table(report: Report) -> str:
+    policies = _all_policies(report)
+    rows = []
+    for scene, results in report.probes.items():
+        by_policy = {r.policy: r for r in results}
+        cells = [html.escape(scene)]
+        for p in policies:
+            r = by_policy.get(p)
+            if r is None:
+                cells.append("-")
+            elif not math.isfinite(r.unstable_s):
+                cells.append(f"≥ {_number(1000 * r.stable_s, 4)}")
+            else:
+                cells.append(f"<span title='{html.escape(r.reason or '')}'>{_number(1000 * r.stable_s, 4)}</span>")
+        rows.append(cells)
+    return (_table(["scene"] + [_policy_cell(p) for p in policies], rows, "stable")
+            + "<p class=small>The longest step (ms) at which each scene stays stable: every frame one step of h "
+            "(max_step_s = fixed_step_s = h), 3 s; stable: no blow-up and every motion quantity within the "
+            "reference's range widened by that range on both sides. Bisection in log h between 1 and 250 ms "
+            "(≥ 250: stable at the top). Hover a number for the first failure above it.</p>")
 
 
 def _as_html(report: Report, command: str, article_paths: list[Path]) -> str:
-    parts = ["<h1>steadystep: constraint softness under variable frame times</h1>",
-             "<p>Every run is real ODE 0.16 (libode from Debian) stepped by libsteadystep. Deviation: RMS of the "
-             "followed quantity minus the reference run (the same scene at a fixed 1/1000 s step, the article's "
-             "mapping), divided by the reference's amplitude (max &minus; min). Spread: RMS over the profiles of "
-             "that deviation, per policy: the smaller, the less the motion depends on the frame rate.</p>",
-             _summary(report)]
+    parts = ["<h1>steadystep: which constraint-softness policy, under variable frame times</h1>",
+             "<p>Every run is real ODE 0.16 (libode from Debian) stepped by libsteadystep: each scene under each "
+             f"frame-time profile ({html.escape(', '.join(report.profiles))}) and each policy, for "
+             f"{report.duration_s:g} s, against a reference run (the same scene at a fixed 1/1000 s step, the "
+             "article's mapping).</p>",
+             page.recommendation(report)]
+    if report.animation:
+        parts += ["<h2 id='animation'>Watch: the chain at 15-45 fps</h2>", animation.section(report.animation)]
+    parts += ["<h2>Frame-rate consistency</h2>",
+              _by_scene(report, report.consistency, "consistency",
+                        "Consistency: each run's followed quantity minus the mean over the profiles of the same "
+                        "policy, RMS over profiles and time, divided by the reference's amplitude (max − min): 0 "
+                        "when the motion is the same at every frame rate (shown 0 at or below "
+                        f"{page.IDENTICAL:g}: rounding).", zero=page.IDENTICAL),
+              "<h2>Deviation from the fine-step reference</h2>",
+              _by_scene(report, report.spreads, "deviation",
+                        "RMS over the profiles of each run's deviation: RMS of the followed quantity minus the "
+                        "reference run, divided by the reference's amplitude (max − min).")]
+    if report.side_by_side:
+        parts += ["<h2>Oscillator against the exact solution</h2>", _side_by_side_table(report)]
+    if report.costs:
+        parts += ["<h2>Cost against plain ODE</h2>", _cost_table(report)]
+    if report.probes:
+        parts += ["<h2>Largest stable step</h2>", _stable_table(report)]
     pngs = [p for p in article_paths if p.suffix == ".png"]
     if pngs:
         parts += ["<h2>The article's figure</h2>",
                   "<p>Top: the article's equations 4 and 5. Bottom: real ODE with the article's mapping, one step per "
                   "frame (policy implicit-euler, max_step_s = 1/15 s).</p>", _embed(pngs[0])]
-    if report.side_by_side:
-        parts += ["<h2>Oscillator against the exact solution</h2>", _side_by_side_table(report)]
+    parts.append("<section id='runs'><h2>Every scene, every run</h2>")
     for scene in report.scenes:
         parts += _scene_section(report, scene)
+    parts.append("</section>")
     parts += ["<h2>Parameters</h2>", _parameters(report),
               "<h2>Regenerate</h2>", f"<pre>{html.escape(command)}</pre>",
               f"<p class=small>Made in {report.elapsed_s:.1f} s on {html.escape(platform.node())} "
@@ -325,59 +457,39 @@ def _as_html(report: Report, command: str, article_paths: list[Path]) -> str:
     return _PAGE.format(body="\n".join(parts))
 
 
-def _summary(report: Report) -> str:
-    rows = []
-    for scene in report.scenes:
-        quantity = runs.motion_quantities(scene)[0]
-        spreads = report.spreads[scene]
-        cells = [html.escape(scene), html.escape(quantity)]
-        for policy in ("naive", "implicit-euler", "fixed"):
-            cells.append(_number(spreads[policy][quantity]) if policy in spreads else "-")
-        naive, spring = spreads.get("naive", {}).get(quantity), spreads.get("implicit-euler", {}).get(quantity)
-        cells.append(_number(spring / naive) if naive and spring is not None and math.isfinite(naive) else "-")
-        rows.append(cells)
-    return "<h2>Summary: spread across profiles</h2>" + _table(
-        ["scene", "quantity", "naive", "implicit-euler", "fixed", "implicit-euler / naive"], rows)
-
-
 def _side_by_side_table(report: Report) -> str:
     rows = []
     for e in report.side_by_side:
-        decay, omega = e["decay_rate_per_s"], e["angular_frequency_rad_s"]
-        rows.append([html.escape(e["profile"]), _policy_cell(e["policy"]), _number(e["rms_vs_exact"]),
+        decay, omega, status = e["decay_rate_per_s"], e["angular_frequency_rad_s"], e["status"]
+        rows.append([html.escape(e["profile"]), _policy_cell(e["policy"]), _cell(e["rms_vs_exact"], status),
                      _number(decay, 4), _number(e["true_decay_rate_per_s"], 4),
-                     _number(omega, 5), _number(e["true_angular_frequency_rad_s"], 5), html.escape(e["status"])])
+                     _number(omega, 5), _number(e["true_angular_frequency_rad_s"], 5), _status(status)])
     return _table(["profile", "policy", "RMS vs exact / x0", "fitted decay (1/s)", "true decay (1/s)",
-                   "fitted ω (rad/s)", "true ω (rad/s)", "status"], rows)
+                   "fitted ω (rad/s)", "true ω (rad/s)", "status"], rows, "exact")
 
 
 def _scene_section(report: Report, scene: str) -> list[str]:
     quantities = runs.motion_quantities(scene)
     info = runs.scene_info(scene)
-    parts = [f"<h2 id='{html.escape(scene)}'>{html.escape(scene)}</h2>", f"<p>{html.escape(info.description)}</p>"]
-    spread_rows = [[_policy_cell(p)] + [_number(report.spreads[scene][p][q]) for q in quantities]
-                   for p in report.policies[scene]]
-    parts += ["<h3>Spread across profiles</h3>", _table(["policy"] + [f"spread of {q}" for q in quantities],
-                                                       spread_rows)]
-    header = (["profile", "policy"] + [f"deviation of {q}" for q in quantities]
+    units = dict(zip(info.quantities, info.units))
+    parts = [f"<h3 id='{html.escape(scene)}'>{html.escape(scene)}</h3>", f"<p>{html.escape(info.description)}</p>"]
+    header = (["profile", "policy"] + [f"deviation of {html.escape(q)}" for q in quantities]
               + (["RMS vs exact / x0"] if scene == "oscillator" else [])
-              + ["steps / frame", "steps / s", "wall µs / step", "status"])
+              + ["steps / frame", "rows served by implicit Euler", "contacts served by implicit Euler", "status"])
     rows = []
     for r in (r for r in report.rows if r.scene == scene):
-        rows.append([html.escape(r.profile), _policy_cell(r.policy)] + [_number(r.deviations[q]) for q in quantities]
-                    + ([_number(r.rms_vs_exact)] if scene == "oscillator" else [])
-                    + [_number(r.steps_per_frame), _number(r.steps_per_second, 4), _number(r.wall_us_per_step),
-                       html.escape(r.status)])
-    parts += ["<h3>Every run</h3>", _table(header, rows)]
-    if scene in report.probes:
-        probe_rows = [[_policy_cell(r.policy), _number(1000 * r.stable_s, 4),
-                       _number(1000 * r.unstable_s, 4) if math.isfinite(r.unstable_s) else "none up to 250",
-                       html.escape(r.reason or "-")] for r in report.probes[scene]]
-        parts += ["<h3>Largest stable step</h3>",
-                  "<p>Every frame one step of h (max_step_s = fixed_step_s = h), 3 s; stable: no blow-up and every "
-                  "motion quantity within the reference's range widened by that range on both sides. Bisection in "
-                  "log h between 1 and 250 ms.</p>",
-                  _table(["policy", "stable up to (ms)", "unstable at (ms)", "first failure there"], probe_rows)]
+        fallback = r.policy in _ACCURATE
+        rows.append([html.escape(r.profile), _policy_cell(r.policy)]
+                    + [_cell(r.deviations[q], r.status) for q in quantities]
+                    + ([_cell(r.rms_vs_exact, r.status)] if scene == "oscillator" else [])
+                    + [_number(r.steps_per_frame), str(r.rows_fallback) if fallback else "-",
+                       str(r.contacts_fallback) if fallback else "-",
+                       _status(r.status)])
+    parts += [_table(header, rows, f"runs-{scene}"),
+              "<p class=small>Rows (contacts) served by implicit Euler: of a matched or exact policy, the joint rows "
+              "(contacts) that the accurate mapping could not serve at that step (near-rigid rows above the step's "
+              "Nyquist frequency, undamped rows...), summed over the run's steps; - for policies that use implicit "
+              f"Euler throughout. Units: {html.escape(', '.join(f'{q} in {units[q]}' for q in quantities))}.</p>"]
     parts += [_embed(p) for p in report.figures.get(scene, []) if p.suffix == ".png"]
     return parts
 
@@ -392,16 +504,24 @@ def _parameters(report: Report) -> str:
     return general + _table(["scene", "parameters"], rows)
 
 
+# Policies whose mapping is matched or exact: their rows can fall back to implicit Euler.
+_ACCURATE = frozenset({"matched", "exact", "fixed-matched", "fixed-exact"})
+
 _PAGE = """<!doctype html>
 <html lang="en"><head><meta charset="utf-8"><title>steadystep report</title>
 <style>
 body {{ font-family: system-ui, sans-serif; max-width: 1400px; margin: 2em auto; padding: 0 1em; color: #222; }}
-table {{ border-collapse: collapse; margin: 0.5em 0 1.5em; font-size: 0.9em; }}
+table {{ border-collapse: collapse; margin: 0.5em 0 0.5em; font-size: 0.9em; }}
 th, td {{ border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: right; }}
 th {{ background: #f3f3f3; }} td:first-child, td:nth-child(2) {{ text-align: left; }}
+#policies td {{ text-align: left; }}
 img {{ max-width: 100%; display: block; margin: 0.5em 0 1.5em; }}
 .dot {{ display: inline-block; width: 0.7em; height: 0.7em; border-radius: 50%; margin-right: 0.4em; }}
-pre {{ background: #f6f6f6; padding: 0.6em; }} .small {{ color: #777; font-size: 0.85em; }}
+.bad {{ color: #b00; font-weight: bold; }}
+#recommendation {{ background: #f4f8ff; border: 1px solid #c9d8f0; padding: 0.3em 1em 1em; }}
+.answers li {{ margin: 0.35em 0; }}
+pre {{ background: #f6f6f6; padding: 0.6em; }} .small {{ color: #666; font-size: 0.85em; margin-bottom: 1.5em; }}
+figure {{ margin: 0.5em 0 1.5em; }}
 </style></head><body>
 {body}
 </body></html>

@@ -173,6 +173,9 @@ class RunResult:
     initial: dict[str, float] = field(default_factory=dict)  # the quantities before the first step (t = 0)
     bound_use: float = 0.0             # the largest value/bound ratio of the scene's sanity bounds (> 1: broken)
     extra: dict = field(default_factory=dict)
+    # ssRun_Counters: frames, steps, rows_written, rows_implicit_euler_fallback, rows_exact_fallback,
+    # contacts_softened, contacts_implicit_euler_fallback (summed over the run)
+    counters: dict = field(default_factory=dict)
 
     @property
     def step_count(self) -> int:
@@ -284,7 +287,7 @@ def _collect(handle, scene, profile, policy, seed, duration_s, params, stepping)
         wall_s=float(lib.ssRun_WallSeconds(handle)),
         status=status_name, message=text(lib.ssRun_Message(handle)) or "",
         initial={name: float(initial[i]) for i, name in enumerate(info.quantities)},
-        bound_use=float(lib.ssRun_BoundUse(handle)))
+        bound_use=float(lib.ssRun_BoundUse(handle)), counters=_as_dict(lib.ssRun_Counters(handle)))
 
 
 def reference_run(scene: str, duration_s: float = 5.0, params: dict | None = None) -> RunResult:
@@ -337,6 +340,29 @@ class Scene:
     def bound_use(self) -> float:
         """The largest value/bound ratio of the scene's sanity bounds over the steps so far (above 1: broken)."""
         return lib.ssScene_BoundUse(self._handle())
+
+    def counters(self) -> dict[str, int]:
+        """What the scene's stepper did so far (ssScene_Counters): frames, steps, rows written, and the rows and
+        contacts an accurate mapping could not serve (served by implicit Euler)."""
+        return _as_dict(lib.ssScene_Counters(self._handle()))
+
+    def points(self) -> np.ndarray:
+        """The scene's drawing now (ssScene_Points): an (n, 3) array of polyline points in m; (0, 3) when the scene
+        has none (only the chain has one)."""
+        count = lib.ssScene_Points(self._handle(), ffi.NULL, 0)
+        xyz = ffi.new("double[]", max(1, 3 * count))
+        lib.ssScene_Points(self._handle(), xyz, count)
+        return np.frombuffer(ffi.buffer(xyz, 3 * count * ffi.sizeof("double")), dtype=np.float64).reshape(count, 3).copy()
+
+    def time_frames(self, frames_s, plain: bool = False) -> float:
+        """Steps the frames (s each) and returns the wall-clock seconds they took (ssScene_TimeFrames): through the
+        stepper, or plain (one dWorldQuickStep a frame, softness as last written; needs one frame() first). Raises
+        SteadystepError named by the library (a bad frame, a plain frame before any frame(), a blow-up)."""
+        frames = np.ascontiguousarray(frames_s, dtype=np.float64)
+        wall = ffi.new("double*")
+        check(lib.ssScene_TimeFrames(self._handle(), ffi.cast("const double*", ffi.from_buffer(frames)),
+                                     len(frames), int(bool(plain)), wall))
+        return wall[0]
 
     def close(self) -> None:
         """Destroys the scene and its ODE world now rather than at garbage collection."""

@@ -108,6 +108,19 @@ static double check(const void* state, char* worst, size_t size) {
   snprintf(worst, size, "hinge %d: anchors %.6g m apart, bound %g m (%g of a %g m link)", widest, widest_m, bound_m,
            CHAIN_MAX_GAP_OF_LINK, CHAIN_LINK_M);
   return widest_m / bound_m;
+/* The pivot, then the far end of each link: the chain as a polyline. */
+static int points(const void* state, double* xyz, int capacity) {
+  const Chain* chain = state;
+  for (int i = 0; i <= chain->count && i < capacity; ++i) {
+    dVector3 point;
+    if (i == 0) {
+      dBodyGetRelPointPos(chain->links[0], -0.5 * CHAIN_LINK_M, 0, 0, point);
+    } else {
+      dBodyGetRelPointPos(chain->links[i - 1], 0.5 * CHAIN_LINK_M, 0, 0, point);
+    }
+    for (int k = 0; k < 3; ++k) xyz[3 * i + k] = point[k];
+  }
+  return chain->count + 1;
 }
 
 const ssSceneDesc ssChainScene = {
@@ -122,5 +135,6 @@ const ssSceneDesc ssChainScene = {
     .build = build,
     .sample = sample,
     .check = check,
+    .points = points,
     .destroy = destroy,
 };

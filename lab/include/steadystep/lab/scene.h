@@ -148,6 +148,37 @@ SS_LAB_API const char* ssScene_Broken(const ssScene* scene);
  *  physics step so far (0 before the first step; above 1 once broken). A correct run stays well below 1; the tests
  *  measure how far. scene = NULL: NaN, and records "scene = NULL: ..." for ssLastError(). */
 SS_LAB_API double ssScene_BoundUse(const ssScene* scene);
+/** What the scene's stepper did since the scene was built, summed over every frame (ssFrameReport): the rows it
+ *  wrote and the rows and contacts an accurate mapping (matched, exact) could not serve, which the implicit-Euler
+ *  mapping served instead (stepper.h, registry.h). */
+typedef struct ssSceneCounters {
+  int64_t frames;                            /* frames stepped with ssScene_Frame */
+  int64_t steps;                             /* physics steps they took */
+  int64_t rows_written;                      /* joint parameter sets written (plus 1 a step for a bound world) */
+  int64_t rows_implicit_euler_fallback;      /* matched/exact rows served by implicit Euler */
+  int64_t rows_exact_fallback;               /* exact rows served by matched */
+  int64_t contacts_softened;                 /* contacts softened for their step */
+  int64_t contacts_implicit_euler_fallback;  /* of those, contacts served by implicit Euler */
+} ssSceneCounters;
+
+/** The scene's counters. scene = NULL: all zero, and records "scene = NULL: ..." for ssLastError(). */
+SS_LAB_API ssSceneCounters ssScene_Counters(const ssScene* scene);
+
+/** The scene's drawing: the points of a polyline in world coordinates (m, x y z each), e.g. the chain's pivot then
+ *  the far end of each link. Writes at most capacity points into xyz (3 doubles each) and returns how many the
+ *  scene has (call with capacity 0 to ask); 0 for a scene that has no drawing (only the chain has one), and for
+ *  scene = NULL, capacity < 0 or xyz = NULL with capacity > 0, which record why for ssLastError(). */
+SS_LAB_API int ssScene_Points(const ssScene* scene, double* xyz, int capacity);
+
+/** Steps count frames of frames_s[i] seconds and writes the wall-clock seconds they took to *wall_s: through the
+ *  scene's stepper (plain = 0, as ssScene_Frame), or (plain = 1) as a program without the library steps, for the
+ *  cost benchmark: collide, one dWorldQuickStep (or dWorldStep, per the stepping's solver) of the whole frame and
+ *  empty the contacts, with every softness left as the stepper last wrote it (contacts softened as for the
+ *  stepper's last step). A plain frame needs one ssScene_Frame first, so that every softness has been written.
+ *  Errors: SS_ERROR_OUT_OF_RANGE (scene, frames_s or wall_s NULL, count < 0, plain not 0 or 1, a plain frame
+ *  before any ssScene_Frame, a frame outside [SS_MIN_STEP_S, SS_MAX_STEP_S] when plain); SS_ERROR_BLOWUP when a
+ *  plain frame leaves a followed quantity not finite (the frames after it are not stepped); those of ssScene_Frame. */
+SS_LAB_API ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, int count, int plain, double* wall_s);
 
 /** A run: a scene under a profile for duration_s, one record after every physics step. */
 typedef struct ssRunDef {
@@ -201,6 +232,9 @@ SS_LAB_API const double* ssRun_Initial(const ssRun* run);
 /** Frames rendered, and the wall-clock seconds the stepping took (scene building excluded). */
 SS_LAB_API int ssRun_FrameCount(const ssRun* run);
 SS_LAB_API double ssRun_WallSeconds(const ssRun* run);
+
+/** The scene's counters at the end of the run (ssScene_Counters); all zero for run = NULL. */
+SS_LAB_API ssSceneCounters ssRun_Counters(const ssRun* run);
 
 /** SS_OK (completed or broken), or the blow-up status that ended the run early. */
 SS_LAB_API ssStatus ssRun_Status(const ssRun* run);

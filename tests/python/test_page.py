@@ -1,0 +1,138 @@
+"""The report's page in a real browser (Debian's headless Chromium), and its recommendation against its own numbers.
+
+The page is made once for the module from a small comparison (the chain, two profiles, two policies, 1 s), written
+with report.write, and opened as a file: the animation must render and move, every link of the recommendation must
+land on something, and the recommendation must name what metrics.json, read independently here, says is best.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+import os
+import re
+import shutil
+import statistics
+import subprocess
+
+import numpy as np
+import pytest
+
+from steadystep import report
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+needs_chromium = pytest.mark.skipif(CHROMIUM is None and not os.environ.get("CI"),
+                                    reason="chromium not installed (scripts/deps.sh installs it; required in CI)")
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    out = tmp_path_factory.mktemp("page")
+    made = report.compare(["chain"], ["fixed:30", "uniform:15:45"], ["naive", "implicit-euler"], duration_s=1.0,
+                          seed=2, progress=False, figure_dir=out)
+    path = report.write(made, out, "steadystep compare --scenes chain")
+    return path, json.loads((out / "metrics.json").read_text())
+
+
+def _chromium(*args: str, tmp_path) -> subprocess.CompletedProcess:
+    assert CHROMIUM is not None, "CI needs chromium (scripts/deps.sh installs it)"
+    command = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+               f"--user-data-dir={tmp_path / 'profile'}", *args]
+    return subprocess.run(command, capture_output=True, text=True, timeout=180)
+
+
+def _section(page: str, need: str) -> str:
+    match = re.search(r"<li><b>" + re.escape(need) + r":</b>(.*?)</li>", page, re.S)
+    assert match, need
+    return match.group(1)
+
+
+def test_every_link_lands_and_nothing_is_fetched(written):
+    page = written[0].read_text()
+    targets = set(re.findall(r"href='#([^']+)'", page))
+    assert {"consistency", "deviation", "cost", "stable", "runs"} <= targets
+    ids = set(re.findall(r"id='([^']+)'", page)) | set(re.findall(r'id="([^"]+)"', page))
+    assert targets <= ids, targets - ids
+    assert not re.search(r"""(src|href)=["']?(https?:)?//""", page), "the page must be self-contained"
+
+
+def test_the_recommendation_names_the_best_by_the_numbers_on_the_page(written):
+    page, metrics = written[0].read_text(), written[1]
+    consistency = metrics["consistency"]["chain"]
+    values = {p: v["end x"] for p, v in consistency.items()}
+    best = min(values, key=lambda p: math.inf if values[p] is None else values[p])
+    assert f"<b>{best}</b>" in _section(page, "Same motion at every frame rate")
+    deviation = {p: v["end x"] for p, v in metrics["spread"]["chain"].items()}
+    assert f"<b>{min(deviation, key=deviation.get)}</b>" in _section(page, "Closest to the fine-step reference")
+    ratios = {}
+    for entry in metrics["cost"]["runs"]:
+        ratios.setdefault(entry["policy"], []).append(entry["ratio_median"])
+    cheapest_text = _section(page, "Cheapest")
+    for policy, values in ratios.items():
+        assert html.escape(policy) + f" ×{statistics.median(values):.3g}" in cheapest_text
+    stable = {e["policy"]: e["stable_s"] for e in metrics["largest_stable_step"]["chain"]}
+    longest = max(stable.values())
+    stable_text = _section(page, "Largest stable step")
+    assert f"{1000 * longest:.3g} ms" in stable_text
+    for policy, value in stable.items():
+        assert (f"<b>{policy}</b>" in stable_text) == (value == longest)
+
+
+def test_the_csv_columns_have_no_spaces(written):
+    header = (written[0].parent / "metrics.csv").read_text().splitlines()[0].split(",")
+    assert header == list(report.CSV_COLUMNS) and not any(" " in name for name in header)
+
+
+@needs_chromium
+def test_the_animation_renders_and_moves(written, tmp_path):
+    url = written[0].resolve().as_uri()
+    dom = _chromium("--virtual-time-budget=2000", "--dump-dom", url, tmp_path=tmp_path).stdout
+    frame = re.search(r'id="animation-player" data-frame="(\d+)"', dom)
+    assert frame and int(frame.group(1)) >= 30, dom[:300]
+    lines = re.findall(r'<polyline class="chain" data-panel="\d" [^>]*points="([^"]*)"', dom)
+    assert len(lines) == 3 and all(len(points.split()) == 9 for points in lines), lines  # pivot + 8 links
+
+    import matplotlib.image
+
+    shots = []
+    for budget in (300, 1500):
+        shot = tmp_path / f"shot_{budget}.png"
+        _chromium(f"--virtual-time-budget={budget}", f"--screenshot={shot}", "--window-size=1400,2200", url,
+                  tmp_path=tmp_path)
+        shots.append(matplotlib.image.imread(shot))
+    assert shots[0].shape == shots[1].shape
+    changed = np.any(np.abs(shots[0] - shots[1]) > 0.05, axis=-1)
+    rows = np.nonzero(changed.any(axis=1))[0]
+    assert changed.sum() > 200, changed.sum()
+    # Only the animation moves: the changed pixels lie in one band of the page, not all over it.
+    assert rows.max() - rows.min() < 500, (rows.min(), rows.max())
+
+
+def _legend(figure) -> list[str]:
+    return [text.get_text() for legend in figure.legends for text in legend.get_texts()]
+
+
+def test_a_run_that_leaves_the_axes_is_marked_and_the_legend_says_only_what_is_drawn():
+    from steadystep import figures, runs
+
+    reference = runs.reference_run("chain", 3.0)
+    # Naive under 2 s frames: the chain's end falls tens of metres, far below the reference's range.
+    results = {(profile, policy): runs.run("chain", profile, policy, 3.0)
+               for profile in ("fixed:2", "fixed:30") for policy in ("naive", "implicit-euler")}
+    assert results[("fixed:2", "naive")].quantities["end z"].min() < -10
+    figure = figures.draw_scene_figure("chain", "end z", "m", reference, results)
+    labels = _legend(figure)
+    assert "leaves the axes here" in labels and "fixed:2" in labels and "fixed:30" in labels
+    assert "exact solution" not in labels
+    if all(r.status == "ok" for r in results.values()):
+        assert not any("failed" in label for label in labels)
+    calm = {key: value for key, value in results.items() if key[0] == "fixed:30"}
+    assert "leaves the axes here" not in _legend(figures.draw_scene_figure("chain", "end z", "m", reference, calm))
+    bars = figures.draw_deviation_figure("chain", "end z", {("fixed:30", "naive"): 0.1,
+                                                            ("fixed:30", "implicit-euler"): 0.01})
+    assert "✕" not in bars.axes[0].get_title(loc="left") and "hatched" not in bars.axes[0].get_title(loc="left")
+    failed = figures.draw_deviation_figure("chain", "end z", {("fixed:30", "naive"): math.inf,
+                                                              ("fixed:30", "implicit-euler"): 0.01},
+                                           {("fixed:30", "naive"): "blow-up", ("fixed:30", "implicit-euler"): "ok"})
+    assert "the run failed" in failed.axes[0].get_title(loc="left")

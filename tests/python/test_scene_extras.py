@@ -1,0 +1,80 @@
+"""What the report reads from the lab besides the followed quantities: the stepper's counters, the chain's drawing,
+and frames timed plain or through the stepper (ssScene_Counters, ssScene_Points, ssScene_TimeFrames)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from steadystep import cost, runs
+from steadystep._native import SteadystepError
+from steadystep.profiles import frame_times
+
+
+def test_run_counters_count_the_recorded_steps_and_frames():
+    for policy in runs.policy_names():
+        result = runs.run("chain", "uniform:15:45", policy, 1.0, seed=4)
+        assert result.counters["steps"] == result.step_count, policy
+        assert result.counters["frames"] == result.frame_count, policy
+        if policy in ("naive", "implicit-euler", "fixed"):
+            assert result.counters["rows_implicit_euler_fallback"] == 0, policy
+
+
+def test_the_chain_is_drawn_as_links_of_its_length_hanging_from_the_pivot():
+    scene = runs.Scene("chain", "implicit-euler", params={"body_count": 5})
+    try:
+        start = scene.points()
+        assert start.shape == (6, 3)
+        assert np.allclose(start[0], [0.0, 0.0, 2.5], atol=1e-9)  # the pivot, at the chain's start
+        lowest_tip_z = start[-1, 2]
+        for _ in range(60):
+            scene.frame(1 / 30)
+            lowest_tip_z = min(lowest_tip_z, scene.points()[-1, 2])
+        moved = scene.points()
+        links = np.linalg.norm(np.diff(moved, axis=0), axis=1)
+        assert np.allclose(links, 0.25, rtol=1e-2), links  # rigid links of 0.25 m, the joints' error small
+        assert np.allclose(moved[0], [0.0, 0.0, 2.5], atol=1e-3)  # still pinned
+        assert lowest_tip_z < start[-1, 2] - 0.5  # it swung down
+    finally:
+        scene.close()
+    oscillator = runs.Scene("oscillator")
+    assert oscillator.points().shape == (0, 3)
+    oscillator.close()
+
+
+def test_plain_frames_are_naive_frames_without_the_stepper():
+    # naive writes the same softness (frozen at 1/30 s) before each whole-frame step: stepping the world plain after
+    # its first frame must give the same motion.
+    frames = frame_times("uniform:15:45", 40, 7)
+    stepped, plain = runs.Scene("oscillator", "naive"), runs.Scene("oscillator", "naive")
+    try:
+        stepped.frame(frames[0])
+        plain.frame(frames[0])
+        stepped.time_frames(frames[1:])
+        plain.time_frames(frames[1:], plain=True)
+        assert stepped.time_s == pytest.approx(plain.time_s, rel=1e-12)
+        assert stepped.sample()["x"] == pytest.approx(plain.sample()["x"], rel=1e-9, abs=1e-12)
+        assert plain.counters()["frames"] == 1 and stepped.counters()["frames"] == len(frames)
+    finally:
+        stepped.close()
+        plain.close()
+
+
+def test_plain_frames_are_refused_before_the_first_frame_and_out_of_range():
+    scene = runs.Scene("oscillator", "naive")
+    try:
+        with pytest.raises(SteadystepError, match="plain = 1"):
+            scene.time_frames([1 / 60], plain=True)
+        scene.frame(1 / 60)
+        with pytest.raises(SteadystepError, match=r"frames_s\[1\] = -1"):
+            scene.time_frames([1 / 60, -1.0], plain=True)
+        assert scene.counters()["frames"] == 1 and scene.time_s == pytest.approx(1 / 60)  # nothing stepped
+    finally:
+        scene.close()
+
+
+def test_a_cost_is_a_ratio_in_its_range():
+    measured = cost.measure("chain", "implicit-euler", repeats=3)
+    assert measured.status == "ok"
+    assert measured.ratio_low <= measured.ratio_median <= measured.ratio_high
+    assert measured.steps_per_frame > 1.5  # 15-45 fps frames in substeps of at most 1/60 s
