@@ -108,6 +108,8 @@ static double check(const void* state, char* worst, size_t size) {
   snprintf(worst, size, "hinge %d: anchors %.6g m apart, bound %g m (%g of a %g m link)", widest, widest_m, bound_m,
            CHAIN_MAX_GAP_OF_LINK, CHAIN_LINK_M);
   return widest_m / bound_m;
+}
+
 /* The pivot, then the far end of each link: the chain as a polyline. */
 static int points(const void* state, double* xyz, int capacity) {
   const Chain* chain = state;
