@@ -39,5 +39,6 @@ if [ ! -x "$venv/bin/python" ]; then
   "$venv/bin/pip" install --quiet --upgrade pip
 fi
 "$venv/bin/pip" install --quiet scikit-build-core
-# test: pytest and ode-python (the tests' own ODE worlds); report: matplotlib and tqdm (figures, the report).
-"$venv/bin/pip" install --quiet --no-build-isolation "$repo[test,report]"
+# test: pytest and ode-python (the tests' own ODE worlds); report: matplotlib and tqdm (figures, the report);
+# dask: Dask distributed, so that the tests run studies on a real (local) cluster.
+"$venv/bin/pip" install --quiet --no-build-isolation "$repo[test,report,dask]"

@@ -96,6 +96,11 @@ class SteadystepError(ValueError):
     def __str__(self) -> str:
         return f"{self.message} ({self.status})" if self.message else self.status
 
+    def __reduce__(self):
+        # Pickled by its three fields (the default would call it with the message alone): a study's worker process
+        # hands its refusal back to the caller this way.
+        return type(self), (self.status, self.message, self.code)
+
 
 def _decode(raw: bytes) -> str:
     # C messages are cut at 255 bytes, possibly inside a UTF-8 character, and may quote bytes from a file or an

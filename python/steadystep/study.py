@@ -1,0 +1,226 @@
+"""Studies: independent work units run through any concurrent.futures.Executor, results back in task order.
+
+A study (the report's comparison, the probe, your own sweep) is many runs that do not depend on each other. Each
+unit is a top-level function called with plain data (keyword arguments) that returns plain data or numpy arrays,
+so that it can be pickled to another process or machine. ODE is deterministic within a process (every scene sets
+its own ODE random seed), so a unit gives the same numbers bit for bit wherever it runs; only wall-clock timings
+differ.
+
+Executors by name (``make_executor``):
+
+- ``local``: a process pool over every core this process may use (the default of ``steadystep compare`` and
+  ``probe``);
+- ``serial`` (or ``none``): in this process, one unit after the other (debugging, the one-process measurement);
+- ``dask``: a Dask distributed cluster on this machine, one single-threaded worker process per core, shut down
+  after;
+- ``dask:ADDRESS``: an existing Dask scheduler (``tcp://host:8786``); its workers need steadystep installed.
+
+Dask is optional (``pip install 'steadystep[dask]'``) and imported only when asked for. The local pool starts fresh
+interpreters (spawn, as Dask's workers): a script that uses it must keep its top level under
+``if __name__ == "__main__":``, as with any process pool.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import contextlib
+import itertools
+import os
+from collections.abc import Callable, Iterable, Iterator, Mapping
+
+# How long to wait for an existing Dask scheduler before calling it unreachable (s).
+DASK_CONNECT_TIMEOUT_S = 10
+DASK_EXTRA_HINT = "pip install 'steadystep[dask]'"
+EXECUTOR_NAMES = ("local", "serial", "none", "dask", "dask:ADDRESS")
+
+
+class ExecutorUnavailable(RuntimeError):
+    """An executor that cannot be had: an unknown name, Dask not installed, a scheduler that cannot be reached. The
+    message is one line naming the spec."""
+
+
+class SerialExecutor(concurrent.futures.Executor):
+    """Runs each unit in this process when it is submitted; ``sweep`` runs its units one by one through it."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        future = concurrent.futures.Future()
+        try:
+            result = fn(*args, **kwargs)
+        except BaseException as error:  # handed to whoever reads the future, as a pool would
+            future.set_exception(error)
+        else:
+            future.set_result(result)
+        return future
+
+
+def _quiet_on_interrupt() -> None:
+    """In a pool's worker: Ctrl-C (sent to the whole process group) ends it at once, without a Python traceback;
+    the caller reports the interruption."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def usable_cores() -> int:
+    """The cores this process may run on (its CPU affinity), at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
+
+
+@contextlib.contextmanager
+def make_executor(spec: str = "local") -> Iterator[concurrent.futures.Executor]:
+    """The executor that spec names (see the module's docstring), shut down (and a local Dask cluster closed) when
+    the with-block ends. Raises ExecutorUnavailable for an unknown spec, Dask missing, or a scheduler not reached
+    within DASK_CONNECT_TIMEOUT_S (10 s)."""
+    if not isinstance(spec, str):
+        raise ExecutorUnavailable(f"executor = {spec!r}: must be one of {', '.join(EXECUTOR_NAMES)}")
+    if spec in ("serial", "none"):
+        yield SerialExecutor()
+    elif spec == "local":
+        # spawn: fresh workers that import steadystep themselves, with none of this process's threads or state.
+        import multiprocessing
+
+        pool = concurrent.futures.ProcessPoolExecutor(usable_cores(), multiprocessing.get_context("spawn"),
+                                                      initializer=_quiet_on_interrupt)
+        try:
+            yield pool
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+    elif spec == "dask" or spec.startswith("dask:"):
+        with _dask_executor(spec) as executor:
+            yield executor
+    else:
+        raise ExecutorUnavailable(f"executor = {spec!r}: unknown; use one of {', '.join(EXECUTOR_NAMES)}")
+
+
+@contextlib.contextmanager
+def _dask_executor(spec: str) -> Iterator[concurrent.futures.Executor]:
+    try:
+        import distributed
+    except ImportError:
+        raise ExecutorUnavailable(f"executor = {spec!r}: Dask distributed is not installed: {DASK_EXTRA_HINT}") \
+            from None
+    address = spec[len("dask:"):] if spec.startswith("dask:") else None
+    if address == "":
+        raise ExecutorUnavailable(f"executor = {spec!r}: no scheduler address after 'dask:' (dask:tcp://HOST:PORT)")
+    with contextlib.ExitStack() as stack:
+        if address is None:
+            import logging
+
+            # One single-threaded worker process per core: ODE's random seed is global to a process, so two scenes
+            # must never step in one process at once.
+            cluster = stack.enter_context(distributed.LocalCluster(
+                n_workers=usable_cores(), threads_per_worker=1, processes=True, dashboard_address=None,
+                silence_logs=logging.ERROR))
+            client = stack.enter_context(distributed.Client(cluster))
+        else:
+            try:
+                client = distributed.Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
+            except (OSError, TimeoutError, ValueError) as error:
+                reason = " ".join(str(error).split()) or type(error).__name__
+                raise ExecutorUnavailable(f"executor = {spec!r}: cannot reach the Dask scheduler at {address} "
+                                          f"(waited {DASK_CONNECT_TIMEOUT_S} s): {reason}") from None
+            stack.enter_context(client)
+        executor = client.get_executor()
+        try:
+            yield executor
+        finally:
+            executor.shutdown(wait=False)
+
+
+def grid(**axes: Iterable) -> list[dict]:
+    """Every combination of the axes' values as keyword dicts, the last axis varying fastest:
+    grid(k=[1, 2], c=[0.5]) == [{"k": 1, "c": 0.5}, {"k": 2, "c": 0.5}]. No axes: one empty dict."""
+    names, values = list(axes), [list(v) for v in axes.values()]
+    return [dict(zip(names, combination)) for combination in itertools.product(*values)]
+
+
+def sweep(function: Callable, tasks: Iterable[Mapping], executor: concurrent.futures.Executor | str | None = None,
+          progress: bool | None = None, desc: str = "steadystep sweep", unit: str = "run",
+          label: Callable[[Mapping], str] | None = None) -> list:
+    """function(**task) for every task (a dict of keyword arguments, e.g. from grid), through executor; returns
+    the results in the tasks' order, whatever order they complete in.
+
+    function must be a top-level function, and tasks and results plain data, when the executor is another process
+    (they are pickled). executor: any concurrent.futures.Executor; a name for make_executor ("local", "dask", ...),
+    made and shut down for this call; None: in this process. progress: a tqdm bar on stderr (None: only on a
+    terminal; needs tqdm), updated as units complete, with label(task) of the last one. The first unit to fail
+    cancels those not started and its exception is raised."""
+    tasks = [dict(task) for task in tasks]
+    results = [None] * len(tasks)
+    for index, result in as_completed(function, tasks, executor, progress, desc, unit, label):
+        results[index] = result
+    return results
+
+
+def as_completed(function: Callable, tasks: Iterable[Mapping],
+                 executor: concurrent.futures.Executor | str | None = None, progress: bool | None = None,
+                 desc: str = "steadystep sweep", unit: str = "run",
+                 label: Callable[[Mapping], str] | None = None) -> Iterator[tuple[int, object]]:
+    """As sweep, but yields (the task's index, its result) as each unit completes (in this process: in the tasks'
+    order), so that the caller can use a result while the others still run. Leaving the loop early cancels the units
+    not started."""
+    tasks = [dict(task) for task in tasks]
+    if isinstance(executor, str):
+        with make_executor(executor) as made:
+            yield from as_completed(function, tasks, made, progress, desc, unit, label)
+        return
+    with progress_bar(len(tasks), progress, desc, unit) as bar:
+        def done(task):
+            if label is not None:
+                bar.set_postfix_str(label(task), refresh=False)
+            bar.update()
+
+        if executor is None or isinstance(executor, SerialExecutor):
+            for index, task in enumerate(tasks):
+                result = function(**task)
+                done(task)
+                yield index, result
+            return
+        futures = [executor.submit(_apply, function, task) for task in tasks]
+        indices = {future: i for i, future in enumerate(futures)}
+        try:
+            for future in concurrent.futures.as_completed(futures):
+                result = future.result()  # raises the unit's exception at once
+                done(tasks[indices[future]])
+                yield indices[future], result
+        finally:  # a failure, or a caller that stopped early: nothing more is started
+            for future in futures:
+                future.cancel()
+
+
+def _apply(function: Callable, task: dict):
+    """function(**task): the task's names go to function alone, never to an executor's own submit keywords (Dask's
+    key, priority, workers...)."""
+    return function(**task)
+
+
+class _NoBar:
+    def update(self, n: int = 1) -> None:
+        pass
+
+    def set_postfix_str(self, text: str = "", refresh: bool = True) -> None:
+        pass
+
+
+@contextlib.contextmanager
+def progress_bar(total: int, progress: bool | None, desc: str, unit: str = "run"):
+    """A tqdm bar of total units on stderr, closed at the end (progress None: only on a terminal; False, or None
+    without tqdm installed: a bar that shows nothing)."""
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        if progress:
+            raise
+        tqdm = None  # the core package does not need tqdm: no bar unless one is asked for
+    if progress is False or tqdm is None:
+        yield _NoBar()
+        return
+
+    bar = tqdm(total=total, desc=desc, unit=unit, disable=None if progress is None else not progress)
+    try:
+        yield bar
+    finally:
+        bar.close()
