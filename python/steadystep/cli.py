@@ -10,6 +10,7 @@ whole (temporary name, then rename). --json output is strict JSON (no NaN or Inf
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import io
 import json
@@ -85,6 +86,46 @@ def _out_dir(text: str) -> Path:
     return path
 
 
+def _fraction(text: str) -> float:
+    """A number or a fraction such as 1/60."""
+    numerator, slash, denominator = text.partition("/")
+    if not slash:
+        return _float(text)
+    value = _float(numerator) / _nonzero(_float(denominator), text)
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return value
+
+
+def _nonzero(value: float, text: str) -> float:
+    if value == 0:
+        raise argparse.ArgumentTypeError(f"{text!r} divides by zero")
+    return value
+
+
+def _positive_fraction(text: str) -> float:
+    value = _fraction(text)
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be a finite number above 0")
+    return value
+
+
+def _grid_value(text: str) -> float:
+    """A spring's stiffness or damping for a grid: any finite number; the library judges its range."""
+    value = _fraction(text)
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} must be a finite number")
+    return value
+
+
+def _executor_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--executor", default="local", metavar="WHERE",
+                        help="where the independent runs go: local (a process pool over every core, the default), "
+                        "serial (this process), dask (a Dask cluster on this machine) or dask:ADDRESS (an existing "
+                        "Dask scheduler, e.g. dask:tcp://host:8786; needs pip install 'steadystep[dask]'). The "
+                        "results do not depend on it")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from steadystep.profiles import DEFAULT_PROFILES
 
@@ -121,6 +162,15 @@ def build_parser() -> argparse.ArgumentParser:
                          help=f"simulated seconds per run, at least {MIN_MEASURED_DURATION_S:g} (default 5); the "
                          f"reference's 1 ms steps bound it to {MAX_RUN_STEPS / 1000:.0f} s")
     compare.add_argument("--seed", type=_seed, default=1, metavar="N", help="profile seed (default 1)")
+    compare.add_argument("--stiffness", type=_grid_value, nargs="+", metavar="K",
+                         help="a study's grid: the scenes' spring stiffness (N/m), one set of runs per value")
+    compare.add_argument("--damping", type=_grid_value, nargs="+", metavar="C",
+                         help="a study's grid: the scenes' spring damping (N·s/m), one set of runs per value")
+    compare.add_argument("--max-step", type=_positive_fraction, nargs="+", metavar="S",
+                         help="a study's grid: the longest physics step (s, fractions such as 1/60 allowed; the "
+                         "fixed policies step at their own fixed step). Every combination of the grid's values runs, "
+                         "and each row of the report carries its values")
+    _executor_argument(compare)
 
     run = commands.add_parser("run", help="one run of a scene; the trajectory as CSV or JSON",
                               description="Runs SCENE under a frame-time profile and a policy and prints a row for "
@@ -157,6 +207,7 @@ def build_parser() -> argparse.ArgumentParser:
     probe.add_argument("--high", type=_positive_float, default=0.25, metavar="S",
                        help="longest step tried (default 0.25 s)")
     probe.add_argument("--json", action="store_true", help="strict JSON on stdout")
+    _executor_argument(probe)
 
     convert = commands.add_parser("convert", help="springs <-> ERP/CFM <-> frequency and damping ratio",
                                   description="One of: --k K --c C --dt H (spring to ERP/CFM), --erp E --cfm F "
@@ -231,6 +282,18 @@ def _require_report_extra(command: str) -> None:
                           "pip install 'steadystep[report]'")
 
 
+@contextlib.contextmanager
+def _executor(command: str, spec: str):
+    """study.make_executor(spec), refused in one line (exit 2) when it cannot be had."""
+    from steadystep import study
+
+    try:
+        with study.make_executor(spec) as executor:
+            yield executor
+    except study.ExecutorUnavailable as error:
+        raise _UsageError(f"steadystep {command}: {error}") from None
+
+
 def _figure(args, argv) -> int:
     _require_report_extra("figure")
     from steadystep.figures import article_figure
@@ -246,10 +309,14 @@ def _compare(args, argv) -> int:
     from steadystep import report
     from steadystep.figures import article_figure
 
-    report.validate(args.scenes, args.profiles, args.policies, args.duration, args.seed)  # before any directory
-    args.out.mkdir(parents=True, exist_ok=True)
-    result = report.compare(args.scenes, args.profiles, args.policies, args.duration, args.seed,
-                            figure_dir=args.out)
+    grid = {axis: values for axis, values in (("stiffness", args.stiffness), ("damping", args.damping),
+                                              ("max_step_s", args.max_step)) if values}
+    # Everything checked before any directory is made or any worker started.
+    report.validate(args.scenes, args.profiles, args.policies, args.duration, args.seed, grid)
+    with _executor("compare", args.executor) as executor:
+        args.out.mkdir(parents=True, exist_ok=True)
+        result = report.compare(args.scenes, args.profiles, args.policies, args.duration, args.seed,
+                                figure_dir=args.out, executor=executor, grid=grid)
     article_paths = article_figure(args.out, args.duration, args.seed)
     path = report.write(result, args.out, _command_line(argv), article_paths)
     _say(str(path))
@@ -293,8 +360,9 @@ def _probe(args, argv) -> int:
     runs.scene_info(args.scene)
     for policy in args.policies:
         runs.make_stepping(policy)
-    results = [probe.largest_stable_step(args.scene, policy, args.duration, args.low, args.high)
-               for policy in args.policies]
+    with _executor("probe", args.executor) as executor:
+        results = probe.largest_stable_steps(args.scene, args.policies, args.duration, args.low, args.high,
+                                             executor=executor)
     if args.json:
         print(_strict_json("probe", [{"scene": r.scene, "policy": r.policy, "stable_s": r.stable_s,
                                       "unstable_s": r.unstable_s if math.isfinite(r.unstable_s) else None,

@@ -11,7 +11,7 @@ start of the search.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -33,6 +33,7 @@ class ProbeResult:
     unstable_s: float    # the shortest step found unstable (s); inf when high_s is stable
     trials: int
     reason: str          # why unstable_s failed ("blow-up: ...", "x left its range", ""), for the report
+    grid: dict = field(default_factory=dict)  # a study's swept values for this bisection (the report's), {} if none
 
 
 def _trial(scene: str, policy: str, step_s: float, duration_s: float, bounds: dict, params,
@@ -103,3 +104,18 @@ def largest_stable_step(scene: str, policy: str, duration_s: float = 3.0, low_s:
         else:
             stable = middle
     return ProbeResult(scene, policy, stable, unstable, trials, reason)
+
+
+def largest_stable_steps(scene: str, policies, duration_s: float = 3.0, low_s: float = DEFAULT_LOW_S,
+                         high_s: float = DEFAULT_HIGH_S, tolerance: float = 0.02, params: dict | None = None,
+                         executor=None, progress: bool | None = None) -> list[ProbeResult]:
+    """largest_stable_step for each policy, one bisection per policy through executor (any
+    concurrent.futures.Executor, or a name for study.make_executor: "local", "dask", ...; None: in this process),
+    in the policies' order. progress: a tqdm bar on stderr (None: only on a terminal) counting finished policies.
+    The results do not depend on the executor."""
+    from steadystep import study
+
+    tasks = [dict(scene=scene, policy=policy, duration_s=duration_s, low_s=low_s, high_s=high_s,
+                  tolerance=tolerance, params=params) for policy in policies]
+    return study.sweep(largest_stable_step, tasks, executor, progress, f"steadystep probe {scene}", "policy",
+                       lambda task: task["policy"])

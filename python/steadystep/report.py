@@ -17,9 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
-
-from steadystep import animation, article, cost, figures, metrics, page, probe, runs
+from steadystep import animation, article, cost, figures, metrics, page, probe, runs, study
 from steadystep.consistency import consistency
 from steadystep._native import SteadystepError, number, printable
 from steadystep.files import atomic_write_text
@@ -50,6 +48,7 @@ class Row:
     rms_vs_exact: float | None = None
     rows_fallback: int = 0           # matched/exact rows the implicit-Euler mapping served (ssRun_Counters)
     contacts_fallback: int = 0       # matched/exact contacts the implicit-Euler mapping served
+    grid: dict[str, float] = field(default_factory=dict)  # the swept values of this row (GRID_AXES), {} if none
 
 
 @dataclass
@@ -62,7 +61,7 @@ class Report:
     rows: list[Row] = field(default_factory=list)
     spreads: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)  # scene -> policy -> quantity
     side_by_side: list[dict] = field(default_factory=list)
-    probes: dict[str, list[probe.ProbeResult]] = field(default_factory=dict)  # scene -> one per policy
+    probes: dict[str, list[probe.ProbeResult]] = field(default_factory=dict)  # scene -> one per policy (grid point)
     params: dict[str, dict] = field(default_factory=dict)
     figures: dict[str, list[Path]] = field(default_factory=dict)
     elapsed_s: float = 0.0
@@ -79,11 +78,38 @@ def policies_for(scene: str, policies) -> list[str]:
     return runs.policy_names()
 
 
-def validate(scenes, profiles, policies, duration_s: float = 5.0, seed: int = 1) -> list[str]:
+GRID_AXES = {"stiffness": "N/m", "damping": "N·s/m", "max_step_s": "s"}  # what a study may sweep, with units
+GRID_CSV_COLUMNS = {"stiffness": "stiffness_N_per_m", "damping": "damping_N_s_per_m", "max_step_s": "max_step_s"}
+
+
+def _grid_points(grid: dict | None) -> tuple[list[dict], list[dict]]:
+    """The spring points (stiffness x damping) and step points (max_step_s) of a grid, each [{}] when not swept."""
+    grid = grid or {}
+    unknown = set(grid) - set(GRID_AXES)
+    if unknown:
+        raise SteadystepError("out of range", f"grid: no axis {sorted(unknown)[0]!r} (axes: {', '.join(GRID_AXES)})")
+    springs = study.grid(**{axis: grid[axis] for axis in ("stiffness", "damping") if axis in grid})
+    steps = study.grid(**{axis: grid[axis] for axis in ("max_step_s",) if axis in grid})
+    return springs, steps
+
+
+def _with_spring(scene_params: dict | None, point: dict) -> dict | None:
+    """A scene's parameters with a spring point's stiffness and damping (None: the scene's defaults)."""
+    if not point:
+        return scene_params
+    merged = dict(scene_params or {})
+    merged["spring"] = {**merged.get("spring", {}), **point}
+    return merged
+
+
+def validate(scenes, profiles, policies, duration_s: float = 5.0, seed: int = 1, grid: dict | None = None,
+             params: dict | None = None) -> list[str]:
     """Checks every name, spec and number before anything runs or is written; returns the scenes (default: all).
 
     duration_s (s) is at least MIN_MEASURED_DURATION_S (0.1 s), and every run within the bound of limits.py (the
-    reference's 1 ms steps: at most 1000 s). Raises SteadystepError naming the value."""
+    reference's 1 ms steps: at most 1000 s). grid: a list of values per axis of GRID_AXES (stiffness N/m, damping
+    N·s/m, max_step_s s), each non-empty; every spring is checked on each scene by the library. Raises
+    SteadystepError naming the value."""
     scenes = list(scenes) if scenes else [info.name for info in runs.scenes()]
     for scene in scenes:
         runs.scene_info(scene)
@@ -98,92 +124,196 @@ def validate(scenes, profiles, policies, duration_s: float = 5.0, seed: int = 1)
     if not duration_s >= MIN_MEASURED_DURATION_S or not math.isfinite(duration_s):
         raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: must be finite and at least "
                               f"{MIN_MEASURED_DURATION_S:g} s to be measured")
+    for axis, values in (grid or {}).items():
+        if axis in GRID_AXES and not isinstance(values, (list, tuple)):
+            raise SteadystepError("out of range", f"grid.{axis} = {values!r}: must be a list of values")
+        if axis in GRID_AXES and not values:
+            raise SteadystepError("out of range", f"grid.{axis} = []: give at least one value or leave it out")
+        for value in values if axis in GRID_AXES else ():
+            number(f"grid.{axis}", value, GRID_AXES[axis])
+    springs, steps = _grid_points(grid)
+    params = REPORT_PARAMS if params is None else params
+    for scene in scenes:
+        for point in springs if springs != [{}] else ():
+            runs.Scene(scene, params=_with_spring(params.get(scene), point)).close()  # the library checks it
     runs.check_run_size(runs.REFERENCE_PROFILE, duration_s, 1, runs.reference_stepping())
     for policy in sorted({p for scene in scenes for p in policies_for(scene, policies)}):
-        for profile in profiles:
-            runs.check_run_size(profile, duration_s, seed, runs.make_stepping(policy))
+        for step in steps:
+            stepping = runs.make_stepping(policy, **step)
+            for profile in profiles:
+                runs.check_run_size(profile, duration_s, seed, stepping)
     return scenes
 
 
+def _unit(kind: str, **arguments):
+    """One independent piece of the comparison, run wherever the executor puts it: a reference run, a run, one
+    largest-stable-step bisection (sequential inside) or the animation's recording."""
+    return {"reference": runs.reference_run, "run": runs.run, "probe": probe.largest_stable_step,
+            "animation": animation.record}[kind](**arguments)
+
+
+def _label(task: dict) -> str:
+    if task["kind"] == "animation":
+        return "animation"
+    words = [task["scene"], task.get("profile", "reference" if task["kind"] == "reference" else ""),
+             task.get("policy", "")]
+    if task["kind"] == "probe":
+        words[1] = "largest stable step,"
+    return " ".join(w for w in words if w)
+
+
 def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: float = 5.0, seed: int = 1,
-            params: dict | None = None, progress: bool | None = None, figure_dir: Path | None = None) -> Report:
+            params: dict | None = None, progress: bool | None = None, figure_dir: Path | None = None,
+            executor=None, grid: dict | None = None) -> Report:
     """Runs every scene under every profile and policy, plus each scene's reference, and measures them.
 
-    params: per scene changes to its parameters (default REPORT_PARAMS). progress: a tqdm bar (None: only on a
-    terminal). figure_dir: where to draw the figures (None: none drawn)."""
+    params: per scene changes to its parameters (default REPORT_PARAMS). progress: tqdm bars on stderr (None: only
+    on a terminal). figure_dir: where to draw the figures (None: none drawn). executor: where the independent runs,
+    probes and the animation go, any concurrent.futures.Executor or a name for study.make_executor ("local",
+    "dask", ...); None: in this process. The numbers do not depend on it, only the wall times do; the cost
+    benchmark always runs here, alone, after them. grid: values per axis of GRID_AXES (e.g. {"stiffness": [20, 40],
+    "max_step_s": [1/60, 1/30]}): every combination is run, and each row carries its values in Row.grid; a scene's
+    spread and consistency are then the largest over the grid's points, its figures, parameters and the animation
+    those of the first point."""
     started = time.perf_counter()
-    scenes = validate(scenes, profiles, policies, duration_s, seed)
+    scenes = validate(scenes, profiles, policies, duration_s, seed, grid, params)
     seed, duration_s, profiles = seed_value(seed), float(duration_s), list(profiles)
     params = REPORT_PARAMS if params is None else params
     report = Report(scenes, list(profiles), {s: policies_for(s, policies) for s in scenes}, duration_s, seed)
-    total = sum(1 + len(profiles) * len(report.policies[s]) + (0 if s in NOT_PROBED else len(report.policies[s]))
-                for s in scenes)
-    oscillator = "oscillator" in scenes
-    if oscillator:
-        total += len(SIDE_BY_SIDE_PROFILES) * len(runs.policy_names())
-    bar = tqdm(total=total, desc="steadystep compare", unit="run", disable=None if progress is None else not progress)
-    try:
-        for scene in scenes:
-            _compare_scene(report, scene, params.get(scene), bar, figure_dir)
-        if oscillator:
-            _side_by_side(report, params.get("oscillator"), bar)
-        bar.set_postfix_str("cost against plain ODE")
-        report.costs, report.cost_wall_s = cost.measure_all(scenes, report.policies, params=params, seed=seed)
-        if animation.SCENE in scenes:
-            bar.set_postfix_str("animation")
-            report.animation = animation.record(duration_s, seed, params.get(animation.SCENE))
-    finally:
-        bar.close()
+    springs, steps = _grid_points(grid)
+    tasks: dict[tuple, dict] = {}
+    # Submitted longest first (references at 1 ms steps, then bisections), so that no core idles at the end.
+    for scene in scenes:
+        for i, point in enumerate(springs):
+            tasks["reference", scene, i] = dict(kind="reference", scene=scene, duration_s=duration_s,
+                                                params=_with_spring(params.get(scene), point))
+    for scene in (s for s in scenes if s not in NOT_PROBED):
+        for i, point in enumerate(springs):
+            for policy in report.policies[scene]:
+                tasks["probe", scene, i, policy] = dict(kind="probe", scene=scene, policy=policy,
+                                                        params=_with_spring(params.get(scene), point))
+    for scene in scenes:
+        for i, point in enumerate(springs):
+            for j, step in enumerate(steps):
+                for profile in profiles:
+                    for policy in report.policies[scene]:
+                        tasks["run", scene, i, j, profile, policy] = dict(
+                            kind="run", scene=scene, profile=profile, policy=policy, duration_s=duration_s,
+                            seed=seed, params=_with_spring(params.get(scene), point), stepping=step or None)
+    if "oscillator" in scenes:
+        for i, point in enumerate(springs):
+            for profile in SIDE_BY_SIDE_PROFILES:
+                for policy in runs.policy_names():
+                    tasks["side", i, profile, policy] = dict(
+                        kind="run", scene="oscillator", profile=profile, policy=policy, duration_s=duration_s,
+                        seed=seed, params=_with_spring(params.get("oscillator"), point))
+    if animation.SCENE in scenes:
+        tasks["animation", None] = dict(kind="animation", duration_s=duration_s, seed=seed,
+                                        params=_with_spring(params.get(animation.SCENE), springs[0]))
+    keys = list(tasks)
+    waiting = {scene: sum(1 for key in keys if key[1] == scene) for scene in scenes}
+    done, figure_paths = {}, {}
+    for index, result in study.as_completed(_unit, tasks.values(), executor, progress, "steadystep compare",
+                                            "run", _label):
+        done[keys[index]] = result
+        scene = keys[index][1]
+        if scene in waiting:
+            waiting[scene] -= 1
+            if waiting[scene] == 0 and figure_dir is not None:
+                # This process draws a finished scene while the workers run the others.
+                figure_paths[scene] = _scene_figures(report, scene, done, figure_dir)
+    for scene in scenes:
+        _compare_scene(report, scene, done, springs, steps)
+        if figure_dir is not None:
+            report.figures[scene] = figure_paths[scene]
+    if "oscillator" in scenes:
+        for i, point in enumerate(springs):
+            _side_by_side(report, [done["side", i, profile, policy] for profile in SIDE_BY_SIDE_PROFILES
+                                   for policy in runs.policy_names()], point)
+    report.animation = done.get(("animation", None))
+    report.costs, report.cost_wall_s = _costs(report, params, progress)
     report.elapsed_s = time.perf_counter() - started
     return report
 
 
-def _compare_scene(report: Report, scene: str, scene_params: dict | None, bar, figure_dir: Path | None) -> None:
-    bar.set_postfix_str(f"{scene} reference")
-    reference = runs.reference_run(scene, report.duration_s, params=scene_params)
-    bar.update()
-    report.params[scene] = reference.params
-    quantities = runs.motion_quantities(scene)
-    results = {}
-    for profile in report.profiles:
-        for policy in report.policies[scene]:
-            bar.set_postfix_str(f"{scene} {profile} {policy}")
-            result = runs.run(scene, profile, policy, report.duration_s, report.seed, params=scene_params)
+def _costs(report: Report, params: dict, progress: bool | None) -> tuple[list[cost.Cost], float]:
+    """cost.measure_all with a bar: the benchmark runs in this process, once the workers are done, so that its
+    timings are taken on a machine that does nothing else of ours."""
+    pairs = [(scene, policy) for scene in report.scenes for policy in report.policies[scene]]
+    started = time.perf_counter()
+    costs = []
+    with study.progress_bar(len(pairs), progress, "steadystep compare: cost against plain ODE", "run") as bar:
+        for scene, policy in pairs:
+            costs.append(cost.measure(scene, policy, seed=report.seed, params=params.get(scene)))
+            bar.set_postfix_str(f"{scene} {policy}", refresh=False)
             bar.update()
-            results[(profile, policy)] = result
-            deviations = {q: _deviation(result, reference, q) for q in quantities}
-            report.rows.append(Row(
-                scene, profile, policy, deviations,
-                metrics.steps_per_frame(result.step_count, result.frame_count),
-                metrics.steps_per_second(result.step_count, result.simulated_s),
-                1e6 * result.wall_s / result.step_count if result.step_count else math.nan,
-                result.status, _rms_vs_exact(result) if scene == "oscillator" else None,
-                result.counters.get("rows_implicit_euler_fallback", 0),
-                result.counters.get("contacts_implicit_euler_fallback", 0)))
-    report.spreads[scene] = {
-        policy: {q: metrics.spread(row.deviations[q] for row in report.rows
-                                   if row.scene == scene and row.policy == policy) for q in quantities}
-        for policy in report.policies[scene]}
-    report.consistency[scene] = {
-        policy: {q: consistency({pr: r for (pr, po), r in results.items() if po == policy}, reference, q)
-                 for q in quantities} for policy in report.policies[scene]}
+    return costs, time.perf_counter() - started
+
+
+def _compare_scene(report: Report, scene: str, done: dict, springs: list[dict], steps: list[dict]) -> None:
+    """The scene's rows, spreads, consistency and probes from its finished runs (done: by task key)."""
+    report.params[scene] = done["reference", scene, 0].params
+    quantities = runs.motion_quantities(scene)
+    spreads = {policy: {q: [] for q in quantities} for policy in report.policies[scene]}
+    consistencies = {policy: {q: [] for q in quantities} for policy in report.policies[scene]}
+    for i, point in enumerate(springs):
+        reference = done["reference", scene, i]
+        for j, step in enumerate(steps):
+            rows = []
+            for profile in report.profiles:
+                for policy in report.policies[scene]:
+                    result = done["run", scene, i, j, profile, policy]
+                    deviations = {q: _deviation(result, reference, q) for q in quantities}
+                    rows.append(Row(
+                        scene, profile, policy, deviations,
+                        metrics.steps_per_frame(result.step_count, result.frame_count),
+                        metrics.steps_per_second(result.step_count, result.simulated_s),
+                        1e6 * result.wall_s / result.step_count if result.step_count else math.nan,
+                        result.status, _rms_vs_exact(result) if scene == "oscillator" else None,
+                        result.counters.get("rows_implicit_euler_fallback", 0),
+                        result.counters.get("contacts_implicit_euler_fallback", 0),
+                        grid={**point, **step}))
+            for policy in report.policies[scene]:
+                by_profile = {profile: done["run", scene, i, j, profile, policy] for profile in report.profiles}
+                for q in quantities:
+                    spreads[policy][q].append(metrics.spread(r.deviations[q] for r in rows if r.policy == policy))
+                    consistencies[policy][q].append(consistency(by_profile, reference, q))
+            report.rows += rows
+    # One grid point: its numbers; several: the largest, how much the frame rate matters at worst over the grid.
+    report.spreads[scene] = {policy: {q: max(values) for q, values in by_quantity.items()}
+                             for policy, by_quantity in spreads.items()}
+    report.consistency[scene] = {policy: {q: _largest(values) for q, values in by_quantity.items()}
+                                 for policy, by_quantity in consistencies.items()}
     if scene not in NOT_PROBED:
         report.probes[scene] = []
-        for policy in report.policies[scene]:
-            bar.set_postfix_str(f"{scene} largest stable step, {policy}")
-            report.probes[scene].append(probe.largest_stable_step(scene, policy, params=scene_params))
-            bar.update()
-    if figure_dir is not None:
-        exact_curve = _exact_curve(reference.params, report.duration_s) if scene == "oscillator" else None
-        paths = []
-        for q in quantities[:2]:
-            paths += figures.scene_figure(scene, q, reference.units[q], reference, results, figure_dir,
-                                          exact_curve if q == "x" else None)
-        deviations = {(row.profile, row.policy): row.deviations[quantities[0]]
-                      for row in report.rows if row.scene == scene}
-        paths += figures.deviation_figure(scene, quantities[0], deviations, figure_dir,
-                                          {(r.profile, r.policy): r.status for r in report.rows if r.scene == scene})
-        report.figures[scene] = paths
+        for i, point in enumerate(springs):
+            for policy in report.policies[scene]:
+                result = done["probe", scene, i, policy]
+                result.grid = dict(point)
+                report.probes[scene].append(result)
+
+
+def _largest(values: list[float]) -> float:
+    """The largest value, nan when every one is (a consistency of one profile)."""
+    finite_or_inf = [v for v in values if not math.isnan(v)]
+    return max(finite_or_inf) if finite_or_inf else math.nan
+
+
+def _scene_figures(report: Report, scene: str, done: dict, figure_dir: Path) -> list[Path]:
+    """The scene's figures, at the grid's first point, from its finished runs (done: by task key)."""
+    quantities = runs.motion_quantities(scene)
+    reference = done["reference", scene, 0]
+    results = {(profile, policy): done["run", scene, 0, 0, profile, policy]
+               for profile in report.profiles for policy in report.policies[scene]}
+    exact_curve = _exact_curve(reference.params, report.duration_s) if scene == "oscillator" else None
+    paths = []
+    for q in quantities[:2]:
+        paths += figures.scene_figure(scene, q, reference.units[q], reference, results, figure_dir,
+                                      exact_curve if q == "x" else None)
+    deviations = {key: _deviation(result, reference, quantities[0]) for key, result in results.items()}
+    paths += figures.deviation_figure(scene, quantities[0], deviations, figure_dir,
+                                      {key: result.status for key, result in results.items()})
+    return paths
 
 
 def _deviation(result: runs.RunResult, reference: runs.RunResult, quantity: str) -> float:
@@ -210,28 +340,26 @@ def _rms_vs_exact(result: runs.RunResult) -> float:
     return metrics.rms_vs_exact(result.quantities["x"], exact_x, result.params["x0"])
 
 
-def _side_by_side(report: Report, params: dict | None, bar) -> None:
+def _side_by_side(report: Report, results: list[runs.RunResult], point: dict) -> None:
     """Issue 4's table: the oscillator at 30 fps and 15-45 fps under every policy, against the exact solution."""
-    for profile in SIDE_BY_SIDE_PROFILES:
-        for policy in runs.policy_names():
-            bar.set_postfix_str(f"oscillator {profile} {policy} vs exact")
-            result = runs.run("oscillator", profile, policy, report.duration_s, report.seed, params=params)
-            bar.update()
-            osc = _oscillator(result.params)
-            try:
-                true_omega = osc.angular_frequency
-            except SteadystepError:
-                true_omega = math.nan  # damped too strongly to oscillate: the table shows "-"
-            entry = {"profile": profile, "policy": policy, "rms_vs_exact": _rms_vs_exact(result),
-                     "decay_rate_per_s": math.nan, "angular_frequency_rad_s": math.nan,
-                     "true_decay_rate_per_s": osc.decay_rate, "true_angular_frequency_rad_s": true_omega,
-                     "status": result.status}
-            try:
-                entry["decay_rate_per_s"], entry["angular_frequency_rad_s"] = metrics.fit_oscillation(
-                    result.times, result.quantities["x"])
-            except SteadystepError:
-                pass  # nothing oscillates (over-damped or blown up): the table shows "-"
-            report.side_by_side.append(entry)
+    for result in results:
+        osc = _oscillator(result.params)
+        try:
+            true_omega = osc.angular_frequency
+        except SteadystepError:
+            true_omega = math.nan  # damped too strongly to oscillate: the table shows "-"
+        entry = {"profile": result.profile, "policy": result.policy, "rms_vs_exact": _rms_vs_exact(result),
+                 "decay_rate_per_s": math.nan, "angular_frequency_rad_s": math.nan,
+                 "true_decay_rate_per_s": osc.decay_rate, "true_angular_frequency_rad_s": true_omega,
+                 "status": result.status}
+        if point:
+            entry["grid"] = dict(point)
+        try:
+            entry["decay_rate_per_s"], entry["angular_frequency_rad_s"] = metrics.fit_oscillation(
+                result.times, result.quantities["x"])
+        except SteadystepError:
+            pass  # nothing oscillates (over-damped or blown up): the table shows "-"
+        report.side_by_side.append(entry)
 
 
 # ---- writing ------------------------------------------------------------------------------------------------
@@ -277,13 +405,14 @@ def _as_json(report: Report, command: str) -> dict:
                   "deviation": dict(r.deviations),
                   "steps_per_frame": r.steps_per_frame, "steps_per_second": r.steps_per_second,
                   "rms_vs_exact": r.rms_vs_exact, "rows_implicit_euler_fallback": r.rows_fallback,
-                  "contacts_implicit_euler_fallback": r.contacts_fallback}
+                  "contacts_implicit_euler_fallback": r.contacts_fallback, **({"grid": r.grid} if r.grid else {})}
                  for r in report.rows],
         "spread": report.spreads,
         "consistency": report.consistency,
         "oscillator_side_by_side": report.side_by_side,
         "largest_stable_step": {s: [{"policy": r.policy, "stable_s": r.stable_s,
-                                     "unstable_s": r.unstable_s, "reason": r.reason}
+                                     "unstable_s": r.unstable_s, "reason": r.reason,
+                                     **({"grid": r.grid} if r.grid else {})}
                                     for r in results] for s, results in report.probes.items()},
         "cost": {"wall_s": report.cost_wall_s,
                  "runs": [dataclasses.asdict(c) for c in report.costs]},
@@ -299,15 +428,22 @@ def _as_csv(report: Report) -> str:
     """metrics.csv: one line per run and motion quantity; columns CSV_COLUMNS, documented in docs/metrics.md."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(CSV_COLUMNS)
+    swept = _swept_axes(report)  # a study's grid columns (after policy), none without a grid
+    writer.writerow([*CSV_COLUMNS[:3], *(GRID_CSV_COLUMNS[a] for a in swept), *CSV_COLUMNS[3:]])
     for r in report.rows:
         units = dict(zip(runs.scene_info(r.scene).quantities, runs.scene_info(r.scene).units))
         for q, v in r.deviations.items():
             exact = "" if r.rms_vs_exact is None else f"{r.rms_vs_exact:.6g}"
-            writer.writerow([r.scene, r.profile, r.policy, q, f"{v:.6g}", units.get(q, ""), exact,
+            writer.writerow([r.scene, r.profile, r.policy, *(f"{r.grid[a]!r}" for a in swept), q, f"{v:.6g}",
+                             units.get(q, ""), exact,
                              f"{r.steps_per_frame:.6g}", f"{r.steps_per_second:.6g}", r.rows_fallback,
                              r.contacts_fallback, r.status])
     return buffer.getvalue()
+
+
+def _swept_axes(report: Report) -> list[str]:
+    """The grid axes the report's rows carry, in GRID_AXES's order."""
+    return [axis for axis in GRID_AXES if any(axis in r.grid for r in report.rows)]
 
 
 def _number(value, digits: int = 3) -> str:
@@ -398,7 +534,9 @@ def _stable_table(report: Report) -> str:
     policies = _all_policies(report)
     rows = []
     for scene, results in report.probes.items():
-        by_policy = {r.policy: r for r in results}
+        by_policy = {}
+        for r in results:
+            by_policy.setdefault(r.policy, r)  # a study's grid: its first point
         cells = [html.escape(scene)]
         for p in policies:
             r = by_policy.get(p)
@@ -473,13 +611,15 @@ def _scene_section(report: Report, scene: str) -> list[str]:
     info = runs.scene_info(scene)
     units = dict(zip(info.quantities, info.units))
     parts = [f"<h3 id='{html.escape(scene)}'>{html.escape(scene)}</h3>", f"<p>{html.escape(info.description)}</p>"]
-    header = (["profile", "policy"] + [f"deviation of {html.escape(q)}" for q in quantities]
+    swept = _swept_axes(report)
+    header = (["profile", "policy"] + [html.escape(f"{a} ({GRID_AXES[a]})") for a in swept]
+              + [f"deviation of {html.escape(q)}" for q in quantities]
               + (["RMS vs exact / x0"] if scene == "oscillator" else [])
               + ["steps / frame", "rows served by implicit Euler", "contacts served by implicit Euler", "status"])
     rows = []
     for r in (r for r in report.rows if r.scene == scene):
         fallback = r.policy in _ACCURATE
-        rows.append([html.escape(r.profile), _policy_cell(r.policy)]
+        rows.append([html.escape(r.profile), _policy_cell(r.policy)] + [_number(r.grid[a], 6) for a in swept]
                     + [_cell(r.deviations[q], r.status) for q in quantities]
                     + ([_cell(r.rms_vs_exact, r.status)] if scene == "oscillator" else [])
                     + [_number(r.steps_per_frame), str(r.rows_fallback) if fallback else "-",
