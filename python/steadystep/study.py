@@ -53,12 +53,39 @@ class SerialExecutor(concurrent.futures.Executor):
         return future
 
 
-def _quiet_on_interrupt() -> None:
-    """In a pool's worker: Ctrl-C (sent to the whole process group) ends it at once, without a Python traceback;
-    the caller reports the interruption."""
+def _ignore_interrupt() -> None:
+    """In a pool's worker: Ctrl-C, sent to the whole process group, is the caller's to handle (it stops the workers
+    and says so in one line); a worker would only print a traceback."""
     import signal
 
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextlib.contextmanager
+def _workers_ignore_interrupt():
+    """Processes started within ignore Ctrl-C (an ignored signal stays ignored in a child, across exec), so that
+    Dask's workers leave it to this process, which closes the cluster and says so in one line, instead of each
+    printing a traceback. A Ctrl-C during the cluster's start-up (a few seconds) is lost."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield  # only the main thread may change signal handlers, and only it receives Ctrl-C
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if previous is None:  # a handler set outside Python: put the default back
+        previous = signal.default_int_handler
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _stop_workers(pool: concurrent.futures.ProcessPoolExecutor) -> None:
+    """Terminates a process pool's workers now. The pool has no public way before Python 3.14
+    (terminate_workers), hence its _processes."""
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        process.terminate()
 
 
 def usable_cores() -> int:
@@ -83,9 +110,12 @@ def make_executor(spec: str = "local") -> Iterator[concurrent.futures.Executor]:
         import multiprocessing
 
         pool = concurrent.futures.ProcessPoolExecutor(usable_cores(), multiprocessing.get_context("spawn"),
-                                                      initializer=_quiet_on_interrupt)
+                                                      initializer=_ignore_interrupt)
         try:
             yield pool
+        except BaseException:
+            _stop_workers(pool)  # Ctrl-C or a failure: the units still running are not waited for
+            raise
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
     elif spec == "dask" or spec.startswith("dask:"):
@@ -111,9 +141,10 @@ def _dask_executor(spec: str) -> Iterator[concurrent.futures.Executor]:
 
             # One single-threaded worker process per core: ODE's random seed is global to a process, so two scenes
             # must never step in one process at once.
-            cluster = stack.enter_context(distributed.LocalCluster(
-                n_workers=usable_cores(), threads_per_worker=1, processes=True, dashboard_address=None,
-                silence_logs=logging.ERROR))
+            with _workers_ignore_interrupt():
+                cluster = stack.enter_context(distributed.LocalCluster(
+                    n_workers=usable_cores(), threads_per_worker=1, processes=True, dashboard_address=None,
+                    silence_logs=logging.ERROR))
             client = stack.enter_context(distributed.Client(cluster))
         else:
             try:
