@@ -210,22 +210,13 @@ def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: f
     if animation.SCENE in scenes:
         tasks["animation", None] = dict(kind="animation", duration_s=duration_s, seed=seed,
                                         params=_with_spring(params.get(animation.SCENE), springs[0]))
-    keys = list(tasks)
-    waiting = {scene: sum(1 for key in keys if key[1] == scene) for scene in scenes}
-    done, figure_paths = {}, {}
-    for index, result in study.as_completed(_unit, tasks.values(), executor, progress, "steadystep compare",
-                                            "run", _label):
-        done[keys[index]] = result
-        scene = keys[index][1]
-        if scene in waiting:
-            waiting[scene] -= 1
-            if waiting[scene] == 0 and figure_dir is not None:
-                # This process draws a finished scene while the workers run the others.
-                figure_paths[scene] = _scene_figures(report, scene, done, figure_dir)
+    done = dict(zip(tasks, study.sweep(_unit, tasks.values(), executor, progress, "steadystep compare", "run",
+                                       _label)))
     for scene in scenes:
         _compare_scene(report, scene, done, springs, steps)
         if figure_dir is not None:
-            report.figures[scene] = figure_paths[scene]
+            # Drawn here, from the finished runs: the files belong on this machine, not on a worker's.
+            report.figures[scene] = _scene_figures(report, scene, done, figure_dir)
     if "oscillator" in scenes:
         for i, point in enumerate(springs):
             _side_by_side(report, [done["side", i, profile, policy] for profile in SIDE_BY_SIDE_PROFILES
