@@ -165,9 +165,12 @@ CHEAP_TIE = 0.1
 
 def _cost(report) -> str | None:
     by_policy: dict[str, list[float]] = {}
+    overhead: dict[str, list[float]] = {}
     for c in report.costs:
         if _finite(c.ratio_median):
             by_policy.setdefault(c.policy, []).append(c.ratio_median)
+        if _finite(c.overhead_median):
+            overhead.setdefault(c.policy, []).append(c.overhead_median)
     if not by_policy:
         return None
     medians = {p: statistics.median(v) for p, v in by_policy.items()}
@@ -179,10 +182,12 @@ def _cost(report) -> str | None:
     alike = [p for p in accurate if medians[p] <= medians[cheapest] * (1 + CHEAP_TIE)] or [cheapest]
     profile = report.costs[0].profile
     who = " and ".join(f"<b>{html.escape(p)}</b>" for p in alike)
+    library = ", ".join(f"{html.escape(p)} {_x(statistics.median(v))}" for p, v in overhead.items())
     return (f"{who}: the cheapest {'policy' if len(alike) == 1 else f'policies (within {CHEAP_TIE:.0%})'} whose "
-            f"softness follows the step. Wall time per "
-            f"frame against plain ODE under {html.escape(profile)} frames, median over scenes: {text}; the cost is "
-            f"mostly the substeps (steps per frame in the table). " + _link("cost", "cost table"))
+            f"softness follows the step. Wall time per frame against a program's own loop (one plain ODE step a "
+            f"frame) under {html.escape(profile)} frames, median over scenes: {text}. That is the substeps (steps "
+            f"per frame in the table): against plain ODE taking the same steps, the library itself costs "
+            f"{library}. " + _link("cost", "cost table"))
 
 
 def _stable(report) -> str | None:

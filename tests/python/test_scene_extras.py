@@ -3,6 +3,8 @@ and frames timed plain or through the stepper (ssScene_Counters, ssScene_Points,
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -78,3 +80,26 @@ def test_a_cost_is_a_ratio_in_its_range():
     assert measured.status == "ok"
     assert measured.ratio_low <= measured.ratio_median <= measured.ratio_high
     assert measured.steps_per_frame > 1.5  # 15-45 fps frames in substeps of at most 1/60 s
+
+
+@pytest.mark.parametrize("policy", ["naive", "implicit-euler", "exact", "fixed"])
+def test_plain_ode_at_the_same_steps_takes_the_steppers_own_steps(policy):
+    """The cost's plain copy steps what the stepper stepped: as many steps, as long in all, none above the cap."""
+    stepping = runs.make_stepping(policy)
+    counter = runs.Scene("chain", policy)
+    try:
+        frames = cost._frames("uniform:15:45", 60, 3)
+        steps = cost._steps_of(counter, stepping, frames)
+        assert len(steps) == counter.counters()["steps"]
+        assert steps.sum() == pytest.approx(counter.time_s, rel=1e-12)
+        if policy != "naive":
+            assert steps.max() <= stepping["max_step_s"] * (1 + 1e-12)
+    finally:
+        counter.close()
+
+
+def test_a_cost_measures_the_library_against_plain_ode_at_the_same_steps():
+    measured = cost.measure("buggy", "matched", repeats=3)
+    assert measured.status == "ok"
+    assert measured.overhead_low <= measured.overhead_median <= measured.overhead_high
+    assert 0 < measured.overhead_median < math.inf
