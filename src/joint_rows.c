@@ -3,6 +3,7 @@
 #include "joint_rows.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "error.h"
 
@@ -156,46 +157,80 @@ void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double e
   setParam(joint, axis, cfm_param, cfm);
 }
 
-/* d·I⁻¹d for a body's world-frame inertia I = R I_body Rᵀ, solving I_body y = Rᵀd by Cramer's rule. */
-static double inverseInertiaAlong(dBodyID body, const dReal* d) {
+static int isDynamic(dBodyID body) { return body != 0 && !dBodyIsKinematic(body); }
+
+void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
+  /* every field written without memset, whose startup costs more than the rest on the registry's path */
+  out->dynamic = isDynamic(body);
+  if (!out->dynamic) {
+    out->inverse_mass = 0;
+    for (int i = 0; i < 9; ++i) out->inverse_inertia[i] = 0;
+    out->position[0] = out->position[1] = out->position[2] = 0;
+    return;
+  }
   dMass mass;
   dBodyGetMass(body, &mass);
-  const dReal* R = dBodyGetRotation(body); /* rows of 4: R[4*i + j] */
-  double b[3];
-  for (int j = 0; j < 3; ++j) b[j] = R[j] * d[0] + R[4 + j] * d[1] + R[8 + j] * d[2];
-  const dReal* I = mass.I;
+  out->inverse_mass = 1.0 / mass.mass;
+  const dReal* p = dBodyGetPosition(body);
+  out->position[0] = p[0], out->position[1] = p[1], out->position[2] = p[2];
+  /* I_body⁻¹ by its adjugate; a singular or indefinite inertia resists no rotation here (its inverse counts 0) */
+  const dReal* I = mass.I; /* rows of 4 */
   double a00 = I[0], a01 = I[1], a02 = I[2], a10 = I[4], a11 = I[5], a12 = I[6], a20 = I[8], a21 = I[9],
          a22 = I[10];
   double c0 = a11 * a22 - a12 * a21, c1 = a12 * a20 - a10 * a22, c2 = a10 * a21 - a11 * a20;
   double det = a00 * c0 + a01 * c1 + a02 * c2;
-  if (det <= 0) return 0;
-  double y0 = (b[0] * c0 + a01 * (a12 * b[2] - b[1] * a22) + a02 * (b[1] * a21 - a11 * b[2])) / det;
-  double y1 = (a00 * (b[1] * a22 - a12 * b[2]) + b[0] * c1 + a02 * (a10 * b[2] - b[1] * a20)) / det;
-  double y2 = (a00 * (a11 * b[2] - b[1] * a21) + a01 * (b[1] * a20 - a10 * b[2]) + b[0] * c2) / det;
-  return b[0] * y0 + b[1] * y1 + b[2] * y2;
+  if (!(det > 0)) {
+    for (int i = 0; i < 9; ++i) out->inverse_inertia[i] = 0;
+    return;
+  }
+  double inv_det = 1.0 / det;
+  double body_inverse[3][3] = {
+      {c0 * inv_det, (a02 * a21 - a01 * a22) * inv_det, (a01 * a12 - a02 * a11) * inv_det},
+      {c1 * inv_det, (a00 * a22 - a02 * a20) * inv_det, (a02 * a10 - a00 * a12) * inv_det},
+      {c2 * inv_det, (a01 * a20 - a00 * a21) * inv_det, (a00 * a11 - a01 * a10) * inv_det}};
+  /* world frame: R·I_body⁻¹·Rᵀ, R in rows of 4 */
+  const dReal* R = dBodyGetRotation(body);
+  double r_inverse[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      r_inverse[i][j] =
+          R[4 * i] * body_inverse[0][j] + R[4 * i + 1] * body_inverse[1][j] + R[4 * i + 2] * body_inverse[2][j];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      out->inverse_inertia[3 * i + j] =
+          r_inverse[i][0] * R[4 * j] + r_inverse[i][1] * R[4 * j + 1] + r_inverse[i][2] * R[4 * j + 2];
 }
 
-static int isDynamic(dBodyID body) { return body != 0 && !dBodyIsKinematic(body); }
+/* d·I⁻¹d in the world frame. */
+static double inverseInertiaAlong(const ssBodyInverse* body, const double* d) {
+  const double* M = body->inverse_inertia;
+  return d[0] * (M[0] * d[0] + M[1] * d[1] + M[2] * d[2]) + d[1] * (M[3] * d[0] + M[4] * d[1] + M[5] * d[2]) +
+         d[2] * (M[6] * d[0] + M[7] * d[1] + M[8] * d[2]);
+}
+
+double ssRowInverseMass(const ssBodyInverse* body, const ssRowGeometry* row) {
+  if (!body->dynamic) return 0;
+  if (row->angular) return inverseInertiaAlong(body, row->direction);
+  double inverse = body->inverse_mass;
+  if (row->has_point) {
+    const double* p = body->position;
+    double r[3] = {row->point[0] - p[0], row->point[1] - p[1], row->point[2] - p[2]};
+    const double* d = row->direction;
+    double rxd[3] = {r[1] * d[2] - r[2] * d[1], r[2] * d[0] - r[0] * d[2], r[0] * d[1] - r[1] * d[0]};
+    inverse += inverseInertiaAlong(body, rxd);
+  }
+  return inverse;
+}
 
 double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, const dReal* point, int angular) {
+  ssRowGeometry row = {{direction[0], direction[1], direction[2]}, {0, 0, 0}, angular, point != NULL};
+  if (point != NULL) row.point[0] = point[0], row.point[1] = point[1], row.point[2] = point[2];
   dBodyID bodies[2] = {body1, body2};
   double inverse = 0;
   for (int i = 0; i < 2; ++i) {
-    if (!isDynamic(bodies[i])) continue;
-    if (angular) {
-      inverse += inverseInertiaAlong(bodies[i], direction);
-      continue;
-    }
-    dMass mass;
-    dBodyGetMass(bodies[i], &mass);
-    inverse += 1.0 / mass.mass;
-    if (point != NULL) {
-      const dReal* p = dBodyGetPosition(bodies[i]);
-      dVector3 r = {point[0] - p[0], point[1] - p[1], point[2] - p[2], 0};
-      dVector3 rxd;
-      dCalcVectorCross3(rxd, r, direction);
-      inverse += inverseInertiaAlong(bodies[i], rxd);
-    }
+    ssBodyInverse body;
+    ssBodyInverseOf(bodies[i], &body);
+    inverse += ssRowInverseMass(&body, &row);
   }
   return inverse > 0 ? 1.0 / inverse : 0;
 }
@@ -245,8 +280,16 @@ static int rowGeometry(dJointID joint, ssJointParam param, int axis, dVector3 di
       dJointGetPistonAxis(joint, direction);
       *angular = axis == 2;
       return 1;
-    case dJointTypeAMotor: dJointGetAMotorAxis(joint, axis - 1, direction); *angular = 1; return 1;
-    case dJointTypeLMotor: dJointGetLMotorAxis(joint, axis - 1, direction); return 1;
+    /* a motor's axes can be fewer than when the row was bound */
+    case dJointTypeAMotor:
+      if (axis > dJointGetAMotorNumAxes(joint)) return 0;
+      dJointGetAMotorAxis(joint, axis - 1, direction);
+      *angular = 1;
+      return 1;
+    case dJointTypeLMotor:
+      if (axis > dJointGetLMotorNumAxes(joint)) return 0;
+      dJointGetLMotorAxis(joint, axis - 1, direction);
+      return 1;
     case dJointTypePlane2D:
       direction[0] = axis == 1;
       direction[1] = axis == 2;
@@ -263,6 +306,17 @@ static int rowGeometry(dJointID joint, ssJointParam param, int axis, dVector3 di
       return 1;
     default: return 0; /* transmission couples rotations through gear geometry: the program must give a mass */
   }
+}
+
+int ssJointRowGeometry(dJointID joint, ssJointParam param, int axis, ssRowGeometry* out) {
+  /* ODE's axis getters need the joint's first body (some assert on it): a detached joint has no row to measure */
+  if (dJointGetBody(joint, 0) == 0) return 0;
+  dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
+  int angular, has_point;
+  if (!rowGeometry(joint, param, axis, direction, point, &angular, &has_point)) return 0;
+  *out = (ssRowGeometry){{direction[0], direction[1], direction[2]}, {point[0], point[1], point[2]}, angular,
+                         has_point};
+  return 1;
 }
 
 ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, double* mass) {

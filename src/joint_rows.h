@@ -22,9 +22,38 @@ void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* e
 /* The number of limit/motor axes of the joint's type (0: none). */
 int ssJointLimitAxisCount(dJointID joint);
 
+/* What a body opposes to a row's motion, read once per step and shared by all the rows on it: inverse mass (1/kg),
+ * world-frame inverse inertia (1/(kg·m²), row-major 3x3) and centre (m). All 0 for the static world (body 0) and
+ * kinematic bodies (dynamic 0); the inertia part is 0 for an inertia that is not positive definite. */
+typedef struct ssBodyInverse {
+  double inverse_mass;
+  double inverse_inertia[9];
+  double position[3];
+  int dynamic;
+} ssBodyInverse;
+
+void ssBodyInverseOf(dBodyID body, ssBodyInverse* out);
+
+/* A row's unit direction (world frame), whether it is angular, and for a linear row whose point matters (hinge-2
+ * suspension) that point (m). */
+typedef struct ssRowGeometry {
+  double direction[3];
+  double point[3];
+  int angular;
+  int has_point;
+} ssRowGeometry;
+
+/* The geometry of a row of a joint that supports param on axis (checked at bind time). 0 when the row has none to
+ * measure: the joint is detached from its first body, a motor has fewer axes now, or the type's mass is not defined
+ * (transmission). */
+int ssJointRowGeometry(dJointID joint, ssJointParam param, int axis, ssRowGeometry* out);
+
+/* One body's share of the row's inverse effective mass: 1/m + (r x d)·I⁻¹(r x d) (linear) or d·I⁻¹d (angular). */
+double ssRowInverseMass(const ssBodyInverse* body, const ssRowGeometry* row);
+
 /* The effective mass of a row along (linear) or about (angular) the unit direction `direction` through world point
- * `point` (linear rows only), from body1 and body2 (0 for the static world): 1 / sum over dynamic bodies of
- * 1/m + (r x d)·I⁻¹(r x d) (linear) or d·I⁻¹d (angular). Returns 0 when no dynamic body is attached. */
+ * `point` (linear rows only), from body1 and body2 (0 for the static world): 1 / the sum of ssRowInverseMass over
+ * both. Returns 0 when no dynamic body is attached. */
 double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, const dReal* point, int angular);
 
 /* Whether a row has one direction that a load along it can be declared for (every limit, motor and suspension row;

@@ -31,7 +31,15 @@ typedef struct JointBinding {
   ssMapping computed_mapping;
   double computed_mass, computed_step_s, computed_previous_s;
   ssRowFallback computed_fallback;
+  int body_slot[2]; /* the joint's bodies in the registry's body cache; -1: none or not known */
 } JointBinding;
+
+/* A body's inverse mass and inertia, computed at most once per Apply for all the rows on it. */
+typedef struct BodyCache {
+  dBodyID body;
+  unsigned stamp; /* the Apply it was computed for */
+  ssBodyInverse inverse;
+} BodyCache;
 
 struct ssRegistry {
   dWorldID world;
@@ -52,6 +60,13 @@ struct ssRegistry {
   double applied_step_s;
   ssMapping applied_mapping;
   ssApplyReport applied_counts;
+  /* the bound joints' bodies, each once (sorted by address), for the effective masses; rebuilt on any rebinding, and
+   * after a row found its joint attached to other bodies (dJointAttach) */
+  BodyCache* body_cache;
+  int body_cache_count;
+  unsigned body_cache_revision;
+  int body_cache_stale;
+  unsigned apply_stamp;
 };
 
 #define REQUIRE_REGISTRY(registry) \
@@ -69,6 +84,7 @@ ssRegistry* ssRegistry_Create(dWorldID world) {
   }
   registry->world = world;
   registry->applied_step_s = NAN;
+  registry->body_cache_stale = 1;
   return registry;
 }
 
@@ -76,6 +92,7 @@ void ssRegistry_Destroy(ssRegistry* registry) {
   if (registry == NULL) return;
   free(registry->joints);
   free(registry->bodies);
+  free(registry->body_cache);
   free(registry);
 }
 
@@ -119,7 +136,7 @@ ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointPar
                                 double effective_mass) {
   registry->revision += 1;
   JointBinding binding = {joint, param, axis, law, effective_mass, {0, 0}, {NAN, NAN}, 0, 0, NAN, 0,
-                          SS_MAPPING_IMPLICIT_EULER, NAN, NAN, NAN, {0, 0}};
+                          SS_MAPPING_IMPLICIT_EULER, NAN, NAN, NAN, {0, 0}, {-1, -1}};
   JointBinding* existing = findJoint(registry, joint, param, axis);
   if (existing != NULL) {
     *existing = binding;
@@ -275,18 +292,88 @@ static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass,
   return status;
 }
 
+static int compareBodyCache(const void* a, const void* b) {
+  uintptr_t x = (uintptr_t)((const BodyCache*)a)->body, y = (uintptr_t)((const BodyCache*)b)->body;
+  return (x > y) - (x < y);
+}
+
+/* Lists the bound joints' bodies once each and points every binding at its bodies' slots. Out of memory, every
+ * row computes its bodies itself. */
+static void rebuildBodyCache(ssRegistry* registry) {
+  registry->body_cache_revision = registry->revision;
+  registry->body_cache_stale = 0;
+  free(registry->body_cache);
+  registry->body_cache = NULL;
+  registry->body_cache_count = 0;
+  size_t most = 2 * (size_t)registry->joint_count;
+  BodyCache* cache = most > 0 ? malloc(most * sizeof *cache) : NULL;
+  int count = 0;
+  if (cache != NULL) {
+    for (int i = 0; i < registry->joint_count; ++i)
+      for (int side = 0; side < 2; ++side) {
+        dBodyID body = dJointGetBody(registry->joints[i].joint, side);
+        if (body != 0) cache[count++] = (BodyCache){.body = body, .stamp = 0};
+      }
+    qsort(cache, (size_t)count, sizeof *cache, compareBodyCache);
+    int unique = 0;
+    for (int i = 0; i < count; ++i)
+      if (unique == 0 || cache[i].body != cache[unique - 1].body) cache[unique++] = cache[i];
+    count = unique;
+  }
+  for (int i = 0; i < registry->joint_count; ++i)
+    for (int side = 0; side < 2; ++side) {
+      BodyCache key = {.body = dJointGetBody(registry->joints[i].joint, side)};
+      const BodyCache* found =
+          cache != NULL && key.body != 0 ? bsearch(&key, cache, (size_t)count, sizeof *cache, compareBodyCache) : NULL;
+      registry->joints[i].body_slot[side] = found != NULL ? (int)(found - cache) : -1;
+    }
+  registry->body_cache = cache;
+  registry->body_cache_count = count;
+}
+
+/* What the body opposes to its rows in this Apply: from the cache, computed on its first use in the Apply, or into
+ * *local for a body the cache does not know (the joint was attached elsewhere since: the cache is rebuilt next). */
+static const ssBodyInverse* bodyInverse(ssRegistry* registry, int slot, dBodyID body, ssBodyInverse* local) {
+  if (slot >= 0 && registry->body_cache[slot].body == body) {
+    BodyCache* cached = &registry->body_cache[slot];
+    if (cached->stamp != registry->apply_stamp) {
+      ssBodyInverseOf(body, &cached->inverse);
+      cached->stamp = registry->apply_stamp;
+    }
+    return &cached->inverse;
+  }
+  registry->body_cache_stale = 1;
+  ssBodyInverseOf(body, local);
+  return local;
+}
+
+/* The row's effective mass from its bodies (ssJointEffectiveMass's value, through the body cache); NAN when the row
+ * has none to measure. */
+static double rowMass(ssRegistry* registry, const JointBinding* binding) {
+  ssRowGeometry row;
+  if (!ssJointRowGeometry(binding->joint, binding->param, binding->axis, &row)) return NAN;
+  double inverse = 0;
+  for (int side = 0; side < 2; ++side) {
+    dBodyID body = dJointGetBody(binding->joint, side);
+    if (body == 0) continue;
+    ssBodyInverse local;
+    inverse += ssRowInverseMass(bodyInverse(registry, binding->body_slot[side], body, &local), &row);
+  }
+  double mass = inverse > 0 ? 1.0 / inverse : 0;
+  return mass > 0 && isfinite(mass) ? mass : NAN;
+}
+
 /* The binding's mass for this Apply: given, or computed (every time where the mapping depends on it; under the
  * implicit-Euler mapping every few Applies, for the Nyquist report). NAN when the row has none (no dynamic body, or a
  * transmission): the accurate mappings then hand the row to the implicit-Euler mapping. */
-static double bindingMass(JointBinding* binding, ssMapping mapping) {
+static double bindingMass(ssRegistry* registry, JointBinding* binding, ssMapping mapping) {
   if (binding->effective_mass > 0) return binding->effective_mass;
   if (binding->law.hard) return NAN;
   if (mapping == SS_MAPPING_IMPLICIT_EULER && binding->report_mass_age > 0) {
     binding->report_mass_age -= 1;
     return binding->report_mass;
   }
-  double mass;
-  if (ssJointEffectiveMass(binding->joint, binding->param, binding->axis, &mass) != SS_OK) mass = NAN;
+  double mass = rowMass(registry, binding);
   binding->report_mass = mass;
   binding->report_mass_age = kReportMassRefresh;
   return mass;
@@ -298,6 +385,14 @@ static int sharesRow(const JointBinding* a, const JointBinding* b) {
   int b_limit = b->param == SS_PARAM_STOP || b->param == SS_PARAM_MOTOR;
   return a->joint == b->joint && a->axis == b->axis && a_limit && b_limit;
 }
+
+/* One softness an Apply computed, for the rows with the same law and mass that follow. */
+typedef struct SharedSoftness {
+  ssRowLaw law;
+  double mass; /* compared only where the mapping reads it */
+  ssSoftness softness;
+  ssRowFallback fallback;
+} SharedSoftness;
 
 static int sameLaw(const ssRowLaw* a, const ssRowLaw* b) {
   return a->hard == b->hard && a->spring.stiffness == b->spring.stiffness && a->spring.damping == b->spring.damping &&
@@ -359,6 +454,11 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     return SS_OK;
   }
   ssApplyReport counts = {0, 0, 0, 0};
+  if (registry->body_cache_stale || registry->body_cache_revision != registry->revision) rebuildBodyCache(registry);
+  if (++registry->apply_stamp == 0) { /* after 2^32 Applies: no cached body may look computed for this one */
+    for (int i = 0; i < registry->body_cache_count; ++i) registry->body_cache[i].stamp = 0;
+    registry->apply_stamp = 1;
+  }
   if (registry->world_bound) {
     ssRowFallback fallback;
     status = softnessFor(&registry->world_law, mapping, registry->world_mass, step_s, previous_step_s, &counts,
@@ -367,53 +467,54 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
       status = ssCheckSoftnessForOde("softness", registry->world_pending.erp, registry->world_pending.cfm);
     if (status != SS_OK) return failBinding(status, NULL);
   }
-  /* Programs bind many rows to a few springs: under the implicit-Euler mapping each one's softness is computed once. */
-  enum { kCacheSize = 4 };
-  ssRowLaw cached_law[kCacheSize];
-  ssSoftness cached_softness[kCacheSize];
-  int cached = 0;
+  /* Programs bind many rows to a few springs, and many rows move equal masses (identical links, wheels, stop and
+   * motor on one axis): within one Apply the softness is a function of the law and (accurate mappings) the mass, so
+   * each distinct pair is computed once and shared. */
+  enum { kSharedSize = 8 };
+  SharedSoftness shared[kSharedSize];
+  int shared_count = 0, shared_next = 0;
+  double previous_s = mapping == SS_MAPPING_EXACT ? previous_step_s : 0;
   double last_mass = NAN;
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
     const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
     /* a stop and a motor on one axis move the same mass: computed once */
     int same_row = before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
-    double mass = same_row ? last_mass : bindingMass(binding, mapping);
+    double mass = same_row ? last_mass : bindingMass(registry, binding, mapping);
     last_mass = mass;
-    int hit = -1;
-    for (int j = 0; j < cached && hit < 0; ++j)
-      if (sameLaw(&cached_law[j], &binding->law)) hit = j;
-    if (hit >= 0) { /* implicit Euler and hard rows never fall back */
-      binding->pending = cached_softness[hit];
-      countRow(&binding->law, mass, step_s, &(ssRowFallback){0, 0}, &counts);
-      continue;
-    }
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
-    double previous_s = mapping == SS_MAPPING_EXACT ? previous_step_s : 0;
     int same_inputs = binding->computed_mapping == mapping && binding->computed_mass == mass &&
                       binding->computed_step_s == step_s && binding->computed_previous_s == previous_s;
     if (mapping != SS_MAPPING_IMPLICIT_EULER && same_inputs) {
       countRow(&binding->law, mass, step_s, &binding->computed_fallback, &counts);
       continue;
     }
-    status = softnessFor(&binding->law, mapping, mass, step_s, previous_s, &counts, &binding->computed_fallback,
-                         &binding->pending);
-    /* the boundary with ODE: nothing outside limits.h's ranges is ever written */
-    if (status == SS_OK) status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
-    if (status != SS_OK) {
-      binding->computed_step_s = NAN;
-      return failBinding(status, binding);
+    int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || binding->law.hard;
+    const SharedSoftness* hit = NULL;
+    for (int j = 0; j < shared_count && hit == NULL; ++j)
+      if (sameLaw(&shared[j].law, &binding->law) && (any_mass || shared[j].mass == mass)) hit = &shared[j];
+    if (hit != NULL) {
+      binding->pending = hit->softness;
+      binding->computed_fallback = hit->fallback;
+      countRow(&binding->law, mass, step_s, &hit->fallback, &counts);
+    } else {
+      status = softnessFor(&binding->law, mapping, mass, step_s, previous_s, &counts, &binding->computed_fallback,
+                           &binding->pending);
+      /* the boundary with ODE: nothing outside limits.h's ranges is ever written */
+      if (status == SS_OK) status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
+      if (status != SS_OK) {
+        binding->computed_step_s = NAN;
+        return failBinding(status, binding);
+      }
+      shared[shared_next] = (SharedSoftness){binding->law, mass, binding->pending, binding->computed_fallback};
+      shared_next = (shared_next + 1) % kSharedSize;
+      if (shared_count < kSharedSize) shared_count += 1;
     }
     binding->computed_mapping = mapping;
     binding->computed_mass = mass;
     binding->computed_step_s = step_s;
     binding->computed_previous_s = previous_s;
-    if (mapping == SS_MAPPING_IMPLICIT_EULER || binding->law.hard) {
-      int slot = cached < kCacheSize ? cached++ : i % kCacheSize;
-      cached_law[slot] = binding->law;
-      cached_softness[slot] = binding->pending;
-    }
   }
 
   /* The load corrections, computed and bounded before anything is written. */
