@@ -80,29 +80,32 @@ int ssJointSupports(dJointID joint, ssJointParam param, int axis) {
 /* ODE's parameter number for a set on an axis: groups are 0x100 apart (dParamGroup). */
 static int groupParam(int param, int axis) { return param + (axis - 1) * dParamGroup; }
 
-static void setParam(dJointID joint, int axis, int param, double value) {
-  switch (dJointGetType(joint)) {
-    case dJointTypeBall: dJointSetBallParam(joint, param, value); break;
-    case dJointTypeFixed: dJointSetFixedParam(joint, param, value); break;
-    case dJointTypeDBall: dJointSetDBallParam(joint, param, value); break;
-    case dJointTypeDHinge: dJointSetDHingeParam(joint, param, value); break;
-    case dJointTypeTransmission: dJointSetTransmissionParam(joint, param, value); break;
-    case dJointTypeHinge: dJointSetHingeParam(joint, param, value); break;
-    case dJointTypeSlider: dJointSetSliderParam(joint, param, value); break;
-    case dJointTypeUniversal: dJointSetUniversalParam(joint, groupParam(param, axis), value); break;
-    case dJointTypeHinge2: dJointSetHinge2Param(joint, groupParam(param, axis), value); break;
-    case dJointTypePR: dJointSetPRParam(joint, groupParam(param, axis), value); break;
-    case dJointTypePU: dJointSetPUParam(joint, groupParam(param, axis), value); break;
-    case dJointTypePiston: dJointSetPistonParam(joint, groupParam(param, axis), value); break;
-    case dJointTypeAMotor: dJointSetAMotorParam(joint, groupParam(param, axis), value); break;
-    case dJointTypeLMotor: dJointSetLMotorParam(joint, groupParam(param, axis), value); break;
-    case dJointTypePlane2D:
-      /* plane-2D has one function per axis instead of groups */
-      if (axis == 1) dJointSetPlane2DXParam(joint, param, value);
-      else if (axis == 2) dJointSetPlane2DYParam(joint, param, value);
-      else dJointSetPlane2DAngleParam(joint, param, value);
-      break;
+/* ODE's setter for a joint type's parameters, and in *number the number of param on axis for it; NULL for a type
+ * without soft parameters. */
+static ssParamSetter setterOf(int type, int axis, int param, int* number) {
+  *number = param;
+  switch (type) {
+    case dJointTypeBall: return dJointSetBallParam;
+    case dJointTypeFixed: return dJointSetFixedParam;
+    case dJointTypeDBall: return dJointSetDBallParam;
+    case dJointTypeDHinge: return dJointSetDHingeParam;
+    case dJointTypeTransmission: return dJointSetTransmissionParam;
+    case dJointTypeHinge: return dJointSetHingeParam;
+    case dJointTypeSlider: return dJointSetSliderParam;
+    case dJointTypePlane2D: /* one function per axis instead of groups */
+      return axis == 1 ? dJointSetPlane2DXParam : axis == 2 ? dJointSetPlane2DYParam : dJointSetPlane2DAngleParam;
     default: break;
+  }
+  *number = groupParam(param, axis);
+  switch (type) {
+    case dJointTypeUniversal: return dJointSetUniversalParam;
+    case dJointTypeHinge2: return dJointSetHinge2Param;
+    case dJointTypePR: return dJointSetPRParam;
+    case dJointTypePU: return dJointSetPUParam;
+    case dJointTypePiston: return dJointSetPistonParam;
+    case dJointTypeAMotor: return dJointSetAMotorParam;
+    case dJointTypeLMotor: return dJointSetLMotorParam;
+    default: return NULL;
   }
 }
 
@@ -150,11 +153,19 @@ void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* e
 
 int ssJointLimitAxisCount(dJointID joint) { return limitAxisCount(joint); }
 
-void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm) {
+void ssJointRowWriterOf(dJointID joint, ssJointParam param, int axis, ssRowWriter* out) {
   int erp_param, cfm_param;
+  *out = (ssRowWriter){NULL, -1, -1};
   if (!softnessParams(param, &erp_param, &cfm_param)) return;
-  if (erp_param >= 0) setParam(joint, axis, erp_param, erp);
-  setParam(joint, axis, cfm_param, cfm);
+  int type = dJointGetType(joint);
+  out->set = setterOf(type, axis, cfm_param, &out->cfm_number);
+  if (erp_param >= 0) setterOf(type, axis, erp_param, &out->erp_number);
+}
+
+void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm) {
+  ssRowWriter writer;
+  ssJointRowWriterOf(joint, param, axis, &writer);
+  ssRowWrite(&writer, joint, erp, cfm);
 }
 
 static int isDynamic(dBodyID body) { return body != 0 && !dBodyIsKinematic(body); }
@@ -201,27 +212,6 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
           r_inverse[i][0] * R[4 * j] + r_inverse[i][1] * R[4 * j + 1] + r_inverse[i][2] * R[4 * j + 2];
 }
 
-/* d·I⁻¹d in the world frame. */
-static double inverseInertiaAlong(const ssBodyInverse* body, const double* d) {
-  const double* M = body->inverse_inertia;
-  return d[0] * (M[0] * d[0] + M[1] * d[1] + M[2] * d[2]) + d[1] * (M[3] * d[0] + M[4] * d[1] + M[5] * d[2]) +
-         d[2] * (M[6] * d[0] + M[7] * d[1] + M[8] * d[2]);
-}
-
-double ssRowInverseMass(const ssBodyInverse* body, const ssRowGeometry* row) {
-  if (!body->dynamic) return 0;
-  if (row->angular) return inverseInertiaAlong(body, row->direction);
-  double inverse = body->inverse_mass;
-  if (row->has_point) {
-    const double* p = body->position;
-    double r[3] = {row->point[0] - p[0], row->point[1] - p[1], row->point[2] - p[2]};
-    const double* d = row->direction;
-    double rxd[3] = {r[1] * d[2] - r[2] * d[1], r[2] * d[0] - r[0] * d[2], r[0] * d[1] - r[1] * d[0]};
-    inverse += inverseInertiaAlong(body, rxd);
-  }
-  return inverse;
-}
-
 double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, const dReal* point, int angular) {
   ssRowGeometry row = {{direction[0], direction[1], direction[2]}, {0, 0, 0}, angular, point != NULL};
   if (point != NULL) row.point[0] = point[0], row.point[1] = point[1], row.point[2] = point[2];
@@ -236,11 +226,11 @@ double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, 
 }
 
 /* The row's direction, whether it is angular, and (for a linear row whose point matters) its point. */
-static int rowGeometry(dJointID joint, ssJointParam param, int axis, dVector3 direction, dVector3 point,
+static int rowGeometry(dJointID joint, int type, ssJointParam param, int axis, dVector3 direction, dVector3 point,
                        int* angular, int* has_point) {
   *angular = 0;
   *has_point = 0;
-  switch (dJointGetType(joint)) {
+  switch (type) {
     case dJointTypeHinge: dJointGetHingeAxis(joint, direction); *angular = 1; return 1;
     case dJointTypeSlider: dJointGetSliderAxis(joint, direction); return 1;
     case dJointTypeUniversal:
@@ -308,12 +298,10 @@ static int rowGeometry(dJointID joint, ssJointParam param, int axis, dVector3 di
   }
 }
 
-int ssJointRowGeometry(dJointID joint, ssJointParam param, int axis, ssRowGeometry* out) {
-  /* ODE's axis getters need the joint's first body (some assert on it): a detached joint has no row to measure */
-  if (dJointGetBody(joint, 0) == 0) return 0;
+int ssJointRowGeometry(dJointID joint, int type, ssJointParam param, int axis, ssRowGeometry* out) {
   dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
   int angular, has_point;
-  if (!rowGeometry(joint, param, axis, direction, point, &angular, &has_point)) return 0;
+  if (!rowGeometry(joint, type, param, axis, direction, point, &angular, &has_point)) return 0;
   *out = (ssRowGeometry){{direction[0], direction[1], direction[2]}, {point[0], point[1], point[2]}, angular,
                          has_point};
   return 1;
@@ -330,7 +318,7 @@ ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, doub
     return ssFail(SS_ERROR_OUT_OF_RANGE, "the %s joint has no dynamic body attached", ssJointTypeName(joint));
   dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
   int angular, has_point;
-  if (!rowGeometry(joint, param, axis, direction, point, &angular, &has_point))
+  if (!rowGeometry(joint, dJointGetType(joint), param, axis, direction, point, &angular, &has_point))
     return ssFail(SS_ERROR_UNSUPPORTED, "the effective mass of a %s joint's rows is not defined: give it",
                   ssJointTypeName(joint));
   double value = ssRowEffectiveMass(dJointGetBody(joint, 0), dJointGetBody(joint, 1), direction,
@@ -350,7 +338,7 @@ void ssJointAddRowForce(dJointID joint, ssJointParam param, int axis, double for
   if (dJointGetBody(joint, 0) == 0) return; /* detached: no row, and ODE's getters would assert */
   dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
   int angular, has_point;
-  if (!rowGeometry(joint, param, axis, direction, point, &angular, &has_point)) return;
+  if (!rowGeometry(joint, dJointGetType(joint), param, axis, direction, point, &angular, &has_point)) return;
   for (int side = 0; side < 2; ++side) {
     dBodyID body = dJointGetBody(joint, side);
     if (!isDynamic(body)) continue;

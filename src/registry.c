@@ -14,24 +14,29 @@
 #include "steadystep/adopt.h"
 #include "steadystep/registry.h"
 
+/* Laid out by use: the first cache line is what both of Apply's passes read for every row, the second what the first
+ * pass reads under every mapping, the rest what the accurate mappings and loads add. */
 typedef struct JointBinding {
   dJointID joint;
-  ssJointParam param;
-  int axis;
-  ssRowLaw law;
-  double effective_mass; /* 0: computed from the bodies at each Apply */
+  ssRowWriter writer;    /* ODE's setter and parameter numbers for the row, resolved at bind time */
   ssSoftness pending;    /* computed in Apply's first pass */
   ssSoftness written;    /* last written: the registry owns the row, so an unchanged value is not written again */
-  double load; /* the steady force or torque the row carries (ssRegistry_SetJointLoad); 0 = none declared */
-  double load_correction; /* the force this Apply adds along the row for the load (N or N·m) */
+  ssJointParam param;
+  int axis;
+
+  ssRowLaw law;
+  double effective_mass; /* 0: computed from the bodies at each Apply */
   /* The implicit-Euler mapping needs the mass only for the Nyquist report: it is refreshed every few Applies there. */
   double report_mass;
-  int report_mass_age;
   /* what pending was computed from: the mappings are pure functions of these, so equal inputs reuse it */
   ssMapping computed_mapping;
-  double computed_mass, computed_step_s, computed_previous_s;
   ssRowFallback computed_fallback;
+
+  double computed_mass, computed_step_s, computed_previous_s;
+  double load; /* the steady force or torque the row carries (ssRegistry_SetJointLoad); 0 = none declared */
+  double load_correction; /* the force this Apply adds along the row for the load (N or N·m) */
   int body_slot[2]; /* the joint's bodies in the registry's body cache; -1: none or not known */
+  int joint_type;   /* dJointGetType, resolved at bind time: a joint's type never changes */
 } JointBinding;
 
 /* A body's inverse mass and inertia, computed at most once per Apply for all the rows on it. */
@@ -67,6 +72,8 @@ struct ssRegistry {
   unsigned body_cache_revision;
   int body_cache_stale;
   unsigned apply_stamp;
+  int loaded_rows; /* bindings with a load, counted with the body cache: Apply skips the load passes without */
+  int report_mass_age; /* implicit-Euler Applies until the report's masses are computed again; 0 after a rebinding */
 };
 
 #define REQUIRE_REGISTRY(registry) \
@@ -135,8 +142,24 @@ int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam par
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass) {
   registry->revision += 1;
-  JointBinding binding = {joint, param, axis, law, effective_mass, {0, 0}, {NAN, NAN}, 0, 0, NAN, 0,
-                          SS_MAPPING_IMPLICIT_EULER, NAN, NAN, NAN, {0, 0}, {-1, -1}};
+  JointBinding binding = {.joint = joint,
+                          .pending = {0, 0},
+                          .written = {NAN, NAN},
+                          .param = param,
+                          .axis = axis,
+                          .law = law,
+                          .effective_mass = effective_mass,
+                          .report_mass = NAN,
+                          .computed_mapping = SS_MAPPING_IMPLICIT_EULER,
+                          .computed_fallback = {0, 0},
+                          .computed_mass = NAN,
+                          .computed_step_s = NAN,
+                          .computed_previous_s = NAN,
+                          .load = 0,
+                          .load_correction = 0,
+                          .body_slot = {-1, -1},
+                          .joint_type = dJointGetType(joint)};
+  ssJointRowWriterOf(joint, param, axis, &binding.writer);
   JointBinding* existing = findJoint(registry, joint, param, axis);
   if (existing != NULL) {
     *existing = binding;
@@ -179,6 +202,7 @@ ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointPa
     return ssFail(SS_ERROR_UNSUPPORTED, "a %s joint's %s rows have no single direction to carry a load",
                   ssJointTypeName(joint), ssJointParamName(param));
   binding->load = load;
+  binding->computed_step_s = NAN; /* a softness the old load sent to implicit Euler is not reused */
   registry->revision += 1;
   return SS_OK;
 }
@@ -297,9 +321,10 @@ static int compareBodyCache(const void* a, const void* b) {
   return (x > y) - (x < y);
 }
 
-/* Lists the bound joints' bodies once each and points every binding at its bodies' slots. Out of memory, every
- * row computes its bodies itself. */
-static void rebuildBodyCache(ssRegistry* registry) {
+/* What Apply derives from the bindings, rebuilt when they change: the bound joints' bodies listed once each, with
+ * every binding pointed at its bodies' slots (out of memory, every row computes its bodies itself), and the count of
+ * rows with a load. */
+static void rebuildApplyCache(ssRegistry* registry) {
   registry->body_cache_revision = registry->revision;
   registry->body_cache_stale = 0;
   free(registry->body_cache);
@@ -329,6 +354,9 @@ static void rebuildBodyCache(ssRegistry* registry) {
     }
   registry->body_cache = cache;
   registry->body_cache_count = count;
+  registry->report_mass_age = 0;
+  registry->loaded_rows = 0;
+  for (int i = 0; i < registry->joint_count; ++i) registry->loaded_rows += registry->joints[i].load != 0;
 }
 
 /* What the body opposes to its rows in this Apply: from the cache, computed on its first use in the Apply, or into
@@ -350,33 +378,30 @@ static const ssBodyInverse* bodyInverse(ssRegistry* registry, int slot, dBodyID 
 /* The row's effective mass from its bodies (ssJointEffectiveMass's value, through the body cache); NAN when the row
  * has none to measure. */
 static double rowMass(ssRegistry* registry, const JointBinding* binding) {
+  dBodyID bodies[2] = {dJointGetBody(binding->joint, 0), 0};
   ssRowGeometry row;
-  if (!ssJointRowGeometry(binding->joint, binding->param, binding->axis, &row)) return NAN;
+  if (bodies[0] == 0 || !ssJointRowGeometry(binding->joint, binding->joint_type, binding->param, binding->axis, &row))
+    return NAN;
+  bodies[1] = dJointGetBody(binding->joint, 1);
   double inverse = 0;
   for (int side = 0; side < 2; ++side) {
-    dBodyID body = dJointGetBody(binding->joint, side);
-    if (body == 0) continue;
+    if (bodies[side] == 0) continue;
     ssBodyInverse local;
-    inverse += ssRowInverseMass(bodyInverse(registry, binding->body_slot[side], body, &local), &row);
+    inverse += ssRowInverseMass(bodyInverse(registry, binding->body_slot[side], bodies[side], &local), &row);
   }
   double mass = inverse > 0 ? 1.0 / inverse : 0;
   return mass > 0 && isfinite(mass) ? mass : NAN;
 }
 
-/* The binding's mass for this Apply: given, or computed (every time where the mapping depends on it; under the
- * implicit-Euler mapping every few Applies, for the Nyquist report). NAN when the row has none (no dynamic body, or a
+/* The binding's mass for this Apply: given, or measured from the bodies when `measure` (every Apply of the accurate
+ * mappings; every few of the implicit-Euler mapping, which needs it only for the Nyquist report), or the last one. NAN when the row has none (no dynamic body, or a
  * transmission): the accurate mappings then hand the row to the implicit-Euler mapping. */
-static double bindingMass(ssRegistry* registry, JointBinding* binding, ssMapping mapping) {
+static double bindingMass(ssRegistry* registry, JointBinding* binding, int measure) {
   if (binding->effective_mass > 0) return binding->effective_mass;
   if (binding->law.hard) return NAN;
-  if (mapping == SS_MAPPING_IMPLICIT_EULER && binding->report_mass_age > 0) {
-    binding->report_mass_age -= 1;
-    return binding->report_mass;
-  }
-  double mass = rowMass(registry, binding);
-  binding->report_mass = mass;
-  binding->report_mass_age = kReportMassRefresh;
-  return mass;
+  if (!measure) return binding->report_mass;
+  binding->report_mass = rowMass(registry, binding);
+  return binding->report_mass;
 }
 
 /* Whether two bindings drive rows along the same axis of the same joint (a stop and a motor). */
@@ -454,7 +479,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     return SS_OK;
   }
   ssApplyReport counts = {0, 0, 0, 0};
-  if (registry->body_cache_stale || registry->body_cache_revision != registry->revision) rebuildBodyCache(registry);
+  if (registry->body_cache_stale || registry->body_cache_revision != registry->revision) rebuildApplyCache(registry);
   if (++registry->apply_stamp == 0) { /* after 2^32 Applies: no cached body may look computed for this one */
     for (int i = 0; i < registry->body_cache_count; ++i) registry->body_cache[i].stamp = 0;
     registry->apply_stamp = 1;
@@ -475,18 +500,21 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   int shared_count = 0, shared_next = 0;
   double previous_s = mapping == SS_MAPPING_EXACT ? previous_step_s : 0;
   double last_mass = NAN;
+  int measure = mapping != SS_MAPPING_IMPLICIT_EULER || registry->report_mass_age == 0;
+  if (mapping == SS_MAPPING_IMPLICIT_EULER)
+    registry->report_mass_age = measure ? kReportMassRefresh - 1 : registry->report_mass_age - 1;
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
     const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
     /* a stop and a motor on one axis move the same mass: computed once */
     int same_row = before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
-    double mass = same_row ? last_mass : bindingMass(registry, binding, mapping);
+    double mass = same_row ? last_mass : bindingMass(registry, binding, measure);
     last_mass = mass;
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
-    int same_inputs = binding->computed_mapping == mapping && binding->computed_mass == mass &&
-                      binding->computed_step_s == step_s && binding->computed_previous_s == previous_s;
-    if (mapping != SS_MAPPING_IMPLICIT_EULER && same_inputs) {
+    if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_mapping == mapping &&
+        binding->computed_mass == mass && binding->computed_step_s == step_s &&
+        binding->computed_previous_s == previous_s) {
       countRow(&binding->law, mass, step_s, &binding->computed_fallback, &counts);
       continue;
     }
@@ -511,14 +539,16 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
       shared_next = (shared_next + 1) % kSharedSize;
       if (shared_count < kSharedSize) shared_count += 1;
     }
-    binding->computed_mapping = mapping;
+    binding->computed_mapping = mapping; /* implicit Euler: enough that an accurate mapping never reuses it */
+    if (mapping == SS_MAPPING_IMPLICIT_EULER) continue;
     binding->computed_mass = mass;
     binding->computed_step_s = step_s;
     binding->computed_previous_s = previous_s;
   }
 
   /* The load corrections, computed and bounded before anything is written. */
-  if (mapping != SS_MAPPING_IMPLICIT_EULER) {
+  int corrects_loads = mapping != SS_MAPPING_IMPLICIT_EULER && registry->loaded_rows > 0;
+  if (corrects_loads) {
     for (int i = 0; i < registry->joint_count; ++i) {
       JointBinding* binding = &registry->joints[i];
       binding->load_correction = 0;
@@ -549,10 +579,10 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
     if (binding->pending.erp == binding->written.erp && binding->pending.cfm == binding->written.cfm) continue;
-    ssJointWriteSoftness(binding->joint, binding->param, binding->axis, binding->pending.erp, binding->pending.cfm);
+    ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
     binding->written = binding->pending;
   }
-  if (mapping != SS_MAPPING_IMPLICIT_EULER) {
+  if (corrects_loads) {
     for (int i = 0; i < registry->joint_count; ++i) {
       const JointBinding* binding = &registry->joints[i];
       if (binding->load_correction != 0)
