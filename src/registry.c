@@ -14,29 +14,31 @@
 #include "steadystep/adopt.h"
 #include "steadystep/registry.h"
 
-/* Laid out by use: the first cache line is what both of Apply's passes read for every row, the second what the first
- * pass reads under every mapping, the rest what the accurate mappings and loads add. */
+/* Laid out by use, one cache line a group (the array is aligned to lines): what both of Apply's passes read for every
+ * row; what the first pass reads; what only rows outside the registry's law table and rows with a load read. */
 typedef struct JointBinding {
-  dJointID joint;
+  _Alignas(64) dJointID joint;
   ssRowWriter writer;    /* ODE's setter and parameter numbers for the row, resolved at bind time */
   ssSoftness pending;    /* computed in Apply's first pass */
   ssSoftness written;    /* last written: the registry owns the row, so an unchanged value is not written again */
   ssJointParam param;
   int axis;
 
-  ssRowLaw law;
   double effective_mass; /* 0: computed from the bodies at each Apply */
-  /* The implicit-Euler mapping needs the mass only for the Nyquist report: it is refreshed every few Applies there. */
-  double report_mass;
-  /* what pending was computed from: the mappings are pure functions of these, so equal inputs reuse it */
+  /* the mass the last Apply gave the row (NAN: none): the input of its softness under the accurate mappings, and
+   * under implicit Euler, which needs it only for the Nyquist report, the one measured every few Applies */
+  double mass;
+  /* what pending was computed from besides the mass: the mappings are pure functions, so equal inputs reuse it */
+  double computed_step_s, computed_previous_s;
+  int body_slot[2]; /* the joint's bodies in the registry's body cache; -1: none or not known */
+  int law_slot;     /* the law in the registry's table; -1: not there, read law */
+  int joint_type;   /* dJointGetType, resolved at bind time: a joint's type never changes */
   ssMapping computed_mapping;
   ssRowFallback computed_fallback;
 
-  double computed_mass, computed_step_s, computed_previous_s;
+  ssRowLaw law;
   double load; /* the steady force or torque the row carries (ssRegistry_SetJointLoad); 0 = none declared */
   double load_correction; /* the force this Apply adds along the row for the load (N or N·m) */
-  int body_slot[2]; /* the joint's bodies in the registry's body cache; -1: none or not known */
-  int joint_type;   /* dJointGetType, resolved at bind time: a joint's type never changes */
 } JointBinding;
 
 /* A body's inverse mass and inertia, computed at most once per Apply for all the rows on it. */
@@ -45,6 +47,8 @@ typedef struct BodyCache {
   unsigned stamp; /* the Apply it was computed for */
   ssBodyInverse inverse;
 } BodyCache;
+
+enum { kLawTableSize = 16 };
 
 struct ssRegistry {
   dWorldID world;
@@ -74,6 +78,9 @@ struct ssRegistry {
   unsigned apply_stamp;
   int loaded_rows; /* bindings with a load, counted with the body cache: Apply skips the load passes without */
   int report_mass_age; /* implicit-Euler Applies until the report's masses are computed again; 0 after a rebinding */
+  /* the distinct laws of the bindings (programs bind many rows to a few springs), rebuilt with the body cache */
+  ssRowLaw laws[kLawTableSize];
+  int law_count;
 };
 
 #define REQUIRE_REGISTRY(registry) \
@@ -121,6 +128,41 @@ ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effe
   return SS_OK;
 }
 
+/* After an ODE step the bindings are out of the cache and each row does little: the lines of a row a few ahead
+ * are asked for while this one is worked on. */
+enum { kPrefetchAhead = 8 };
+#if defined(__GNUC__)
+#define PREFETCH_ROWS(registry, i)                                                         \
+  do {                                                                                     \
+    if ((i) + kPrefetchAhead < (registry)->joint_count) {                                  \
+      const char* ahead = (const char*)&(registry)->joints[(i) + kPrefetchAhead];          \
+      __builtin_prefetch(ahead, 1);                                                        \
+      __builtin_prefetch(ahead + 64, 1);                                                   \
+    }                                                                                      \
+    if ((i) + kPrefetchAhead / 2 < (registry)->joint_count) {                              \
+      const char* joint = (const char*)(registry)->joints[(i) + kPrefetchAhead / 2].joint; \
+      __builtin_prefetch(joint);                                                           \
+      __builtin_prefetch(joint + 64);                                                      \
+    }                                                                                      \
+  } while (0)
+#else
+#define PREFETCH_ROWS(registry, i) ((void)0)
+#endif
+
+/* Room for `more` joint bindings, in an array aligned to cache lines (JointBinding's groups are lines). */
+static int reserveJoints(ssRegistry* registry, int more) {
+  if (registry->joint_count + more <= registry->joint_capacity) return 1;
+  int wanted = registry->joint_capacity ? 2 * registry->joint_capacity : 8;
+  if (wanted < registry->joint_count + more) wanted = registry->joint_count + more;
+  JointBinding* larger = aligned_alloc(_Alignof(JointBinding), (size_t)wanted * sizeof(JointBinding));
+  if (larger == NULL) return 0;
+  if (registry->joint_count > 0) memcpy(larger, registry->joints, (size_t)registry->joint_count * sizeof(JointBinding));
+  free(registry->joints);
+  registry->joints = larger;
+  registry->joint_capacity = wanted;
+  return 1;
+}
+
 static JointBinding* findJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis) {
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* existing = &registry->joints[i];
@@ -149,10 +191,10 @@ ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointPar
                           .axis = axis,
                           .law = law,
                           .effective_mass = effective_mass,
-                          .report_mass = NAN,
+                          .mass = NAN,
                           .computed_mapping = SS_MAPPING_IMPLICIT_EULER,
                           .computed_fallback = {0, 0},
-                          .computed_mass = NAN,
+                          .law_slot = -1,
                           .computed_step_s = NAN,
                           .computed_previous_s = NAN,
                           .load = 0,
@@ -165,7 +207,7 @@ ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointPar
     *existing = binding;
     return SS_OK;
   }
-  if (!ssReserveOne((void**)&registry->joints, registry->joint_count, &registry->joint_capacity, sizeof binding))
+  if (!reserveJoints(registry, 1))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding a joint");
   registry->joints[registry->joint_count++] = binding;
   registry->generation += 1;
@@ -316,6 +358,26 @@ static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass,
   return status;
 }
 
+/* One softness an Apply computed, for the rows with the same law and mass that follow. */
+typedef struct SharedSoftness {
+  const ssRowLaw* law;
+  int law_slot;
+  double mass; /* compared only where the mapping reads it */
+  ssSoftness softness;
+  ssRowFallback fallback;
+} SharedSoftness;
+
+static int sameLaw(const ssRowLaw* a, const ssRowLaw* b) {
+  return a->hard == b->hard && a->spring.stiffness == b->spring.stiffness && a->spring.damping == b->spring.damping &&
+         a->hard_rate_per_s == b->hard_rate_per_s;
+}
+
+/* Whether the row's law is the shared one's: by slot where both are in the law table (distinct there). */
+static int sharedLaw(const SharedSoftness* shared, const ssRowLaw* law, int law_slot) {
+  if (shared->law_slot >= 0 && law_slot >= 0) return shared->law_slot == law_slot;
+  return sameLaw(shared->law, law);
+}
+
 static int compareBodyCache(const void* a, const void* b) {
   uintptr_t x = (uintptr_t)((const BodyCache*)a)->body, y = (uintptr_t)((const BodyCache*)b)->body;
   return (x > y) - (x < y);
@@ -355,6 +417,17 @@ static void rebuildApplyCache(ssRegistry* registry) {
   registry->body_cache = cache;
   registry->body_cache_count = count;
   registry->report_mass_age = 0;
+  registry->law_count = 0;
+  for (int i = 0; i < registry->joint_count; ++i) {
+    JointBinding* binding = &registry->joints[i];
+    binding->law_slot = -1;
+    for (int j = 0; j < registry->law_count && binding->law_slot < 0; ++j)
+      if (sameLaw(&registry->laws[j], &binding->law)) binding->law_slot = j;
+    if (binding->law_slot < 0 && registry->law_count < kLawTableSize) {
+      registry->laws[registry->law_count] = binding->law;
+      binding->law_slot = registry->law_count++;
+    }
+  }
   registry->loaded_rows = 0;
   for (int i = 0; i < registry->joint_count; ++i) registry->loaded_rows += registry->joints[i].load != 0;
 }
@@ -396,12 +469,10 @@ static double rowMass(ssRegistry* registry, const JointBinding* binding) {
 /* The binding's mass for this Apply: given, or measured from the bodies when `measure` (every Apply of the accurate
  * mappings; every few of the implicit-Euler mapping, which needs it only for the Nyquist report), or the last one. NAN when the row has none (no dynamic body, or a
  * transmission): the accurate mappings then hand the row to the implicit-Euler mapping. */
-static double bindingMass(ssRegistry* registry, JointBinding* binding, int measure) {
+static double bindingMass(ssRegistry* registry, const JointBinding* binding, const ssRowLaw* law, int measure) {
   if (binding->effective_mass > 0) return binding->effective_mass;
-  if (binding->law.hard) return NAN;
-  if (!measure) return binding->report_mass;
-  binding->report_mass = rowMass(registry, binding);
-  return binding->report_mass;
+  if (law->hard) return NAN;
+  return measure ? rowMass(registry, binding) : binding->mass;
 }
 
 /* Whether two bindings drive rows along the same axis of the same joint (a stop and a motor). */
@@ -409,19 +480,6 @@ static int sharesRow(const JointBinding* a, const JointBinding* b) {
   int a_limit = a->param == SS_PARAM_STOP || a->param == SS_PARAM_MOTOR;
   int b_limit = b->param == SS_PARAM_STOP || b->param == SS_PARAM_MOTOR;
   return a->joint == b->joint && a->axis == b->axis && a_limit && b_limit;
-}
-
-/* One softness an Apply computed, for the rows with the same law and mass that follow. */
-typedef struct SharedSoftness {
-  ssRowLaw law;
-  double mass; /* compared only where the mapping reads it */
-  ssSoftness softness;
-  ssRowFallback fallback;
-} SharedSoftness;
-
-static int sameLaw(const ssRowLaw* a, const ssRowLaw* b) {
-  return a->hard == b->hard && a->spring.stiffness == b->spring.stiffness && a->spring.damping == b->spring.damping &&
-         a->hard_rate_per_s == b->hard_rate_per_s;
 }
 
 /* ODE counts steps: a count of seconds in steps of h, where a whole number of steps computed with rounding error
@@ -505,29 +563,31 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     registry->report_mass_age = measure ? kReportMassRefresh - 1 : registry->report_mass_age - 1;
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
+    PREFETCH_ROWS(registry, i);
+    const ssRowLaw* law = binding->law_slot >= 0 ? &registry->laws[binding->law_slot] : &binding->law;
     const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
     /* a stop and a motor on one axis move the same mass: computed once */
     int same_row = before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
-    double mass = same_row ? last_mass : bindingMass(registry, binding, measure);
+    double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
     last_mass = mass;
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
-    if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_mapping == mapping &&
-        binding->computed_mass == mass && binding->computed_step_s == step_s &&
-        binding->computed_previous_s == previous_s) {
-      countRow(&binding->law, mass, step_s, &binding->computed_fallback, &counts);
+    if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_mapping == mapping && binding->mass == mass &&
+        binding->computed_step_s == step_s && binding->computed_previous_s == previous_s) {
+      countRow(law, mass, step_s, &binding->computed_fallback, &counts);
       continue;
     }
-    int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || binding->law.hard;
+    binding->mass = mass;
+    int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
     const SharedSoftness* hit = NULL;
     for (int j = 0; j < shared_count && hit == NULL; ++j)
-      if (sameLaw(&shared[j].law, &binding->law) && (any_mass || shared[j].mass == mass)) hit = &shared[j];
+      if (sharedLaw(&shared[j], law, binding->law_slot) && (any_mass || shared[j].mass == mass)) hit = &shared[j];
     if (hit != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
-      countRow(&binding->law, mass, step_s, &hit->fallback, &counts);
+      countRow(law, mass, step_s, &hit->fallback, &counts);
     } else {
-      status = softnessFor(&binding->law, mapping, mass, step_s, previous_s, &counts, &binding->computed_fallback,
+      status = softnessFor(law, mapping, mass, step_s, previous_s, &counts, &binding->computed_fallback,
                            &binding->pending);
       /* the boundary with ODE: nothing outside limits.h's ranges is ever written */
       if (status == SS_OK) status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
@@ -535,13 +595,13 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
         binding->computed_step_s = NAN;
         return failBinding(status, binding);
       }
-      shared[shared_next] = (SharedSoftness){binding->law, mass, binding->pending, binding->computed_fallback};
+      shared[shared_next] =
+          (SharedSoftness){law, binding->law_slot, mass, binding->pending, binding->computed_fallback};
       shared_next = (shared_next + 1) % kSharedSize;
       if (shared_count < kSharedSize) shared_count += 1;
     }
     binding->computed_mapping = mapping; /* implicit Euler: enough that an accurate mapping never reuses it */
     if (mapping == SS_MAPPING_IMPLICIT_EULER) continue;
-    binding->computed_mass = mass;
     binding->computed_step_s = step_s;
     binding->computed_previous_s = previous_s;
   }
@@ -578,6 +638,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   }
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
+    PREFETCH_ROWS(registry, i);
     if (binding->pending.erp == binding->written.erp && binding->pending.cfm == binding->written.cfm) continue;
     ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
     binding->written = binding->pending;
@@ -615,8 +676,7 @@ static int reserve(void** items, int count, int more, int* capacity, size_t size
 }
 
 ssStatus ssRegistryReserve(ssRegistry* registry, int more_joints, int more_bodies) {
-  if (!reserve((void**)&registry->joints, registry->joint_count, more_joints, &registry->joint_capacity,
-               sizeof(JointBinding)) ||
+  if (!reserveJoints(registry, more_joints) ||
       !reserve((void**)&registry->bodies, registry->body_count, more_bodies, &registry->body_capacity,
                sizeof(ssBodyBinding)))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory reserving %d joint rows and %d bodies", more_joints,
