@@ -81,6 +81,7 @@ struct ssRegistry {
   /* the distinct laws of the bindings (programs bind many rows to a few springs), rebuilt with the body cache */
   ssRowLaw laws[kLawTableSize];
   int law_count;
+  int rows_outside_laws; /* bindings whose law did not fit in the table */
 };
 
 #define REQUIRE_REGISTRY(registry) \
@@ -428,6 +429,8 @@ static void rebuildApplyCache(ssRegistry* registry) {
       binding->law_slot = registry->law_count++;
     }
   }
+  registry->rows_outside_laws = 0;
+  for (int i = 0; i < registry->joint_count; ++i) registry->rows_outside_laws += registry->joints[i].law_slot < 0;
   registry->loaded_rows = 0;
   for (int i = 0; i < registry->joint_count; ++i) registry->loaded_rows += registry->joints[i].load != 0;
 }
@@ -467,8 +470,9 @@ static double rowMass(ssRegistry* registry, const JointBinding* binding) {
 }
 
 /* The binding's mass for this Apply: given, or measured from the bodies when `measure` (every Apply of the accurate
- * mappings; every few of the implicit-Euler mapping, which needs it only for the Nyquist report), or the last one. NAN when the row has none (no dynamic body, or a
- * transmission): the accurate mappings then hand the row to the implicit-Euler mapping. */
+ * mappings; every few of the implicit-Euler mapping, which needs it only for the Nyquist report), or the last one.
+ * NAN when the row has none (no dynamic body, or a transmission): the accurate mappings then hand the row to the
+ * implicit-Euler mapping. */
 static double bindingMass(ssRegistry* registry, const JointBinding* binding, const ssRowLaw* law, int measure) {
   if (binding->effective_mass > 0) return binding->effective_mass;
   if (law->hard) return NAN;
@@ -521,6 +525,144 @@ static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
   binding->written_step_s = step_s;
 }
 
+/* Apply's first pass in general: each row's mass and softness into pending, and the load corrections, all checked
+ * before anything is written. */
+static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step_s, double previous_s, int measure,
+                           ssApplyReport* counts) {
+  ssStatus status = SS_OK;
+  /* Programs bind many rows to a few springs, and many rows move equal masses (identical links, wheels, stop and
+   * motor on one axis): within one Apply the softness is a function of the law and (accurate mappings) the mass, so
+   * each distinct pair is computed once and shared. */
+  enum { kSharedSize = 8 };
+  SharedSoftness shared[kSharedSize];
+  int shared_count = 0, shared_next = 0;
+  double last_mass = NAN;
+  for (int i = 0; i < registry->joint_count; ++i) {
+    JointBinding* binding = &registry->joints[i];
+    PREFETCH_ROWS(registry, i);
+    const ssRowLaw* law = binding->law_slot >= 0 ? &registry->laws[binding->law_slot] : &binding->law;
+    const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
+    /* a stop and a motor on one axis move the same mass: computed once */
+    int same_row = before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
+    double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
+    last_mass = mass;
+    /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
+     * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
+    if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_mapping == mapping && binding->mass == mass &&
+        binding->computed_step_s == step_s && binding->computed_previous_s == previous_s) {
+      countRow(law, mass, step_s, &binding->computed_fallback, counts);
+      continue;
+    }
+    binding->mass = mass;
+    int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
+    const SharedSoftness* hit = NULL;
+    for (int j = 0; j < shared_count && hit == NULL; ++j)
+      if (sharedLaw(&shared[j], law, binding->law_slot) && (any_mass || shared[j].mass == mass)) hit = &shared[j];
+    if (hit != NULL) {
+      binding->pending = hit->softness;
+      binding->computed_fallback = hit->fallback;
+      countRow(law, mass, step_s, &hit->fallback, counts);
+    } else {
+      status = softnessFor(law, mapping, mass, step_s, previous_s, counts, &binding->computed_fallback,
+                           &binding->pending);
+      /* the boundary with ODE: nothing outside limits.h's ranges is ever written */
+      if (status == SS_OK) status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
+      if (status != SS_OK) {
+        binding->computed_step_s = NAN;
+        return failBinding(status, binding);
+      }
+      shared[shared_next] =
+          (SharedSoftness){law, binding->law_slot, mass, binding->pending, binding->computed_fallback};
+      shared_next = (shared_next + 1) % kSharedSize;
+      if (shared_count < kSharedSize) shared_count += 1;
+    }
+    binding->computed_mapping = mapping; /* implicit Euler: enough that an accurate mapping never reuses it */
+    if (mapping == SS_MAPPING_IMPLICIT_EULER) continue;
+    binding->computed_step_s = step_s;
+    binding->computed_previous_s = previous_s;
+  }
+
+  /* The load corrections, computed and bounded before anything is written. */
+  if (mapping != SS_MAPPING_IMPLICIT_EULER && registry->loaded_rows > 0) {
+    for (int i = 0; i < registry->joint_count; ++i) {
+      JointBinding* binding = &registry->joints[i];
+      binding->load_correction = 0;
+      const ssSpring* spring = &binding->law.spring;
+      if (binding->load == 0 || binding->law.hard || spring->stiffness == 0) continue;
+      /* the step's static stiffness is k' = erp/(h·cfm): this force puts the rest position back at load/k */
+      double static_stiffness = binding->pending.erp / (step_s * binding->pending.cfm);
+      double correction = binding->load * (static_stiffness / spring->stiffness - 1);
+      if (!(fabs(correction) <= SS_MAX_FORCE_N)) {
+        /* an accurate softness this far from the spring's static stiffness cannot carry the load: implicit Euler,
+         * whose static stiffness is k itself, serves the row (as for every row an accurate mapping cannot) */
+        status = ssSoftnessFromSpring(*spring, step_s, &binding->pending);
+        if (status != SS_OK) return failBinding(status, binding);
+        binding->computed_fallback = (ssRowFallback){0, 1};
+        counts->rows_implicit_euler_fallback += 1;
+        correction = 0;
+      }
+      binding->load_correction = correction;
+    }
+  }
+
+  return SS_OK;
+}
+
+/* Apply's second pass in general: the rows whose softness changed, then the load forces. */
+static void writeRows(ssRegistry* registry, ssMapping mapping) {
+  for (int i = 0; i < registry->joint_count; ++i) {
+    JointBinding* binding = &registry->joints[i];
+    PREFETCH_ROWS(registry, i);
+    if (binding->pending.erp == binding->written.erp && binding->pending.cfm == binding->written.cfm) continue;
+    ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
+    binding->written = binding->pending;
+  }
+  if (mapping != SS_MAPPING_IMPLICIT_EULER && registry->loaded_rows > 0) {
+    for (int i = 0; i < registry->joint_count; ++i) {
+      const JointBinding* binding = &registry->joints[i];
+      if (binding->load_correction != 0)
+        ssJointAddRowForce(binding->joint, binding->param, binding->axis, binding->load_correction);
+    }
+  }
+}
+
+/* Implicit Euler when every row's law is in the table: the softness of each law, checked (the only part that can
+ * fail), so that the rows can then be counted and written in one pass. */
+static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* softness) {
+  for (int j = 0; j < registry->law_count; ++j) {
+    ssStatus status = ssRowSoftness(&registry->laws[j], SS_MAPPING_IMPLICIT_EULER, NAN, step_s, 0, NULL, &softness[j]);
+    if (status == SS_OK) status = ssCheckSoftnessForOde("softness", softness[j].erp, softness[j].cfm);
+    if (status == SS_OK) continue;
+    for (int i = 0; i < registry->joint_count; ++i)
+      if (registry->joints[i].law_slot == j) return failBinding(status, &registry->joints[i]);
+    return status;
+  }
+  return SS_OK;
+}
+
+/* The one pass of lawSoftnesses' case: each row's mass for the Nyquist report, and its law's softness written
+ * where it changed. Nothing here can fail. */
+static void writeRowsByLaw(ssRegistry* registry, double step_s, int measure, const ssSoftness* softness,
+                           ssApplyReport* counts) {
+  double last_mass = NAN;
+  for (int i = 0; i < registry->joint_count; ++i) {
+    JointBinding* binding = &registry->joints[i];
+    PREFETCH_ROWS(registry, i);
+    const ssRowLaw* law = &registry->laws[binding->law_slot];
+    const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
+    int same_row = before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
+    double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
+    last_mass = mass;
+    binding->mass = mass;
+    binding->computed_mapping = SS_MAPPING_IMPLICIT_EULER;
+    if (!law->hard) counts->rows_over_nyquist += ssOverNyquist(law->spring, mass, step_s);
+    binding->pending = softness[binding->law_slot];
+    if (binding->pending.erp == binding->written.erp && binding->pending.cfm == binding->written.cfm) continue;
+    ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
+    binding->written = binding->pending;
+  }
+}
+
 ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
                           ssApplyReport* report) {
   REQUIRE_REGISTRY(registry);
@@ -550,106 +692,24 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
       status = ssCheckSoftnessForOde("softness", registry->world_pending.erp, registry->world_pending.cfm);
     if (status != SS_OK) return failBinding(status, NULL);
   }
-  /* Programs bind many rows to a few springs, and many rows move equal masses (identical links, wheels, stop and
-   * motor on one axis): within one Apply the softness is a function of the law and (accurate mappings) the mass, so
-   * each distinct pair is computed once and shared. */
-  enum { kSharedSize = 8 };
-  SharedSoftness shared[kSharedSize];
-  int shared_count = 0, shared_next = 0;
-  double previous_s = mapping == SS_MAPPING_EXACT ? previous_step_s : 0;
-  double last_mass = NAN;
   int measure = mapping != SS_MAPPING_IMPLICIT_EULER || registry->report_mass_age == 0;
+  int by_law = mapping == SS_MAPPING_IMPLICIT_EULER && registry->rows_outside_laws == 0;
+  ssSoftness law_softness[kLawTableSize];
+  status = by_law ? lawSoftnesses(registry, step_s, law_softness)
+                  : computeRows(registry, mapping, step_s, mapping == SS_MAPPING_EXACT ? previous_step_s : 0,
+                                measure, &counts);
+  if (status != SS_OK) return status;
+
+  /* Nothing below can fail. */
   if (mapping == SS_MAPPING_IMPLICIT_EULER)
     registry->report_mass_age = measure ? kReportMassRefresh - 1 : registry->report_mass_age - 1;
-  for (int i = 0; i < registry->joint_count; ++i) {
-    JointBinding* binding = &registry->joints[i];
-    PREFETCH_ROWS(registry, i);
-    const ssRowLaw* law = binding->law_slot >= 0 ? &registry->laws[binding->law_slot] : &binding->law;
-    const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
-    /* a stop and a motor on one axis move the same mass: computed once */
-    int same_row = before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
-    double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
-    last_mass = mass;
-    /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
-     * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
-    if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_mapping == mapping && binding->mass == mass &&
-        binding->computed_step_s == step_s && binding->computed_previous_s == previous_s) {
-      countRow(law, mass, step_s, &binding->computed_fallback, &counts);
-      continue;
-    }
-    binding->mass = mass;
-    int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
-    const SharedSoftness* hit = NULL;
-    for (int j = 0; j < shared_count && hit == NULL; ++j)
-      if (sharedLaw(&shared[j], law, binding->law_slot) && (any_mass || shared[j].mass == mass)) hit = &shared[j];
-    if (hit != NULL) {
-      binding->pending = hit->softness;
-      binding->computed_fallback = hit->fallback;
-      countRow(law, mass, step_s, &hit->fallback, &counts);
-    } else {
-      status = softnessFor(law, mapping, mass, step_s, previous_s, &counts, &binding->computed_fallback,
-                           &binding->pending);
-      /* the boundary with ODE: nothing outside limits.h's ranges is ever written */
-      if (status == SS_OK) status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
-      if (status != SS_OK) {
-        binding->computed_step_s = NAN;
-        return failBinding(status, binding);
-      }
-      shared[shared_next] =
-          (SharedSoftness){law, binding->law_slot, mass, binding->pending, binding->computed_fallback};
-      shared_next = (shared_next + 1) % kSharedSize;
-      if (shared_count < kSharedSize) shared_count += 1;
-    }
-    binding->computed_mapping = mapping; /* implicit Euler: enough that an accurate mapping never reuses it */
-    if (mapping == SS_MAPPING_IMPLICIT_EULER) continue;
-    binding->computed_step_s = step_s;
-    binding->computed_previous_s = previous_s;
-  }
-
-  /* The load corrections, computed and bounded before anything is written. */
-  int corrects_loads = mapping != SS_MAPPING_IMPLICIT_EULER && registry->loaded_rows > 0;
-  if (corrects_loads) {
-    for (int i = 0; i < registry->joint_count; ++i) {
-      JointBinding* binding = &registry->joints[i];
-      binding->load_correction = 0;
-      const ssSpring* spring = &binding->law.spring;
-      if (binding->load == 0 || binding->law.hard || spring->stiffness == 0) continue;
-      /* the step's static stiffness is k' = erp/(h·cfm): this force puts the rest position back at load/k */
-      double static_stiffness = binding->pending.erp / (step_s * binding->pending.cfm);
-      double correction = binding->load * (static_stiffness / spring->stiffness - 1);
-      if (!(fabs(correction) <= SS_MAX_FORCE_N)) {
-        /* an accurate softness this far from the spring's static stiffness cannot carry the load: implicit Euler,
-         * whose static stiffness is k itself, serves the row (as for every row an accurate mapping cannot) */
-        status = ssSoftnessFromSpring(*spring, step_s, &binding->pending);
-        if (status != SS_OK) return failBinding(status, binding);
-        binding->computed_fallback = (ssRowFallback){0, 1};
-        counts.rows_implicit_euler_fallback += 1;
-        correction = 0;
-      }
-      binding->load_correction = correction;
-    }
-  }
-
-  /* Second pass: nothing below can fail. */
   if (registry->world_bound) {
     dWorldSetERP(registry->world, registry->world_pending.erp);
     dWorldSetCFM(registry->world, registry->world_pending.cfm);
     counts.rows_written += 1;
   }
-  for (int i = 0; i < registry->joint_count; ++i) {
-    JointBinding* binding = &registry->joints[i];
-    PREFETCH_ROWS(registry, i);
-    if (binding->pending.erp == binding->written.erp && binding->pending.cfm == binding->written.cfm) continue;
-    ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
-    binding->written = binding->pending;
-  }
-  if (corrects_loads) {
-    for (int i = 0; i < registry->joint_count; ++i) {
-      const JointBinding* binding = &registry->joints[i];
-      if (binding->load_correction != 0)
-        ssJointAddRowForce(binding->joint, binding->param, binding->axis, binding->load_correction);
-    }
-  }
+  if (by_law) writeRowsByLaw(registry, step_s, measure, law_softness, &counts);
+  else writeRows(registry, mapping);
   counts.rows_written += registry->joint_count;
   for (int i = 0; i < registry->body_count; ++i) {
     ssBodyBinding* binding = &registry->bodies[i];
