@@ -557,7 +557,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
     const SharedSoftness* hit = NULL;
     for (int j = 0; j < shared_count && hit == NULL; ++j)
-      if (sharedLaw(&shared[j], law, binding->law_slot) && (any_mass || shared[j].mass == mass)) hit = &shared[j];
+      if ((any_mass || shared[j].mass == mass) && sharedLaw(&shared[j], law, binding->law_slot)) hit = &shared[j];
     if (hit != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
