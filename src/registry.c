@@ -14,26 +14,28 @@
 #include "steadystep/adopt.h"
 #include "steadystep/registry.h"
 
-/* Laid out by use, one cache line a group (the array is aligned to lines): what both of Apply's passes read for every
- * row; what the first pass reads; what only rows outside the registry's law table and rows with a load read. */
+/* Laid out by use, one cache line a group (the array is aligned to lines): what every Apply reads for every row
+ * (implicit Euler with its laws in the table reads nothing else, but every few Applies); what the other Applies'
+ * first pass reads; what only rows outside the registry's law table and rows with a load read. */
 typedef struct JointBinding {
   _Alignas(64) dJointID joint;
   ssRowWriter writer;    /* ODE's setter and parameter numbers for the row, resolved at bind time */
-  ssSoftness pending;    /* computed in Apply's first pass */
   ssSoftness written;    /* last written: the registry owns the row, so an unchanged value is not written again */
   ssJointParam param;
   int axis;
-
-  double effective_mass; /* 0: computed from the bodies at each Apply */
+  int law_slot; /* the law in the registry's table; -1: not there, read law */
   /* the mass the last Apply gave the row (NAN: none): the input of its softness under the accurate mappings, and
    * under implicit Euler, which needs it only for the Nyquist report, the one measured every few Applies */
   double mass;
+
+  ssSoftness pending; /* computed in the general first pass */
+  double effective_mass; /* 0: computed from the bodies at each Apply */
   /* what pending was computed from besides the mass: the mappings are pure functions, so equal inputs reuse it */
   double computed_step_s, computed_previous_s;
   int body_slot[2]; /* the joint's bodies in the registry's body cache; -1: none or not known */
-  int law_slot;     /* the law in the registry's table; -1: not there, read law */
   int joint_type;   /* dJointGetType, resolved at bind time: a joint's type never changes */
   ssMapping computed_mapping;
+  unsigned computed_epoch; /* the registry's reuse_epoch when computed: an implicit-Euler Apply since voids it */
   ssRowFallback computed_fallback;
 
   ssRowLaw law;
@@ -82,6 +84,7 @@ struct ssRegistry {
   ssRowLaw laws[kLawTableSize];
   int law_count;
   int rows_outside_laws; /* bindings whose law did not fit in the table */
+  unsigned reuse_epoch;  /* changes at every implicit-Euler Apply, which leaves the rows' pending behind */
 };
 
 #define REQUIRE_REGISTRY(registry) \
@@ -133,12 +136,11 @@ ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effe
  * are asked for while this one is worked on. */
 enum { kPrefetchAhead = 8 };
 #if defined(__GNUC__)
-#define PREFETCH_ROWS(registry, i)                                                         \
+#define PREFETCH_ROWS(registry, i, lines)                                                  \
   do {                                                                                     \
     if ((i) + kPrefetchAhead < (registry)->joint_count) {                                  \
       const char* ahead = (const char*)&(registry)->joints[(i) + kPrefetchAhead];          \
-      __builtin_prefetch(ahead, 1);                                                        \
-      __builtin_prefetch(ahead + 64, 1);                                                   \
+      for (int line = 0; line < (lines); ++line) __builtin_prefetch(ahead + 64 * line, 1); \
     }                                                                                      \
     if ((i) + kPrefetchAhead / 2 < (registry)->joint_count) {                              \
       const char* joint = (const char*)(registry)->joints[(i) + kPrefetchAhead / 2].joint; \
@@ -147,7 +149,7 @@ enum { kPrefetchAhead = 8 };
     }                                                                                      \
   } while (0)
 #else
-#define PREFETCH_ROWS(registry, i) ((void)0)
+#define PREFETCH_ROWS(registry, i, lines) ((void)0)
 #endif
 
 /* Room for `more` joint bindings, in an array aligned to cache lines (JointBinding's groups are lines). */
@@ -539,7 +541,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
   double last_mass = NAN;
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
-    PREFETCH_ROWS(registry, i);
+    PREFETCH_ROWS(registry, i, 2);
     const ssRowLaw* law = binding->law_slot >= 0 ? &registry->laws[binding->law_slot] : &binding->law;
     const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
     /* a stop and a motor on one axis move the same mass: computed once */
@@ -548,8 +550,9 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     last_mass = mass;
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
-    if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_mapping == mapping && binding->mass == mass &&
-        binding->computed_step_s == step_s && binding->computed_previous_s == previous_s) {
+    if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_epoch == registry->reuse_epoch &&
+        binding->computed_mapping == mapping && binding->mass == mass && binding->computed_step_s == step_s &&
+        binding->computed_previous_s == previous_s) {
       countRow(law, mass, step_s, &binding->computed_fallback, counts);
       continue;
     }
@@ -576,8 +579,9 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       shared_next = (shared_next + 1) % kSharedSize;
       if (shared_count < kSharedSize) shared_count += 1;
     }
-    binding->computed_mapping = mapping; /* implicit Euler: enough that an accurate mapping never reuses it */
+    binding->computed_mapping = mapping; /* implicit Euler: an accurate mapping never reuses this pending */
     if (mapping == SS_MAPPING_IMPLICIT_EULER) continue;
+    binding->computed_epoch = registry->reuse_epoch;
     binding->computed_step_s = step_s;
     binding->computed_previous_s = previous_s;
   }
@@ -612,7 +616,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
 static void writeRows(ssRegistry* registry, ssMapping mapping) {
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
-    PREFETCH_ROWS(registry, i);
+    PREFETCH_ROWS(registry, i, 2);
     if (binding->pending.erp == binding->written.erp && binding->pending.cfm == binding->written.cfm) continue;
     ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
     binding->written = binding->pending;
@@ -641,25 +645,27 @@ static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* s
 }
 
 /* The one pass of lawSoftnesses' case: each row's mass for the Nyquist report, and its law's softness written
- * where it changed. Nothing here can fail. */
+ * where it changed. Nothing here can fail. Between the Applies that measure the masses, it reads each row's first
+ * cache line and nothing else. */
 static void writeRowsByLaw(ssRegistry* registry, double step_s, int measure, const ssSoftness* softness,
                            ssApplyReport* counts) {
   double last_mass = NAN;
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
-    PREFETCH_ROWS(registry, i);
+    PREFETCH_ROWS(registry, i, measure ? 2 : 1);
     const ssRowLaw* law = &registry->laws[binding->law_slot];
-    const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
-    int same_row = before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
-    double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
-    last_mass = mass;
-    binding->mass = mass;
-    binding->computed_mapping = SS_MAPPING_IMPLICIT_EULER;
-    if (!law->hard) counts->rows_over_nyquist += ssOverNyquist(law->spring, mass, step_s);
-    binding->pending = softness[binding->law_slot];
-    if (binding->pending.erp == binding->written.erp && binding->pending.cfm == binding->written.cfm) continue;
-    ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
-    binding->written = binding->pending;
+    if (measure) {
+      const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
+      int same_row =
+          before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
+      binding->mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
+      last_mass = binding->mass;
+    }
+    if (!law->hard) counts->rows_over_nyquist += ssOverNyquist(law->spring, binding->mass, step_s);
+    const ssSoftness* law_softness = &softness[binding->law_slot];
+    if (law_softness->erp == binding->written.erp && law_softness->cfm == binding->written.cfm) continue;
+    ssRowWrite(&binding->writer, binding->joint, law_softness->erp, law_softness->cfm);
+    binding->written = *law_softness;
   }
 }
 
@@ -701,8 +707,10 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   if (status != SS_OK) return status;
 
   /* Nothing below can fail. */
-  if (mapping == SS_MAPPING_IMPLICIT_EULER)
+  if (mapping == SS_MAPPING_IMPLICIT_EULER) {
     registry->report_mass_age = measure ? kReportMassRefresh - 1 : registry->report_mass_age - 1;
+    registry->reuse_epoch += 1;
+  }
   if (registry->world_bound) {
     dWorldSetERP(registry->world, registry->world_pending.erp);
     dWorldSetCFM(registry->world, registry->world_pending.cfm);
