@@ -188,6 +188,22 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
   const dReal* I = mass.I; /* rows of 4 */
   double a00 = I[0], a01 = I[1], a02 = I[2], a10 = I[4], a11 = I[5], a12 = I[6], a20 = I[8], a21 = I[9],
          a22 = I[10];
+  const dReal* R = dBodyGetRotation(body); /* rows of 4 */
+  if (a01 == 0 && a02 == 0 && a10 == 0 && a12 == 0 && a20 == 0 && a21 == 0) {
+    /* principal axes along the body's (boxes, spheres, capsules, cylinders): R·diag(1/I)·Rᵀ, symmetric, in half the
+     * products of the general case */
+    if (!(a00 > 0 && a11 > 0 && a22 > 0)) {
+      for (int i = 0; i < 9; ++i) out->inverse_inertia[i] = 0;
+      return;
+    }
+    double inverse[3] = {1.0 / a00, 1.0 / a11, 1.0 / a22};
+    for (int i = 0; i < 3; ++i)
+      for (int j = i; j < 3; ++j)
+        out->inverse_inertia[3 * i + j] = out->inverse_inertia[3 * j + i] =
+            R[4 * i] * inverse[0] * R[4 * j] + R[4 * i + 1] * inverse[1] * R[4 * j + 1] +
+            R[4 * i + 2] * inverse[2] * R[4 * j + 2];
+    return;
+  }
   double c0 = a11 * a22 - a12 * a21, c1 = a12 * a20 - a10 * a22, c2 = a10 * a21 - a11 * a20;
   double det = a00 * c0 + a01 * c1 + a02 * c2;
   if (!(det > 0)) {
@@ -199,8 +215,7 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
       {c0 * inv_det, (a02 * a21 - a01 * a22) * inv_det, (a01 * a12 - a02 * a11) * inv_det},
       {c1 * inv_det, (a00 * a22 - a02 * a20) * inv_det, (a02 * a10 - a00 * a12) * inv_det},
       {c2 * inv_det, (a01 * a20 - a00 * a21) * inv_det, (a00 * a11 - a01 * a10) * inv_det}};
-  /* world frame: R·I_body⁻¹·Rᵀ, R in rows of 4 */
-  const dReal* R = dBodyGetRotation(body);
+  /* world frame: R·I_body⁻¹·Rᵀ */
   double r_inverse[3][3];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
