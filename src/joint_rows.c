@@ -162,12 +162,6 @@ void ssJointRowWriterOf(dJointID joint, ssJointParam param, int axis, ssRowWrite
   if (erp_param >= 0) setterOf(type, axis, erp_param, &out->erp_number);
 }
 
-void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm) {
-  ssRowWriter writer;
-  ssJointRowWriterOf(joint, param, axis, &writer);
-  ssRowWrite(&writer, joint, erp, cfm);
-}
-
 static int isDynamic(dBodyID body) { return body != 0 && !dBodyIsKinematic(body); }
 
 void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {

@@ -12,11 +12,9 @@ const char* ssJointTypeName(dJointID joint);
 /* A short name of a parameter set for messages ("stop", "motor", ...), or NULL for an unknown value. */
 const char* ssJointParamName(ssJointParam param);
 
-/* Writes the row's softness. The joint must support param on axis (ssJointSupports). MOTOR rows write only cfm. */
-void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm);
-
 /* How to write one row's softness, resolved once (a joint's type never changes): ODE's setter for the joint's type
- * and the parameter numbers of erp (-1: none, a motor row) and cfm. set is NULL for a row without softness. */
+ * and the parameter numbers of erp (-1: none, a motor row) and cfm. set is NULL for a row without softness. The
+ * joint must support param on axis (ssJointSupports). */
 typedef void (*ssParamSetter)(dJointID joint, int parameter, dReal value);
 typedef struct ssRowWriter {
   ssParamSetter set;
@@ -25,7 +23,8 @@ typedef struct ssRowWriter {
 
 void ssJointRowWriterOf(dJointID joint, ssJointParam param, int axis, ssRowWriter* out);
 
-/* ssJointWriteSoftness through a resolved writer: what the registry does for every row at every Apply. */
+/* Writes the row's softness through its writer (MOTOR rows write only cfm): what the registry does for every row at
+ * every Apply. */
 static inline void ssRowWrite(const ssRowWriter* writer, dJointID joint, double erp, double cfm) {
   if (writer->set == NULL) return;
   if (writer->erp_number >= 0) writer->set(joint, writer->erp_number, erp);
