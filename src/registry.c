@@ -527,10 +527,12 @@ static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
   binding->written_step_s = step_s;
 }
 
+static int sameSoftness(const ssSoftness* a, const ssSoftness* b) { return a->erp == b->erp && a->cfm == b->cfm; }
+
 /* Apply's first pass in general: each row's mass and softness into pending, and the load corrections, all checked
  * before anything is written. */
 static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step_s, double previous_s, int measure,
-                           ssApplyReport* counts) {
+                           ssApplyReport* counts, int* unwritten) {
   ssStatus status = SS_OK;
   /* Programs bind many rows to a few springs, and many rows move equal masses (identical links, wheels, stop and
    * motor on one axis): within one Apply the softness is a function of the law and (accurate mappings) the mass, so
@@ -554,6 +556,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
         binding->computed_mapping == mapping && binding->mass == mass && binding->computed_step_s == step_s &&
         binding->computed_previous_s == previous_s) {
       countRow(law, mass, step_s, &binding->computed_fallback, counts);
+      *unwritten += !sameSoftness(&binding->pending, &binding->written);
       continue;
     }
     binding->mass = mass;
@@ -579,6 +582,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       shared_next = (shared_next + 1) % kSharedSize;
       if (shared_count < kSharedSize) shared_count += 1;
     }
+    *unwritten += !sameSoftness(&binding->pending, &binding->written);
     binding->computed_mapping = mapping; /* implicit Euler: an accurate mapping never reuses this pending */
     if (mapping == SS_MAPPING_IMPLICIT_EULER) continue;
     binding->computed_epoch = registry->reuse_epoch;
@@ -617,7 +621,7 @@ static void writeRows(ssRegistry* registry, ssMapping mapping) {
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
     PREFETCH_ROWS(registry, i, 2);
-    if (binding->pending.erp == binding->written.erp && binding->pending.cfm == binding->written.cfm) continue;
+    if (sameSoftness(&binding->pending, &binding->written)) continue;
     ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
     binding->written = binding->pending;
   }
@@ -701,9 +705,10 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   int measure = mapping != SS_MAPPING_IMPLICIT_EULER || registry->report_mass_age == 0;
   int by_law = mapping == SS_MAPPING_IMPLICIT_EULER && registry->rows_outside_laws == 0;
   ssSoftness law_softness[kLawTableSize];
+  int unwritten = 0; /* rows whose pending differs from what ODE holds: with none (constant steps), no second pass */
   status = by_law ? lawSoftnesses(registry, step_s, law_softness)
                   : computeRows(registry, mapping, step_s, mapping == SS_MAPPING_EXACT ? previous_step_s : 0,
-                                measure, &counts);
+                                measure, &counts, &unwritten);
   if (status != SS_OK) return status;
 
   /* Nothing below can fail. */
@@ -717,7 +722,8 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     counts.rows_written += 1;
   }
   if (by_law) writeRowsByLaw(registry, step_s, measure, law_softness, &counts);
-  else writeRows(registry, mapping);
+  else if (unwritten > 0 || (mapping != SS_MAPPING_IMPLICIT_EULER && registry->loaded_rows > 0))
+    writeRows(registry, mapping);
   counts.rows_written += registry->joint_count;
   for (int i = 0; i < registry->body_count; ++i) {
     ssBodyBinding* binding = &registry->bodies[i];
