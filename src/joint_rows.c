@@ -3,6 +3,7 @@
 #include "joint_rows.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "error.h"
 
@@ -79,29 +80,32 @@ int ssJointSupports(dJointID joint, ssJointParam param, int axis) {
 /* ODE's parameter number for a set on an axis: groups are 0x100 apart (dParamGroup). */
 static int groupParam(int param, int axis) { return param + (axis - 1) * dParamGroup; }
 
-static void setParam(dJointID joint, int axis, int param, double value) {
-  switch (dJointGetType(joint)) {
-    case dJointTypeBall: dJointSetBallParam(joint, param, value); break;
-    case dJointTypeFixed: dJointSetFixedParam(joint, param, value); break;
-    case dJointTypeDBall: dJointSetDBallParam(joint, param, value); break;
-    case dJointTypeDHinge: dJointSetDHingeParam(joint, param, value); break;
-    case dJointTypeTransmission: dJointSetTransmissionParam(joint, param, value); break;
-    case dJointTypeHinge: dJointSetHingeParam(joint, param, value); break;
-    case dJointTypeSlider: dJointSetSliderParam(joint, param, value); break;
-    case dJointTypeUniversal: dJointSetUniversalParam(joint, groupParam(param, axis), value); break;
-    case dJointTypeHinge2: dJointSetHinge2Param(joint, groupParam(param, axis), value); break;
-    case dJointTypePR: dJointSetPRParam(joint, groupParam(param, axis), value); break;
-    case dJointTypePU: dJointSetPUParam(joint, groupParam(param, axis), value); break;
-    case dJointTypePiston: dJointSetPistonParam(joint, groupParam(param, axis), value); break;
-    case dJointTypeAMotor: dJointSetAMotorParam(joint, groupParam(param, axis), value); break;
-    case dJointTypeLMotor: dJointSetLMotorParam(joint, groupParam(param, axis), value); break;
-    case dJointTypePlane2D:
-      /* plane-2D has one function per axis instead of groups */
-      if (axis == 1) dJointSetPlane2DXParam(joint, param, value);
-      else if (axis == 2) dJointSetPlane2DYParam(joint, param, value);
-      else dJointSetPlane2DAngleParam(joint, param, value);
-      break;
+/* ODE's setter for a joint type's parameters, and in *number the number of param on axis for it; NULL for a type
+ * without soft parameters. */
+static ssParamSetter setterOf(int type, int axis, int param, int* number) {
+  *number = param;
+  switch (type) {
+    case dJointTypeBall: return dJointSetBallParam;
+    case dJointTypeFixed: return dJointSetFixedParam;
+    case dJointTypeDBall: return dJointSetDBallParam;
+    case dJointTypeDHinge: return dJointSetDHingeParam;
+    case dJointTypeTransmission: return dJointSetTransmissionParam;
+    case dJointTypeHinge: return dJointSetHingeParam;
+    case dJointTypeSlider: return dJointSetSliderParam;
+    case dJointTypePlane2D: /* one function per axis instead of groups */
+      return axis == 1 ? dJointSetPlane2DXParam : axis == 2 ? dJointSetPlane2DYParam : dJointSetPlane2DAngleParam;
     default: break;
+  }
+  *number = groupParam(param, axis);
+  switch (type) {
+    case dJointTypeUniversal: return dJointSetUniversalParam;
+    case dJointTypeHinge2: return dJointSetHinge2Param;
+    case dJointTypePR: return dJointSetPRParam;
+    case dJointTypePU: return dJointSetPUParam;
+    case dJointTypePiston: return dJointSetPistonParam;
+    case dJointTypeAMotor: return dJointSetAMotorParam;
+    case dJointTypeLMotor: return dJointSetLMotorParam;
+    default: return NULL;
   }
 }
 
@@ -149,63 +153,93 @@ void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* e
 
 int ssJointLimitAxisCount(dJointID joint) { return limitAxisCount(joint); }
 
-void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm) {
+void ssJointRowWriterOf(dJointID joint, ssJointParam param, int axis, ssRowWriter* out) {
   int erp_param, cfm_param;
+  *out = (ssRowWriter){NULL, -1, -1};
   if (!softnessParams(param, &erp_param, &cfm_param)) return;
-  if (erp_param >= 0) setParam(joint, axis, erp_param, erp);
-  setParam(joint, axis, cfm_param, cfm);
-}
-
-/* d·I⁻¹d for a body's world-frame inertia I = R I_body Rᵀ, solving I_body y = Rᵀd by Cramer's rule. */
-static double inverseInertiaAlong(dBodyID body, const dReal* d) {
-  dMass mass;
-  dBodyGetMass(body, &mass);
-  const dReal* R = dBodyGetRotation(body); /* rows of 4: R[4*i + j] */
-  double b[3];
-  for (int j = 0; j < 3; ++j) b[j] = R[j] * d[0] + R[4 + j] * d[1] + R[8 + j] * d[2];
-  const dReal* I = mass.I;
-  double a00 = I[0], a01 = I[1], a02 = I[2], a10 = I[4], a11 = I[5], a12 = I[6], a20 = I[8], a21 = I[9],
-         a22 = I[10];
-  double c0 = a11 * a22 - a12 * a21, c1 = a12 * a20 - a10 * a22, c2 = a10 * a21 - a11 * a20;
-  double det = a00 * c0 + a01 * c1 + a02 * c2;
-  if (det <= 0) return 0;
-  double y0 = (b[0] * c0 + a01 * (a12 * b[2] - b[1] * a22) + a02 * (b[1] * a21 - a11 * b[2])) / det;
-  double y1 = (a00 * (b[1] * a22 - a12 * b[2]) + b[0] * c1 + a02 * (a10 * b[2] - b[1] * a20)) / det;
-  double y2 = (a00 * (a11 * b[2] - b[1] * a21) + a01 * (b[1] * a20 - a10 * b[2]) + b[0] * c2) / det;
-  return b[0] * y0 + b[1] * y1 + b[2] * y2;
+  int type = dJointGetType(joint);
+  out->set = setterOf(type, axis, cfm_param, &out->cfm_number);
+  if (erp_param >= 0) setterOf(type, axis, erp_param, &out->erp_number);
 }
 
 static int isDynamic(dBodyID body) { return body != 0 && !dBodyIsKinematic(body); }
 
+void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
+  /* every field written without memset, whose startup costs more than the rest on the registry's path */
+  out->dynamic = isDynamic(body);
+  if (!out->dynamic) {
+    out->inverse_mass = 0;
+    for (int i = 0; i < 9; ++i) out->inverse_inertia[i] = 0;
+    out->position[0] = out->position[1] = out->position[2] = 0;
+    return;
+  }
+  dMass mass;
+  dBodyGetMass(body, &mass);
+  out->inverse_mass = 1.0 / mass.mass;
+  const dReal* p = dBodyGetPosition(body);
+  out->position[0] = p[0], out->position[1] = p[1], out->position[2] = p[2];
+  /* I_body⁻¹ by its adjugate; a singular or indefinite inertia resists no rotation here (its inverse counts 0) */
+  const dReal* I = mass.I; /* rows of 4 */
+  double a00 = I[0], a01 = I[1], a02 = I[2], a10 = I[4], a11 = I[5], a12 = I[6], a20 = I[8], a21 = I[9],
+         a22 = I[10];
+  const dReal* R = dBodyGetRotation(body); /* rows of 4 */
+  if (a01 == 0 && a02 == 0 && a10 == 0 && a12 == 0 && a20 == 0 && a21 == 0) {
+    /* principal axes along the body's (boxes, spheres, capsules, cylinders): R·diag(1/I)·Rᵀ, symmetric, in half the
+     * products of the general case */
+    if (!(a00 > 0 && a11 > 0 && a22 > 0)) {
+      for (int i = 0; i < 9; ++i) out->inverse_inertia[i] = 0;
+      return;
+    }
+    double inverse[3] = {1.0 / a00, 1.0 / a11, 1.0 / a22};
+    for (int i = 0; i < 3; ++i)
+      for (int j = i; j < 3; ++j)
+        out->inverse_inertia[3 * i + j] = out->inverse_inertia[3 * j + i] =
+            R[4 * i] * inverse[0] * R[4 * j] + R[4 * i + 1] * inverse[1] * R[4 * j + 1] +
+            R[4 * i + 2] * inverse[2] * R[4 * j + 2];
+    return;
+  }
+  double c0 = a11 * a22 - a12 * a21, c1 = a12 * a20 - a10 * a22, c2 = a10 * a21 - a11 * a20;
+  double det = a00 * c0 + a01 * c1 + a02 * c2;
+  if (!(det > 0)) {
+    for (int i = 0; i < 9; ++i) out->inverse_inertia[i] = 0;
+    return;
+  }
+  double inv_det = 1.0 / det;
+  double body_inverse[3][3] = {
+      {c0 * inv_det, (a02 * a21 - a01 * a22) * inv_det, (a01 * a12 - a02 * a11) * inv_det},
+      {c1 * inv_det, (a00 * a22 - a02 * a20) * inv_det, (a02 * a10 - a00 * a12) * inv_det},
+      {c2 * inv_det, (a01 * a20 - a00 * a21) * inv_det, (a00 * a11 - a01 * a10) * inv_det}};
+  /* world frame: R·I_body⁻¹·Rᵀ */
+  double r_inverse[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      r_inverse[i][j] =
+          R[4 * i] * body_inverse[0][j] + R[4 * i + 1] * body_inverse[1][j] + R[4 * i + 2] * body_inverse[2][j];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      out->inverse_inertia[3 * i + j] =
+          r_inverse[i][0] * R[4 * j] + r_inverse[i][1] * R[4 * j + 1] + r_inverse[i][2] * R[4 * j + 2];
+}
+
 double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, const dReal* point, int angular) {
+  ssRowGeometry row = {{direction[0], direction[1], direction[2]}, {0, 0, 0}, angular, point != NULL};
+  if (point != NULL) row.point[0] = point[0], row.point[1] = point[1], row.point[2] = point[2];
   dBodyID bodies[2] = {body1, body2};
   double inverse = 0;
   for (int i = 0; i < 2; ++i) {
-    if (!isDynamic(bodies[i])) continue;
-    if (angular) {
-      inverse += inverseInertiaAlong(bodies[i], direction);
-      continue;
-    }
-    dMass mass;
-    dBodyGetMass(bodies[i], &mass);
-    inverse += 1.0 / mass.mass;
-    if (point != NULL) {
-      const dReal* p = dBodyGetPosition(bodies[i]);
-      dVector3 r = {point[0] - p[0], point[1] - p[1], point[2] - p[2], 0};
-      dVector3 rxd;
-      dCalcVectorCross3(rxd, r, direction);
-      inverse += inverseInertiaAlong(bodies[i], rxd);
-    }
+    ssBodyInverse body;
+    ssBodyInverseOf(bodies[i], &body);
+    inverse += ssRowInverseMass(&body, &row);
   }
   return inverse > 0 ? 1.0 / inverse : 0;
 }
 
 /* The row's direction, whether it is angular, and (for a linear row whose point matters) its point. */
-static int rowGeometry(dJointID joint, ssJointParam param, int axis, dVector3 direction, dVector3 point,
+static int rowGeometry(dJointID joint, int type, ssJointParam param, int axis, dVector3 direction, dVector3 point,
                        int* angular, int* has_point) {
   *angular = 0;
   *has_point = 0;
-  switch (dJointGetType(joint)) {
+  switch (type) {
     case dJointTypeHinge: dJointGetHingeAxis(joint, direction); *angular = 1; return 1;
     case dJointTypeSlider: dJointGetSliderAxis(joint, direction); return 1;
     case dJointTypeUniversal:
@@ -245,8 +279,16 @@ static int rowGeometry(dJointID joint, ssJointParam param, int axis, dVector3 di
       dJointGetPistonAxis(joint, direction);
       *angular = axis == 2;
       return 1;
-    case dJointTypeAMotor: dJointGetAMotorAxis(joint, axis - 1, direction); *angular = 1; return 1;
-    case dJointTypeLMotor: dJointGetLMotorAxis(joint, axis - 1, direction); return 1;
+    /* a motor's axes can be fewer than when the row was bound */
+    case dJointTypeAMotor:
+      if (axis > dJointGetAMotorNumAxes(joint)) return 0;
+      dJointGetAMotorAxis(joint, axis - 1, direction);
+      *angular = 1;
+      return 1;
+    case dJointTypeLMotor:
+      if (axis > dJointGetLMotorNumAxes(joint)) return 0;
+      dJointGetLMotorAxis(joint, axis - 1, direction);
+      return 1;
     case dJointTypePlane2D:
       direction[0] = axis == 1;
       direction[1] = axis == 2;
@@ -265,6 +307,15 @@ static int rowGeometry(dJointID joint, ssJointParam param, int axis, dVector3 di
   }
 }
 
+int ssJointRowGeometry(dJointID joint, int type, ssJointParam param, int axis, ssRowGeometry* out) {
+  dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
+  int angular, has_point;
+  if (!rowGeometry(joint, type, param, axis, direction, point, &angular, &has_point)) return 0;
+  *out = (ssRowGeometry){{direction[0], direction[1], direction[2]}, {point[0], point[1], point[2]}, angular,
+                         has_point};
+  return 1;
+}
+
 ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, double* mass) {
   if (joint == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "joint = NULL: a joint is required");
   if (mass == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "mass = NULL: needs somewhere to write the mass");
@@ -276,7 +327,7 @@ ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, doub
     return ssFail(SS_ERROR_OUT_OF_RANGE, "the %s joint has no dynamic body attached", ssJointTypeName(joint));
   dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
   int angular, has_point;
-  if (!rowGeometry(joint, param, axis, direction, point, &angular, &has_point))
+  if (!rowGeometry(joint, dJointGetType(joint), param, axis, direction, point, &angular, &has_point))
     return ssFail(SS_ERROR_UNSUPPORTED, "the effective mass of a %s joint's rows is not defined: give it",
                   ssJointTypeName(joint));
   double value = ssRowEffectiveMass(dJointGetBody(joint, 0), dJointGetBody(joint, 1), direction,
@@ -296,7 +347,7 @@ void ssJointAddRowForce(dJointID joint, ssJointParam param, int axis, double for
   if (dJointGetBody(joint, 0) == 0) return; /* detached: no row, and ODE's getters would assert */
   dVector3 direction = {0, 0, 0, 0}, point = {0, 0, 0, 0};
   int angular, has_point;
-  if (!rowGeometry(joint, param, axis, direction, point, &angular, &has_point)) return;
+  if (!rowGeometry(joint, dJointGetType(joint), param, axis, direction, point, &angular, &has_point)) return;
   for (int side = 0; side < 2; ++side) {
     dBodyID body = dJointGetBody(joint, side);
     if (!isDynamic(body)) continue;

@@ -12,8 +12,24 @@ const char* ssJointTypeName(dJointID joint);
 /* A short name of a parameter set for messages ("stop", "motor", ...), or NULL for an unknown value. */
 const char* ssJointParamName(ssJointParam param);
 
-/* Writes the row's softness. The joint must support param on axis (ssJointSupports). MOTOR rows write only cfm. */
-void ssJointWriteSoftness(dJointID joint, ssJointParam param, int axis, double erp, double cfm);
+/* How to write one row's softness, resolved once (a joint's type never changes): ODE's setter for the joint's type
+ * and the parameter numbers of erp (-1: none, a motor row) and cfm. set is NULL for a row without softness. The
+ * joint must support param on axis (ssJointSupports). */
+typedef void (*ssParamSetter)(dJointID joint, int parameter, dReal value);
+typedef struct ssRowWriter {
+  ssParamSetter set;
+  int erp_number, cfm_number;
+} ssRowWriter;
+
+void ssJointRowWriterOf(dJointID joint, ssJointParam param, int axis, ssRowWriter* out);
+
+/* Writes the row's softness through its writer (MOTOR rows write only cfm): what the registry does for every row at
+ * every Apply. */
+static inline void ssRowWrite(const ssRowWriter* writer, dJointID joint, double erp, double cfm) {
+  if (writer->set == NULL) return;
+  if (writer->erp_number >= 0) writer->set(joint, writer->erp_number, erp);
+  writer->set(joint, writer->cfm_number, cfm);
+}
 
 /* Reads the row's softness as ODE holds it (MOTOR rows: erp 0 and the motor's cfm). NAN for plane-2D, which ODE 0.16
  * cannot read back. */
@@ -22,9 +38,58 @@ void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* e
 /* The number of limit/motor axes of the joint's type (0: none). */
 int ssJointLimitAxisCount(dJointID joint);
 
+/* What a body opposes to a row's motion, read once per step and shared by all the rows on it: inverse mass (1/kg),
+ * world-frame inverse inertia (1/(kg·m²), row-major 3x3) and centre (m). All 0 for the static world (body 0) and
+ * kinematic bodies (dynamic 0); the inertia part is 0 for an inertia that is not positive definite. */
+typedef struct ssBodyInverse {
+  double inverse_mass;
+  double inverse_inertia[9];
+  double position[3];
+  int dynamic;
+} ssBodyInverse;
+
+void ssBodyInverseOf(dBodyID body, ssBodyInverse* out);
+
+/* A row's unit direction (world frame), whether it is angular, and for a linear row whose point matters (hinge-2
+ * suspension) that point (m). */
+typedef struct ssRowGeometry {
+  double direction[3];
+  double point[3];
+  int angular;
+  int has_point;
+} ssRowGeometry;
+
+/* The geometry of a row of a joint of ODE type `type` that supports param on axis (checked at bind time), whose first
+ * body the caller found attached (ODE's axis getters assert on it). 0 when the row has none to measure: a motor has
+ * fewer axes now, or the type's mass is not defined (transmission). */
+int ssJointRowGeometry(dJointID joint, int type, ssJointParam param, int axis, ssRowGeometry* out);
+
+/* d·I⁻¹d in the world frame. */
+static inline double ssInverseInertiaAlong(const ssBodyInverse* body, const double* d) {
+  const double* M = body->inverse_inertia;
+  return d[0] * (M[0] * d[0] + M[1] * d[1] + M[2] * d[2]) + d[1] * (M[3] * d[0] + M[4] * d[1] + M[5] * d[2]) +
+         d[2] * (M[6] * d[0] + M[7] * d[1] + M[8] * d[2]);
+}
+
+/* One body's share of the row's inverse effective mass: 1/m + (r x d)·I⁻¹(r x d) (linear) or d·I⁻¹d (angular).
+ * Inline: the registry asks it of every row's bodies at every Apply of an accurate mapping. */
+static inline double ssRowInverseMass(const ssBodyInverse* body, const ssRowGeometry* row) {
+  if (!body->dynamic) return 0;
+  if (row->angular) return ssInverseInertiaAlong(body, row->direction);
+  double inverse = body->inverse_mass;
+  if (row->has_point) {
+    const double* p = body->position;
+    double r[3] = {row->point[0] - p[0], row->point[1] - p[1], row->point[2] - p[2]};
+    const double* d = row->direction;
+    double rxd[3] = {r[1] * d[2] - r[2] * d[1], r[2] * d[0] - r[0] * d[2], r[0] * d[1] - r[1] * d[0]};
+    inverse += ssInverseInertiaAlong(body, rxd);
+  }
+  return inverse;
+}
+
 /* The effective mass of a row along (linear) or about (angular) the unit direction `direction` through world point
- * `point` (linear rows only), from body1 and body2 (0 for the static world): 1 / sum over dynamic bodies of
- * 1/m + (r x d)·I⁻¹(r x d) (linear) or d·I⁻¹d (angular). Returns 0 when no dynamic body is attached. */
+ * `point` (linear rows only), from body1 and body2 (0 for the static world): 1 / the sum of ssRowInverseMass over
+ * both. Returns 0 when no dynamic body is attached. */
 double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, const dReal* point, int angular);
 
 /* Whether a row has one direction that a load along it can be declared for (every limit, motor and suspension row;

@@ -34,7 +34,9 @@ struct ssStepper {
   unsigned watched_generation;
   /* the registry's bodies and the watched ones, each once, sorted; rebuilt when either set changes */
   KnownBody* known;
+  dBodyID* known_ids; /* known[i].body, packed: the checks after every step read nothing else */
   int known_count;
+  int carrying; /* whether any known body may carry momentum: without, the forces' capture reads no carried */
   unsigned known_registry_generation, known_watched_generation;
   int known_valid;
   int* pushed; /* indices into known of the bodies with a force or carried momentum this frame */
@@ -98,6 +100,7 @@ void ssStepper_Destroy(ssStepper* stepper) {
   if (stepper == NULL) return;
   free(stepper->watched);
   free(stepper->known);
+  free(stepper->known_ids);
   free(stepper->pushed);
   free(stepper);
 }
@@ -160,6 +163,7 @@ ssStatus ssStepper_DestroyJoint(ssStepper* stepper, dJointID joint) {
 
 static void forgetCarried(ssStepper* stepper) {
   for (int i = 0; i < stepper->known_count; ++i) memset(stepper->known[i].carried, 0, sizeof stepper->known[i].carried);
+  stepper->carrying = 0;
 }
 
 void ssStepper_ResetHistory(ssStepper* stepper) {
@@ -259,9 +263,11 @@ static ssStatus refreshKnown(ssStepper* stepper) {
   if (registry != NULL) most += 2 * ssRegistry_JointBindingCount(registry) + ssRegistryBodyBindingCount(registry);
   KnownList list = {calloc((size_t)(most > 0 ? most : 1), sizeof(KnownBody)), 0, most};
   int* pushed = calloc((size_t)(most > 0 ? most : 1), sizeof(int));
-  if (list.bodies == NULL || pushed == NULL) {
+  dBodyID* ids = calloc((size_t)(most > 0 ? most : 1), sizeof(dBodyID));
+  if (list.bodies == NULL || pushed == NULL || ids == NULL) {
     free(list.bodies);
     free(pushed);
+    free(ids);
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
   }
   if (registry != NULL) ssRegistry_VisitBodies(registry, appendKnown, &list);
@@ -276,10 +282,13 @@ static ssStatus refreshKnown(ssStepper* stepper) {
                                                           sizeof(KnownBody), compareKnown)
                                                 : NULL;
     if (old != NULL) memcpy(kept->carried, old->carried, sizeof kept->carried);
+    ids[unique - 1] = kept->body;
   }
   free(stepper->known);
+  free(stepper->known_ids);
   free(stepper->pushed);
   stepper->known = list.bodies;
+  stepper->known_ids = ids;
   stepper->known_count = unique;
   stepper->pushed = pushed;
   stepper->known_registry_generation = generation;
@@ -297,17 +306,17 @@ static int anyNonZero(const double* values) {
 static ssStatus captureForces(ssStepper* stepper) {
   stepper->pushed_count = 0;
   for (int i = 0; i < stepper->known_count; ++i) {
+    const dReal* force = dBodyGetForce(stepper->known_ids[i]);
+    const dReal* torque = dBodyGetTorque(stepper->known_ids[i]);
+    double f[6] = {force[0], force[1], force[2], torque[0], torque[1], torque[2]};
     KnownBody* known = &stepper->known[i];
-    const dReal* force = dBodyGetForce(known->body);
-    const dReal* torque = dBodyGetTorque(known->body);
-    double* f = known->frame_force;
-    f[0] = force[0], f[1] = force[1], f[2] = force[2], f[3] = torque[0], f[4] = torque[1], f[5] = torque[2];
-    if (!anyNonZero(f) && !anyNonZero(known->carried)) continue;
+    if (!anyNonZero(f) && !(stepper->carrying && anyNonZero(known->carried))) continue;
     for (int j = 0; j < 6; ++j)
       if (!(fabs(f[j]) <= SS_MAX_FORCE_N))
         return ssFail(isfinite(f[j]) ? SS_ERROR_OUT_OF_RANGE : SS_ERROR_NOT_FINITE,
                       "body %p: %s %g N or N·m added for the frame: must be finite and at most SS_MAX_FORCE_N = %g",
                       (void*)known->body, j < 3 ? "force" : "torque", f[j], SS_MAX_FORCE_N);
+    memcpy(known->frame_force, f, sizeof f);
     stepper->pushed[stepper->pushed_count++] = i;
   }
   return SS_OK;
@@ -332,14 +341,17 @@ static void carryForces(ssStepper* stepper, double frame_s) {
   for (int p = 0; p < stepper->pushed_count; ++p) {
     KnownBody* known = &stepper->known[stepper->pushed[p]];
     for (int j = 0; j < 6; ++j) known->carried[j] += known->frame_force[j] * frame_s;
+    stepper->carrying = 1;
     dBodySetForce(known->body, 0, 0, 0);
     dBodySetTorque(known->body, 0, 0, 0);
   }
 }
 
+/* After a frame's steps: every body that carried momentum was pushed for them (captureForces), so none carries now. */
 static void clearCarried(ssStepper* stepper) {
   for (int p = 0; p < stepper->pushed_count; ++p)
     memset(stepper->known[stepper->pushed[p]].carried, 0, sizeof stepper->known[0].carried);
+  stepper->carrying = 0;
 }
 
 /* Checks one body after a step; returns SS_OK or records the failure. A runaway is stopped while its numbers are
@@ -414,9 +426,9 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     report->step_s = step_s;
     report->simulated_s += step_s;
     for (int k = 0; k < stepper->known_count; ++k) {
-      ssStatus status = checkBody(stepper, stepper->known[k].body);
+      ssStatus status = checkBody(stepper, stepper->known_ids[k]);
       if (status != SS_OK) {
-        report->failed_body = stepper->known[k].body;
+        report->failed_body = stepper->known_ids[k];
         return latch(stepper, status);
       }
     }

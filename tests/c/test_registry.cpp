@@ -138,6 +138,90 @@ TEST_F(RegistryTest, MatchedMappingUsesEachRowsEffectiveMass) {
   ssRegistry_Destroy(registry);
 }
 
+// Apply keeps each body's inverse mass once per Apply and shares a softness between rows with the same law and mass:
+// neither may outlive what it was computed from. Sliders bound to one spring move 2, 3, 5 and 1.2 kg (a and b
+// together); then a body's mass changes and a joint is attached to another body, and the same step is applied again.
+TEST_F(RegistryTest, AccurateMappingsFollowMassesAndAttachmentsBetweenApplies) {
+  dBodyID c = MakeBody(5.0, 1, 1, 1);
+  ssRegistry* registry = ssRegistry_Create(world);
+  struct Slider {
+    dJointID joint;
+    double mass_kg;
+  };
+  std::vector<Slider> sliders;
+  auto add = [&](dBodyID first, dBodyID second, double mass_kg) {
+    dJointID slider = dJointCreateSlider(world, 0);
+    dJointAttach(slider, first, second);
+    ASSERT_EQ(ssRegistry_BindJoint(registry, slider, SS_PARAM_STOP, 1, kSpring, 0), SS_OK);
+    sliders.push_back({slider, mass_kg});
+  };
+  add(a, 0, 2.0);
+  add(b, 0, 3.0);
+  add(c, 0, 5.0);
+  add(a, b, 1.0 / (1.0 / 2.0 + 1.0 / 3.0));
+  add(c, 0, 5.0);
+  auto expectMasses = [&](ssMapping mapping, double step_s, double previous_s) {
+    for (const Slider& slider : sliders) {
+      ssSoftness expected;
+      ASSERT_EQ(ssSoftnessFor(mapping, kSpring, slider.mass_kg, step_s, previous_s, &expected), SS_OK);
+      EXPECT_NEAR(dJointGetSliderParam(slider.joint, dParamStopERP), expected.erp, 1e-12 * std::fabs(expected.erp));
+      EXPECT_NEAR(dJointGetSliderParam(slider.joint, dParamStopCFM), expected.cfm, 1e-12 * expected.cfm)
+          << "slider of " << slider.mass_kg << " kg";
+    }
+  };
+  const double step_s = 1.0 / 60.0, other_s = 1.0 / 90.0;
+  for (ssMapping mapping : {SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
+    SCOPED_TRACE(ssMappingName(mapping));
+    ASSERT_EQ(ssRegistry_Apply(registry, mapping, step_s, other_s, nullptr), SS_OK);
+    expectMasses(mapping, step_s, other_s);
+    dMass mass;
+    dMassSetBoxTotal(&mass, 7.0, 0.1, 0.1, 0.1);
+    dBodySetMass(c, &mass);
+    sliders[2].mass_kg = sliders[4].mass_kg = 7.0;
+    dJointAttach(sliders[0].joint, b, 0);
+    sliders[0].mass_kg = 3.0;
+    for (int again = 0; again < 2; ++again) {  // the second Apply after the attachment uses the rebuilt cache
+      ASSERT_EQ(ssRegistry_Apply(registry, mapping, step_s, other_s, nullptr), SS_OK);
+      expectMasses(mapping, step_s, other_s);
+    }
+    dMassSetBoxTotal(&mass, 5.0, 0.1, 0.1, 0.1);  // as they were, for the next mapping
+    dBodySetMass(c, &mass);
+    sliders[2].mass_kg = sliders[4].mass_kg = 5.0;
+    dJointAttach(sliders[0].joint, a, 0);
+    sliders[0].mass_kg = 2.0;
+  }
+  ssRegistry_Destroy(registry);
+}
+
+// Apply keeps a table of the distinct laws (programs bind many rows to a few springs); rows beyond it take another
+// path. With more distinct springs than fit, every row still gets exactly the implicit-Euler softness of its own.
+TEST_F(RegistryTest, ManyDistinctSpringsEachGetTheirOwnSoftness) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  std::vector<dJointID> sliders;
+  for (int i = 0; i < 40; ++i) {
+    dJointID slider = dJointCreateSlider(world, 0);
+    dJointAttach(slider, i % 2 ? a : b, 0);
+    const ssSpring spring = {100.0 + 10.0 * (i % 25), 1.0 + 0.5 * (i % 25)};  // 25 distinct springs, some twice
+    ASSERT_EQ(ssRegistry_BindJoint(registry, slider, SS_PARAM_STOP, 1, spring, 0), SS_OK);
+    sliders.push_back(slider);
+  }
+  for (ssMapping mapping : {SS_MAPPING_IMPLICIT_EULER, SS_MAPPING_MATCHED}) {
+    for (double step_s : {1.0 / 60.0, 1.0 / 90.0, 1.0 / 60.0}) {
+      ASSERT_EQ(ssRegistry_Apply(registry, mapping, step_s, 0, nullptr), SS_OK) << ssLastError();
+      for (int i = 0; i < 40; ++i) {
+        const ssSpring spring = {100.0 + 10.0 * (i % 25), 1.0 + 0.5 * (i % 25)};
+        ssSoftness expected;
+        ASSERT_EQ(ssSoftnessFor(mapping, spring, i % 2 ? 2.0 : 3.0, step_s, 0, &expected), SS_OK);
+        // implicit Euler is the same function of the same numbers: equal to the bit; matched reads a computed mass
+        const double tolerance = mapping == SS_MAPPING_IMPLICIT_EULER ? 0.0 : 1e-12;
+        EXPECT_NEAR(dJointGetSliderParam(sliders[i], dParamStopERP), expected.erp, tolerance * expected.erp) << i;
+        EXPECT_NEAR(dJointGetSliderParam(sliders[i], dParamStopCFM), expected.cfm, tolerance * expected.cfm) << i;
+      }
+    }
+  }
+  ssRegistry_Destroy(registry);
+}
+
 TEST_F(RegistryTest, EffectiveMassOfLinearAndAngularRows) {
   dJointID slider = dJointCreateSlider(world, 0);
   dJointAttach(slider, a, b);
