@@ -6,9 +6,14 @@
  * The order of the worlds rotates from block to block, and the whole measurement is repeated: the median ratio and
  * its range over the repeats are printed.
  *
- *   bench_stepper [frames] [repeats]      (default 300 frames, 7 repeats) */
+ * Every link weighs 1 kg by default, so that the rows share two effective masses (a chain's first link and the
+ * others), as in a chain, a stack of crates or a field of identical props; with "distinct" every link weighs its
+ * own mass (1 to 1.5 kg), as in a ragdoll, so that matched and exact compute every row's softness by itself.
+ *
+ *   bench_stepper [frames] [repeats] [distinct]      (default 300 frames, 7 repeats, shared masses) */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include <steadystep/lab/profile.h>
@@ -19,6 +24,7 @@ enum { kChains = 50, kLinks = 20, kBlock = 20 }; /* 1000 bodies, 1000 hinges, 20
 static const ssSpring kLimit = {5.0, 0.05}; /* about 6 Hz on a link of 0.0035 kg·m² */
 static const ssSpring kFriction = {0.0, 0.01}; /* a pure damper on each hinge motor row */
 static const double kFrame_s = 1.0 / 60.0;
+static int distinct_masses; /* every link its own mass (see the top) */
 
 typedef struct Scene {
   dWorldID world;
@@ -55,7 +61,9 @@ static Scene build(int with_stepper) {
     for (int link = 0; link < kLinks; ++link) {
       dBodyID body = dBodyCreate(scene.world);
       dMass mass;
-      dMassSetBoxTotal(&mass, 1.0, 0.2, 0.05, 0.05);
+      int index = chain * kLinks + link;
+      double mass_kg = distinct_masses ? 1.0 + 0.5 * index / (kChains * kLinks - 1) : 1.0;
+      dMassSetBoxTotal(&mass, mass_kg, 0.2, 0.05, 0.05);
       dBodySetMass(body, &mass);
       dBodySetPosition(body, 0.2 * link + 0.1, 1.0 * chain, 0);
       dJointID hinge = dJointCreateHinge(scene.world, 0);
@@ -180,15 +188,17 @@ static void report(const char* title, const char* profile_spec, int frames, int 
 int main(int argc, char** argv) {
   int frames = argc > 1 ? atoi(argv[1]) : 300;
   int repeats = argc > 2 ? atoi(argv[2]) : 7;
-  if (frames <= 0 || repeats <= 0 || repeats > 64) {
-    fprintf(stderr, "usage: bench_stepper [frames > 0] [repeats 1..64]\n");
+  distinct_masses = argc > 3 && strcmp(argv[3], "distinct") == 0;
+  if (frames <= 0 || repeats <= 0 || repeats > 64 || (argc > 3 && !distinct_masses) || argc > 4) {
+    fprintf(stderr, "usage: bench_stepper [frames > 0] [repeats 1..64] [distinct]\n");
     return 2;
   }
   dInitODE2(0);
   frames = (frames + kBlock - 1) / kBlock * kBlock;
-  printf("bench_stepper: %d bodies in %d chains, %d soft parameter sets, %d frames a repeat, QuickStep 20 iterations\n"
-         "targets: implicit Euler <= 1.02, matched and exact <= 1.05\n",
-         kChains * kLinks, kChains, 2 * kChains * kLinks, frames);
+  printf("bench_stepper: %d bodies in %d chains, %d soft parameter sets, %d frames a repeat, QuickStep 20 iterations, "
+         "%s\ntargets: implicit Euler <= 1.02, matched and exact <= 1.05\n",
+         kChains * kLinks, kChains, 2 * kChains * kLinks, frames,
+         distinct_masses ? "every link its own mass (1 to 1.5 kg)" : "links of 1 kg (two effective masses)");
   report("frames of 1/60 s:", NULL, frames, repeats);
   report("frames of 1/90 to 1/60 s (every value rewritten every frame):", "uniform:60:90", frames, repeats);
 
