@@ -104,7 +104,9 @@ ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssSteppi
     strncat(known, i ? ", " : "", sizeof known - strlen(known) - 1);
     strncat(known, policies[i].name, sizeof known - strlen(known) - 1);
   }
-  return ssFail(SS_ERROR_PARSE, "policy \"%.64s\": unknown (%s)", name ? name : "(null)", known);
+  /* The article's policy was called "spring" in 0.1.0: say where it went rather than only that it is gone. */
+  const char* renamed = name && strcmp(name, "spring") == 0 ? "; \"spring\" is now called implicit-euler" : "";
+  return ssFail(SS_ERROR_PARSE, "policy \"%.64s\": unknown (%s)%s", name ? name : "(null)", known, renamed);
 }
 
 const char* ssSteppingPolicyName(const ssStepping* stepping) {

@@ -203,3 +203,9 @@ def test_version_is_the_one_in_cmakelists():
     result = steadystep("--version")
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == f"steadystep {version}"
+
+
+def test_the_old_policy_name_spring_is_refused_naming_its_new_name():
+    result = steadystep("run", "oscillator", "--policy", "spring", "--profile", "fixed:30", "--duration", "1")
+    assert result.returncode == 2 and result.stdout == ""
+    assert '"spring" is now called implicit-euler' in result.stderr and "Traceback" not in result.stderr
