@@ -48,11 +48,14 @@ class _Parser(argparse.ArgumentParser):
         raise _UsageError(f"{self.prog}: {message} (see {self.prog} --help)")
 
 
-def _positive_float(text: str) -> float:
-    value = _float(text)
+def _positive(text: str, value: float) -> float:
     if not math.isfinite(value) or value <= 0:
         raise argparse.ArgumentTypeError(f"{text!r} must be a finite number above 0")
     return value
+
+
+def _positive_float(text: str) -> float:
+    return _positive(text, _float(text))
 
 
 def _measured_duration(text: str) -> float:
@@ -104,10 +107,7 @@ def _nonzero(value: float, text: str) -> float:
 
 
 def _positive_fraction(text: str) -> float:
-    value = _fraction(text)
-    if not math.isfinite(value) or value <= 0:
-        raise argparse.ArgumentTypeError(f"{text!r} must be a finite number above 0")
-    return value
+    return _positive(text, _fraction(text))
 
 
 def _grid_value(text: str) -> float:

@@ -75,10 +75,14 @@ def test_plain_frames_are_refused_before_the_first_frame_and_out_of_range():
         scene.close()
 
 
-def test_a_cost_is_a_ratio_in_its_range():
-    measured = cost.measure("chain", "implicit-euler", repeats=3)
+@pytest.mark.parametrize("scene, policy", [("chain", "implicit-euler"), ("buggy", "matched")])
+def test_a_cost_is_two_ratios_in_their_ranges(scene, policy):
+    """Per frame against the program's own loop, and the library against plain ODE at the same steps."""
+    measured = cost.measure(scene, policy, repeats=3)
     assert measured.status == "ok"
     assert measured.ratio_low <= measured.ratio_median <= measured.ratio_high
+    assert measured.overhead_low <= measured.overhead_median <= measured.overhead_high
+    assert 0 < measured.overhead_median < math.inf
     assert measured.steps_per_frame > 1.5  # 15-45 fps frames in substeps of at most 1/60 s
 
 
@@ -97,9 +101,3 @@ def test_plain_ode_at_the_same_steps_takes_the_steppers_own_steps(policy):
     finally:
         counter.close()
 
-
-def test_a_cost_measures_the_library_against_plain_ode_at_the_same_steps():
-    measured = cost.measure("buggy", "matched", repeats=3)
-    assert measured.status == "ok"
-    assert measured.overhead_low <= measured.overhead_median <= measured.overhead_high
-    assert 0 < measured.overhead_median < math.inf
