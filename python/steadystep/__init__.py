@@ -4,7 +4,8 @@ On a program's own ODE world (built with odepy, PyPI ode-python): ``Registry`` (
 tuned), ``Stepper`` (one call per frame: substeps, mappings, forces kept over the frame, failures refused until
 reset), ``Stepper.soften_contact`` in the near callback, and ``Stepping`` for how frames become steps. The
 conversions (``softness_from_spring`` ..., scalars or numpy arrays), the lab's profiles and runs on built-in scenes
-(``steadystep.runs``, ``steadystep.profiles``), the article's model (``steadystep.article``), metrics; figures and
+(``steadystep.runs``, ``steadystep.profiles``), the article's model (``steadystep.article``), metrics, ``sweep`` of
+independent runs over any ``concurrent.futures.Executor`` (``make_executor``: a process pool, Dask); figures and
 the HTML report need the ``report`` extra (``pip install steadystep[report]``). Every failure of the C library
 raises ``SteadystepError`` (a ValueError) naming the value at fault. Importing the package changes no global state.
 """
@@ -18,13 +19,14 @@ from steadystep.registry import (AdoptReport, ApplyReport, Registry, contact_sof
                                  joint_supports)
 from steadystep.stepper import FrameReport, Stepper, StepInfo
 from steadystep.stepping import Stepping, policy_names
+from steadystep.study import grid, make_executor, sweep
 
 __all__ = [
     "AdoptReport", "ApplyReport", "FrameCut", "FrameReport", "JointParam", "Mapping", "Profile", "Registry",
     "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper", "SteadystepError", "Stepping", "contact_soften",
-    "exact_softness", "frame_times", "frequency_from_spring", "joint_effective_mass", "joint_supports",
-    "matched_softness", "policy_names", "softness_for", "softness_from_spring", "spring_from_frequency",
-    "spring_from_softness",
+    "exact_softness", "frame_times", "frequency_from_spring", "grid", "joint_effective_mass", "joint_supports",
+    "make_executor", "matched_softness", "policy_names", "softness_for", "softness_from_spring",
+    "spring_from_frequency", "spring_from_softness", "sweep",
 ]
 try:  # the installed package's version, which the build read from CMakeLists.txt's project()
     from importlib.metadata import version as _version
