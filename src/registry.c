@@ -43,6 +43,17 @@ typedef struct JointBinding {
   double load_correction; /* the force this Apply adds along the row for the load (N or N·m) */
 } JointBinding;
 
+/* What implicit Euler's by-law pass reads of a row, packed apart from the bindings (rebuilt with the Apply cache):
+ * after an ODE step has evicted the registry's arrays, it streams through 32 bytes a row instead of a binding's
+ * first line. mass mirrors the binding's. */
+typedef struct HotRow {
+  dJointID joint;
+  ssParamSetter set; /* the row's writer: NULL for a row without softness */
+  double mass;
+  int16_t erp_number, cfm_number; /* ODE's parameter numbers (below 0x400); erp_number -1: none */
+  int16_t law_slot;
+} HotRow;
+
 /* A body's inverse mass and inertia, computed at most once per Apply for all the rows on it. */
 typedef struct BodyCache {
   dBodyID body;
@@ -61,6 +72,7 @@ struct ssRegistry {
   double tuned_step_s;      /* adoption's tuned step; 0 before any */
   ssSoftness tuned_world;   /* the world's ERP/CFM as adopted (contacts without soft modes stand for these) */
   JointBinding* joints;
+  HotRow* hot_rows; /* joints' hot part, as many; valid while body_cache_revision == revision */
   int joint_count, joint_capacity;
   ssBodyBinding* bodies;
   int body_count, body_capacity;
@@ -85,6 +97,10 @@ struct ssRegistry {
   int law_count;
   int rows_outside_laws; /* bindings whose law did not fit in the table */
   unsigned reuse_epoch;  /* changes at every implicit-Euler Apply, which leaves the rows' pending behind */
+  /* after a by-law pass, every row in the law table holds its law's softness in ODE: law_written stands for the
+   * rows' written until the other passes (or a rebinding) need theirs back (materializeWritten) */
+  int written_by_law;
+  ssSoftness law_written[kLawTableSize];
 };
 
 #define REQUIRE_REGISTRY(registry) \
@@ -109,6 +125,7 @@ ssRegistry* ssRegistry_Create(dWorldID world) {
 void ssRegistry_Destroy(ssRegistry* registry) {
   if (registry == NULL) return;
   free(registry->joints);
+  free(registry->hot_rows);
   free(registry->bodies);
   free(registry->body_cache);
   free(registry);
@@ -158,10 +175,20 @@ static int reserveJoints(ssRegistry* registry, int more) {
   int wanted = registry->joint_capacity ? 2 * registry->joint_capacity : 8;
   if (wanted < registry->joint_count + more) wanted = registry->joint_count + more;
   JointBinding* larger = aligned_alloc(_Alignof(JointBinding), (size_t)wanted * sizeof(JointBinding));
-  if (larger == NULL) return 0;
-  if (registry->joint_count > 0) memcpy(larger, registry->joints, (size_t)registry->joint_count * sizeof(JointBinding));
+  HotRow* hot = aligned_alloc(64, ((size_t)wanted * sizeof(HotRow) + 63) / 64 * 64);
+  if (larger == NULL || hot == NULL) {
+    free(larger);
+    free(hot);
+    return 0;
+  }
+  if (registry->joint_count > 0) {
+    memcpy(larger, registry->joints, (size_t)registry->joint_count * sizeof(JointBinding));
+    memcpy(hot, registry->hot_rows, (size_t)registry->joint_count * sizeof(HotRow));
+  }
   free(registry->joints);
+  free(registry->hot_rows);
   registry->joints = larger;
+  registry->hot_rows = hot;
   registry->joint_capacity = wanted;
   return 1;
 }
@@ -184,8 +211,11 @@ int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam par
   return findJoint(registry, joint, param, axis) != NULL;
 }
 
+static void materializeWritten(ssRegistry* registry);
+
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass) {
+  materializeWritten(registry); /* before the law slots or the rows move */
   registry->revision += 1;
   JointBinding binding = {.joint = joint,
                           .pending = {0, 0},
@@ -254,6 +284,7 @@ ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointPa
 
 ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
   REQUIRE_REGISTRY(registry);
+  materializeWritten(registry);
   int kept = 0;
   for (int i = 0; i < registry->joint_count; ++i)
     if (registry->joints[i].joint != joint) registry->joints[kept++] = registry->joints[i];
@@ -381,6 +412,17 @@ static int sharedLaw(const SharedSoftness* shared, const ssRowLaw* law, int law_
   return sameLaw(shared->law, law);
 }
 
+/* Gives every row in the law table its written back from law_written: before a pass that reads the rows' own, and
+ * before the rows or their law slots change. */
+static void materializeWritten(ssRegistry* registry) {
+  if (!registry->written_by_law) return;
+  for (int i = 0; i < registry->joint_count; ++i) {
+    JointBinding* binding = &registry->joints[i];
+    if (binding->law_slot >= 0) binding->written = registry->law_written[binding->law_slot];
+  }
+  registry->written_by_law = 0;
+}
+
 static int compareBodyCache(const void* a, const void* b) {
   uintptr_t x = (uintptr_t)((const BodyCache*)a)->body, y = (uintptr_t)((const BodyCache*)b)->body;
   return (x > y) - (x < y);
@@ -390,6 +432,7 @@ static int compareBodyCache(const void* a, const void* b) {
  * every binding pointed at its bodies' slots (out of memory, every row computes its bodies itself), and the count of
  * rows with a load. */
 static void rebuildApplyCache(ssRegistry* registry) {
+  materializeWritten(registry);
   registry->body_cache_revision = registry->revision;
   registry->body_cache_stale = 0;
   free(registry->body_cache);
@@ -435,6 +478,15 @@ static void rebuildApplyCache(ssRegistry* registry) {
   for (int i = 0; i < registry->joint_count; ++i) registry->rows_outside_laws += registry->joints[i].law_slot < 0;
   registry->loaded_rows = 0;
   for (int i = 0; i < registry->joint_count; ++i) registry->loaded_rows += registry->joints[i].load != 0;
+  for (int i = 0; i < registry->joint_count; ++i) {
+    const JointBinding* binding = &registry->joints[i];
+    registry->hot_rows[i] = (HotRow){.joint = binding->joint,
+                                     .set = binding->writer.set,
+                                     .mass = binding->mass,
+                                     .erp_number = (int16_t)binding->writer.erp_number,
+                                     .cfm_number = (int16_t)binding->writer.cfm_number,
+                                     .law_slot = (int16_t)binding->law_slot};
+  }
 }
 
 /* What the body opposes to its rows in this Apply: from the cache, computed on its first use in the Apply, or into
@@ -560,6 +612,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       continue;
     }
     binding->mass = mass;
+    registry->hot_rows[i].mass = mass;
     int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
     const SharedSoftness* hit = NULL;
     for (int j = 0; j < shared_count && hit == NULL; ++j)
@@ -649,28 +702,47 @@ static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* s
 }
 
 /* The one pass of lawSoftnesses' case: each row's mass for the Nyquist report, and its law's softness written
- * where it changed. Nothing here can fail. Between the Applies that measure the masses, it reads each row's first
- * cache line and nothing else. */
+ * where it changed. Nothing here can fail. Between the Applies that measure the masses, it reads the rows' hot
+ * records and nothing else: where every row of a law was written by the last such pass, law_written says what ODE
+ * holds. */
 static void writeRowsByLaw(ssRegistry* registry, double step_s, int measure, const ssSoftness* softness,
                            ssApplyReport* counts) {
   double last_mass = NAN;
+  int by_law = registry->written_by_law;
+  int changed[kLawTableSize];
+  for (int j = 0; j < registry->law_count; ++j)
+    changed[j] = softness[j].erp != registry->law_written[j].erp || softness[j].cfm != registry->law_written[j].cfm;
+  HotRow* hot = registry->hot_rows;
   for (int i = 0; i < registry->joint_count; ++i) {
-    JointBinding* binding = &registry->joints[i];
-    PREFETCH_ROWS(registry, i, measure ? 2 : 1);
-    const ssRowLaw* law = &registry->laws[binding->law_slot];
+    HotRow* row = &hot[i];
+#if defined(__GNUC__)
+    if (i + kPrefetchAhead / 2 < registry->joint_count) __builtin_prefetch(hot[i + kPrefetchAhead / 2].joint);
+#endif
+    const ssRowLaw* law = &registry->laws[row->law_slot];
     if (measure) {
+      JointBinding* binding = &registry->joints[i];
+      PREFETCH_ROWS(registry, i, 2);
       const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
       int same_row =
           before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
       binding->mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
+      row->mass = binding->mass;
       last_mass = binding->mass;
     }
-    if (!law->hard) counts->rows_over_nyquist += ssOverNyquist(law->spring, binding->mass, step_s);
-    const ssSoftness* law_softness = &softness[binding->law_slot];
-    if (law_softness->erp == binding->written.erp && law_softness->cfm == binding->written.cfm) continue;
-    ssRowWrite(&binding->writer, binding->joint, law_softness->erp, law_softness->cfm);
-    binding->written = *law_softness;
+    if (!law->hard) counts->rows_over_nyquist += ssOverNyquist(law->spring, row->mass, step_s);
+    const ssSoftness* law_softness = &softness[row->law_slot];
+    if (by_law) {
+      if (!changed[row->law_slot]) continue;
+    } else {
+      const ssSoftness* written = &registry->joints[i].written;
+      if (law_softness->erp == written->erp && law_softness->cfm == written->cfm) continue;
+    }
+    if (row->set == NULL) continue;
+    if (row->erp_number >= 0) row->set(row->joint, row->erp_number, law_softness->erp);
+    row->set(row->joint, row->cfm_number, law_softness->cfm);
   }
+  for (int j = 0; j < registry->law_count; ++j) registry->law_written[j] = softness[j];
+  registry->written_by_law = 1;
 }
 
 ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
@@ -705,6 +777,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   int measure = mapping != SS_MAPPING_IMPLICIT_EULER || registry->report_mass_age == 0;
   int by_law = mapping == SS_MAPPING_IMPLICIT_EULER && registry->rows_outside_laws == 0;
   ssSoftness law_softness[kLawTableSize];
+  if (!by_law) materializeWritten(registry); /* computeRows and writeRows compare each row's own */
   int unwritten = 0; /* rows whose pending differs from what ODE holds: with none (constant steps), no second pass */
   status = by_law ? lawSoftnesses(registry, step_s, law_softness)
                   : computeRows(registry, mapping, step_s, mapping == SS_MAPPING_EXACT ? previous_step_s : 0,

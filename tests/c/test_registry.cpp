@@ -222,6 +222,62 @@ TEST_F(RegistryTest, ManyDistinctSpringsEachGetTheirOwnSoftness) {
   ssRegistry_Destroy(registry);
 }
 
+// Implicit Euler writes rows by law and skips a law whose softness did not change (a pure damper's is the same at
+// every step); the other mappings compare each row with what it was last given. Over a long random mix of mappings,
+// step lengths, rebindings and new rows, every row holds in ODE what its own spring, mass and step give.
+TEST_F(RegistryTest, RowsFollowAnyMixOfMappingsStepsAndRebindings) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  const ssSpring springs[] = {kSpring, {0.0, 5.0}, {150.0, 4.0}};  // the second a pure damper
+  struct Slider {
+    dJointID joint;
+    int spring;
+    double mass_kg;
+  };
+  std::vector<Slider> sliders;
+  auto add = [&](int spring) {
+    dJointID slider = dJointCreateSlider(world, 0);
+    const bool on_a = sliders.size() % 2 == 0;
+    dJointAttach(slider, on_a ? a : b, 0);
+    ASSERT_EQ(ssRegistry_BindJoint(registry, slider, SS_PARAM_STOP, 1, springs[spring], 0), SS_OK);
+    sliders.push_back({slider, spring, on_a ? 2.0 : 3.0});
+  };
+  for (int i = 0; i < 12; ++i) add(i % 2);
+  const ssMapping mappings[] = {SS_MAPPING_IMPLICIT_EULER, SS_MAPPING_MATCHED, SS_MAPPING_EXACT};
+  const double steps_s[] = {1.0 / 60.0, 1.0 / 90.0, 1.0 / 144.0, 1.0 / 30.0};
+  unsigned seed = 12345;
+  auto next = [&](unsigned n) {
+    seed = seed * 1103515245u + 12345u;
+    return (seed >> 16) % n;
+  };
+  for (int apply = 0; apply < 400; ++apply) {
+    // mostly implicit Euler, often at the same step as before, as a program with a few frame rates does
+    const ssMapping mapping = next(3) == 0 ? mappings[1 + next(2)] : SS_MAPPING_IMPLICIT_EULER;
+    const double step_s = steps_s[next(4)], previous_s = steps_s[next(4)];
+    const unsigned change = next(20);
+    if (change == 0) {
+      Slider& slider = sliders[next((unsigned)sliders.size())];
+      slider.spring = (slider.spring + 1) % 3;
+      ASSERT_EQ(ssRegistry_BindJoint(registry, slider.joint, SS_PARAM_STOP, 1, springs[slider.spring], 0), SS_OK);
+    } else if (change == 1 && sliders.size() < 40) {
+      add((int)next(3));
+    }
+    ASSERT_EQ(ssRegistry_Apply(registry, mapping, step_s, previous_s, nullptr), SS_OK) << ssLastError();
+    for (size_t i = 0; i < sliders.size(); ++i) {
+      ssSoftness expected;
+      const ssSpring spring = springs[sliders[i].spring];
+      // a pure damper has no position to correct: the exact mapping serves it as the matched one does
+      const ssMapping row_mapping = mapping == SS_MAPPING_EXACT && spring.stiffness == 0 ? SS_MAPPING_MATCHED : mapping;
+      const double previous = row_mapping == SS_MAPPING_EXACT ? previous_s : 0;
+      ASSERT_EQ(ssSoftnessFor(row_mapping, spring, sliders[i].mass_kg, step_s, previous, &expected), SS_OK);
+      const double tolerance = mapping == SS_MAPPING_IMPLICIT_EULER ? 0.0 : 1e-12;
+      SCOPED_TRACE("apply " + std::to_string(apply) + " " + ssMappingName(mapping) + " slider " + std::to_string(i));
+      EXPECT_NEAR(dJointGetSliderParam(sliders[i].joint, dParamStopERP), expected.erp, tolerance * expected.erp);
+      EXPECT_NEAR(dJointGetSliderParam(sliders[i].joint, dParamStopCFM), expected.cfm, tolerance * expected.cfm);
+    }
+  }
+  ssRegistry_Destroy(registry);
+}
+
 TEST_F(RegistryTest, EffectiveMassOfLinearAndAngularRows) {
   dJointID slider = dJointCreateSlider(world, 0);
   dJointAttach(slider, a, b);
