@@ -31,7 +31,7 @@ DEFAULT_PROFILE = "uniform:15:45"
 DEFAULT_REPEATS = 7
 # A block lasts about this long when stepped plain: long against the clock's resolution, short against the drift
 # of a shared machine.
-BLOCK_TARGET_S = 0.01
+BLOCK_TARGET_S = 0.005
 MAX_BLOCK_FRAMES = 2000
 
 
