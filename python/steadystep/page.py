@@ -192,7 +192,7 @@ def _cost(report) -> str | None:
 
 def _stable(report) -> str | None:
     """The policies stable up to the longest steps: best on the worst probed scene, then on the geometric mean over
-    the probed scenes; and where the others fall short of the best."""
+    the probed scenes; where the others fall short of the best, and where they go further."""
     by_policy: dict[str, dict[str, float]] = {}
     for scene, results in report.probes.items():
         for r in results:
@@ -221,6 +221,15 @@ def _stable(report) -> str | None:
             shortfalls.append(f"{html.escape(policy)} is shorter on {', '.join(short)}")
     if shortfalls:
         text += "; " + "; ".join(shortfalls)
+    # Ranked on the hardest scene and the mean, the best may still be beaten on one scene: say where.
+    beaten = []
+    for scene, best_value in reference.items():
+        further = [f"{html.escape(p)} {_ms(v[scene])}" for p, v in by_policy.items()
+                   if p not in best and v.get(scene, 0) > best_value]
+        if further:
+            beaten.append(f"on {scene}, {', '.join(further)} against {_ms(best_value)}")
+    if beaten:
+        text += "; longer than the best elsewhere: " + "; ".join(beaten)
     return text + ". " + _link("stable", "largest stable step")
 
 
