@@ -147,3 +147,21 @@ def test_a_run_that_leaves_the_axes_is_marked_and_the_legend_says_only_what_is_d
                                                               ("fixed:30", "implicit-euler"): 0.01},
                                            {("fixed:30", "naive"): "blow-up", ("fixed:30", "implicit-euler"): "ok"})
     assert "the run failed" in failed.axes[0].get_title(loc="left")
+
+
+def test_the_stable_step_line_says_where_the_best_is_beaten():
+    """Ranked on the hardest scene and the geometric mean, the best policy may still be beaten on one scene."""
+    import types
+
+    from steadystep import page, probe
+
+    # Both tie on the hardest scene (drop); matched has the larger geometric mean, naive goes further on the chain.
+    stable = {"buggy": {"naive": 0.080, "matched": 0.103}, "chain": {"naive": 0.0271, "matched": 0.0265},
+              "drop": {"naive": 0.0214, "matched": 0.0214}}
+    report_like = types.SimpleNamespace(probes={
+        scene: [probe.ProbeResult(scene, policy, value, 2 * value, 1, "") for policy, value in values.items()]
+        for scene, values in stable.items()})
+    text = re.sub("<[^>]+>", "", page._stable(report_like))
+    assert text.startswith("matched:")
+    assert "naive is shorter on buggy 80 ms against 103 ms" in text
+    assert "on chain, naive 27.1 ms against 26.5 ms" in text
