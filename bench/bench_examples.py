@@ -51,7 +51,7 @@ def run_csv(build: pathlib.Path, program: str, variant: str, profile: str, seed:
         command = [str(build / f"steadystep_example_{program}_ode")]
     else:
         command = [str(build / f"steadystep_example_{program}_steadystep"), "--policy", variant]
-    command += ["--profile", profile, "--seed", str(seed), "--seconds", str(SECONDS)] + (extra or [])
+    command += ["--profile", profile, "--seed", str(seed), "--duration", str(SECONDS)] + (extra or [])
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
         sys.exit(f"bench_examples: {' '.join(command)} exited {done.returncode}: {done.stderr.strip()}")
@@ -95,7 +95,7 @@ def loop_seconds(build: pathlib.Path, variant: str, boxes: int, seconds: float) 
         command = [str(build / "steadystep_example_stack_ode")]
     else:
         command = [str(build / "steadystep_example_stack_steadystep"), "--policy", "implicit-euler", "--max-step", "1"]
-    command += ["--profile", "fixed:60", "--seconds", str(seconds), "--boxes", str(boxes), "--quiet"]
+    command += ["--profile", "fixed:60", "--duration", str(seconds), "--boxes", str(boxes), "--quiet"]
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
         sys.exit(f"bench_examples: {' '.join(command)} exited {done.returncode}: {done.stderr.strip()}")

@@ -4,7 +4,7 @@
  * per rendered frame, whatever that frame lasted, as a variable-rate game does. chain_steadystep.c is the same
  * program adopted with steadystep.
  *
- *   chain_ode --profile uniform:15:45 --seconds 10 > run.csv      (t_s,end_x_m,end_z_m)
+ *   chain_ode --profile uniform:15:45 --duration 10 > run.csv      (t_s,end_x_m,end_z_m)
  *
  * Followed: the free end of the last link, its x (the push's direction) and its height z. */
 #include <math.h>
@@ -89,8 +89,8 @@ int main(int argc, char** argv) {
   record(&flags, 0);
   int code = 0;
   ExampleClock started = exampleClock();
-  for (double time_s = 0; time_s < flags.seconds - 1e-12;) {
-    double frame_s = fmin(ssProfile_Next(flags.frames), flags.seconds - time_s);
+  for (double time_s = 0; time_s < flags.duration_s - 1e-12;) {
+    double frame_s = fmin(ssProfile_Next(flags.frames), flags.duration_s - time_s);
     push(time_s);
     dSpaceCollide(space, 0, nearCallback);
     dWorldQuickStep(world, frame_s);

@@ -3,7 +3,7 @@
  * is ODE's default, bodies are damped per step, and the links collide with the ground. This is chain_ode.c
  * adopted with steadystep: the lines marked "steadystep" take over what it tuned, and the stepper steps each frame.
  *
- *   chain_steadystep --policy implicit-euler --profile uniform:15:45 --seconds 10 > run.csv      (t_s,end_x_m,end_z_m)
+ *   chain_steadystep --policy implicit-euler --profile uniform:15:45 --duration 10 > run.csv      (t_s,end_x_m,end_z_m)
  *
  * Followed: the free end of the last link, its x (the push's direction) and its height z. */
 #include <math.h>
@@ -114,8 +114,8 @@ int main(int argc, char** argv) {
   record(&flags, 0);
   int code = 0;
   ExampleClock started = exampleClock();
-  for (double time_s = 0; time_s < flags.seconds - 1e-12;) {
-    double frame_s = fmin(ssProfile_Next(flags.frames), flags.seconds - time_s);
+  for (double time_s = 0; time_s < flags.duration_s - 1e-12;) {
+    double frame_s = fmin(ssProfile_Next(flags.frames), flags.duration_s - time_s);
     push(time_s);
     ssFrameReport report;
     if (ssStepper_Step(stepper, frame_s, &report) != SS_OK) { /* steadystep: a failed stepper refuses later frames */

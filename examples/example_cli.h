@@ -4,7 +4,7 @@
  *
  * Flags of every example:
  *   --profile SPEC   frame times from a lab profile (steadystep/profile.h), e.g. fixed:60, uniform:15:45
- *   --seconds S      simulated time (s, > 0), default 10
+ *   --duration S     simulated time (s, > 0), default 10 (as `steadystep run`'s --duration)
  *   --seed N         the profile's seed (whole number >= 0), default 1
  *   --quiet          no CSV; print the stepping loop's wall seconds and process CPU seconds to stderr, one line
  *                    "WALL CPU" (for benchmarks: CPU time is what a busy shared machine disturbs least)
@@ -29,7 +29,7 @@ enum { EXAMPLE_FLAGS_STEPPER = 1, EXAMPLE_FLAGS_BOXES = 2 };
 
 typedef struct ExampleFlags {
   ssProfile* frames;  /* made from --profile and --seed */
-  double seconds;     /* --seconds */
+  double duration_s;  /* --duration */
   int quiet;          /* --quiet */
   const char* policy; /* --policy (adopted programs) */
   double max_step_s;  /* --max-step (adopted programs) */
@@ -56,7 +56,7 @@ static inline int exampleParseFlags(const char* program, int argc, char** argv, 
   for (int i = 1; i < argc; ++i) {
     const char* flag = argv[i];
     if (strcmp(flag, "--help") == 0 || strcmp(flag, "-h") == 0) {
-      printf("usage: %s [--profile SPEC] [--seconds S] [--seed N] [--quiet]%s%s\n"
+      printf("usage: %s [--profile SPEC] [--duration S] [--seed N] [--quiet]%s%s\n"
              "Defaults: uniform:15:45, 10 s, seed 1%s%s. CSV on stdout; --quiet prints the stepping loop's wall\n"
              "and CPU seconds to stderr instead.\n",
              program,
@@ -72,7 +72,7 @@ static inline int exampleParseFlags(const char* program, int argc, char** argv, 
     }
     int stepper_flag = strcmp(flag, "--policy") == 0 || strcmp(flag, "--max-step") == 0;
     int boxes_flag = strcmp(flag, "--boxes") == 0;
-    int known = strcmp(flag, "--profile") == 0 || strcmp(flag, "--seconds") == 0 || strcmp(flag, "--seed") == 0 ||
+    int known = strcmp(flag, "--profile") == 0 || strcmp(flag, "--duration") == 0 || strcmp(flag, "--seed") == 0 ||
                 (stepper_flag && (accepts & EXAMPLE_FLAGS_STEPPER)) || (boxes_flag && (accepts & EXAMPLE_FLAGS_BOXES));
     if (!known) return exampleBadFlag(program, flag, "", "unknown flag");
     if (i + 1 >= argc) return exampleBadFlag(program, flag, "", "needs a value");
@@ -81,9 +81,9 @@ static inline int exampleParseFlags(const char* program, int argc, char** argv, 
     if (strcmp(flag, "--profile") == 0) profile = value;
     else if (strcmp(flag, "--policy") == 0) flags->policy = value;
     else if (!exampleNumber(value, &number)) return exampleBadFlag(program, flag, value, "not a finite number");
-    else if (strcmp(flag, "--seconds") == 0) {
+    else if (strcmp(flag, "--duration") == 0) {
       if (!(number > 0)) return exampleBadFlag(program, flag, value, "must be > 0 s");
-      flags->seconds = number;
+      flags->duration_s = number;
     } else if (strcmp(flag, "--seed") == 0) {
       if (number < 0 || number != floor(number) || number > 9e15)
         return exampleBadFlag(program, flag, value, "must be a whole number >= 0");

@@ -148,8 +148,8 @@ int main(int argc, char** argv) {
   record(&flags, 0);
   int code = 0;
   ExampleClock started = exampleClock();
-  for (double time_s = 0; time_s < flags.seconds - 1e-12;) {
-    double frame_s = fmin(ssProfile_Next(flags.frames), flags.seconds - time_s);
+  for (double time_s = 0; time_s < flags.duration_s - 1e-12;) {
+    double frame_s = fmin(ssProfile_Next(flags.frames), flags.duration_s - time_s);
     nudge(time_s);
     ssFrameReport report;
     if (ssStepper_Step(stepper, frame_s, &report) != SS_OK) { /* steadystep: a failed stepper refuses later frames */

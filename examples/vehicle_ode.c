@@ -5,7 +5,7 @@
  * frame, whatever that frame lasted, as a variable-rate game does. vehicle_steadystep.c is the same program adopted
  * with steadystep.
  *
- *   vehicle_ode --profile uniform:15:45 --seconds 10 > run.csv      (t_s,height_m,pitch_rad)
+ *   vehicle_ode --profile uniform:15:45 --duration 10 > run.csv      (t_s,height_m,pitch_rad)
  *
  * Followed: the chassis' height above the ground and its pitch (nose up > 0). */
 #include <math.h>
@@ -127,8 +127,8 @@ int main(int argc, char** argv) {
   record(&flags, 0);
   int code = 0;
   ExampleClock started = exampleClock();
-  for (double time_s = 0; time_s < flags.seconds - 1e-12;) {
-    double frame_s = fmin(ssProfile_Next(flags.frames), flags.seconds - time_s);
+  for (double time_s = 0; time_s < flags.duration_s - 1e-12;) {
+    double frame_s = fmin(ssProfile_Next(flags.frames), flags.duration_s - time_s);
     drive(time_s);
     dSpaceCollide(space, 0, nearCallback);
     dWorldQuickStep(world, frame_s);

@@ -4,7 +4,7 @@
  * ground plane and a row of speed bumps. Its ERP/CFM numbers were tuned at 60 fps. This is vehicle_ode.c adopted
  * with steadystep: the lines marked "steadystep" take over what it tuned, and the stepper steps each frame.
  *
- *   vehicle_steadystep --policy implicit-euler --profile uniform:15:45 --seconds 10 > run.csv      (t_s,height_m,pitch_rad)
+ *   vehicle_steadystep --policy implicit-euler --profile uniform:15:45 --duration 10 > run.csv      (t_s,height_m,pitch_rad)
  *
  * Followed: the chassis' height above the ground and its pitch (nose up > 0). */
 #include <math.h>
@@ -152,8 +152,8 @@ int main(int argc, char** argv) {
   record(&flags, 0);
   int code = 0;
   ExampleClock started = exampleClock();
-  for (double time_s = 0; time_s < flags.seconds - 1e-12;) {
-    double frame_s = fmin(ssProfile_Next(flags.frames), flags.seconds - time_s);
+  for (double time_s = 0; time_s < flags.duration_s - 1e-12;) {
+    double frame_s = fmin(ssProfile_Next(flags.frames), flags.duration_s - time_s);
     drive(time_s);
     ssFrameReport report;
     if (ssStepper_Step(stepper, frame_s, &report) != SS_OK) { /* steadystep: a failed stepper refuses later frames */

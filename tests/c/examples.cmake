@@ -12,18 +12,18 @@ set(STEADYSTEP_EXAMPLE_POLICIES naive implicit-euler matched exact fixed fixed-m
 
 foreach(program ${STEADYSTEP_EXAMPLE_PROGRAMS})
   add_test(NAME example_${program}_ode_uniform
-           COMMAND steadystep_example_${program}_ode --profile uniform:15:45 --seconds 10 --seed 1 --quiet)
+           COMMAND steadystep_example_${program}_ode --profile uniform:15:45 --duration 10 --seed 1 --quiet)
   foreach(policy ${STEADYSTEP_EXAMPLE_POLICIES})
     add_test(NAME example_${program}_steadystep_${policy}_uniform
-             COMMAND steadystep_example_${program}_steadystep --policy ${policy} --profile uniform:15:45 --seconds 10
+             COMMAND steadystep_example_${program}_steadystep --policy ${policy} --profile uniform:15:45 --duration 10
                      --seed 1 --quiet)
   endforeach()
 
   # Naive adoption against the program's own stepping, 2 s of 15-45 fps: every value within 1e-6 of the plain run's
   # (absolute, in the CSV's units: m, rad, N), every row present.
   add_test(NAME example_${program}_naive_is_own_stepping
-           COMMAND sh -c "\"$1\" --profile uniform:15:45 --seconds 2 --seed 3 > \"$3.ode.csv\" && \
-\"$2\" --policy naive --profile uniform:15:45 --seconds 2 --seed 3 > \"$3.naive.csv\" && \
+           COMMAND sh -c "\"$1\" --profile uniform:15:45 --duration 2 --seed 3 > \"$3.ode.csv\" && \
+\"$2\" --policy naive --profile uniform:15:45 --duration 2 --seed 3 > \"$3.naive.csv\" && \
 paste -d, \"$3.ode.csv\" \"$3.naive.csv\" | awk -F, 'NR == 1 { n = NF / 2; next } \
 { for (i = 1; i <= n; ++i) { d = $i - $(i + n); if (d < 0) d = -d; if (d > worst) worst = d } rows++ } \
 END { printf \"rows %d, largest difference %g\\n\", rows, worst; exit !(rows > 20 && worst <= 1e-6) }'"
@@ -33,7 +33,7 @@ END { printf \"rows %d, largest difference %g\\n\", rows, worst; exit !(rows > 2
 
   # A pass expression overrides the exit code, so the code is printed and matched too.
   add_test(NAME example_${program}_bad_policy
-           COMMAND sh -c "\"$1\" --policy sideways --seconds 1 2>&1; echo exit $?"
+           COMMAND sh -c "\"$1\" --policy sideways --duration 1 2>&1; echo exit $?"
                    sh $<TARGET_FILE:steadystep_example_${program}_steadystep>)
   set_tests_properties(example_${program}_bad_policy PROPERTIES PASS_REGULAR_EXPRESSION
                        "--policy sideways: [^\n]*\nexit 2\n")
@@ -43,7 +43,7 @@ END { printf \"rows %d, largest difference %g\\n\", rows, worst; exit !(rows > 2
   set_tests_properties(example_${program}_bad_profile PROPERTIES PASS_REGULAR_EXPRESSION
                        "--profile uniform:45:15: [^\n]*\nexit 2\n")
   add_test(NAME example_${program}_csv_header
-           COMMAND steadystep_example_${program}_steadystep --profile fixed:30 --seconds 0.1)
+           COMMAND steadystep_example_${program}_steadystep --profile fixed:30 --duration 0.1)
 endforeach()
 
 set_tests_properties(example_vehicle_csv_header PROPERTIES PASS_REGULAR_EXPRESSION
