@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 import statistics
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -120,12 +119,3 @@ def measure(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: in
         for copy in copies:
             copy.close()
 
-
-def measure_all(scenes, policies: dict, profile: str = DEFAULT_PROFILE, repeats: int = DEFAULT_REPEATS,
-                params: dict | None = None, seed: int = 1) -> tuple[list[Cost], float]:
-    """Every scene's policies (policies: scene -> names) against plain ODE; returns the costs and the benchmark's
-    wall time (s). params: scene -> parameter changes."""
-    started = time.perf_counter()
-    costs = [measure(scene, policy, profile, repeats, seed, (params or {}).get(scene))
-             for scene in scenes for policy in policies[scene]]
-    return costs, time.perf_counter() - started

@@ -228,7 +228,7 @@ def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: f
 
 
 def _costs(report: Report, params: dict, progress: bool | None) -> tuple[list[cost.Cost], float]:
-    """cost.measure_all with a bar: the benchmark runs in this process, once the workers are done, so that its
+    """cost.measure for every scene and policy, with a bar: the benchmark runs in this process, once the workers are done, so that its
     timings are taken on a machine that does nothing else of ours."""
     pairs = [(scene, policy) for scene in report.scenes for policy in report.policies[scene]]
     started = time.perf_counter()
