@@ -19,7 +19,7 @@ import json
 import numpy as np
 
 from steadystep import runs
-from steadystep.profiles import Profile
+from steadystep.profiles import frames_within
 
 SCENE = "chain"
 PROFILE = "uniform:15:45"
@@ -54,19 +54,9 @@ def _record(policy: str, frames: list[float], stepping: dict | None, params: dic
     return {"policy": policy, "t": times, "points": points, "status": status}
 
 
-def _frames(profile: str, duration_s: float, seed: int) -> list[float]:
-    source = Profile(profile, seed)
-    frames, total = [], 0.0
-    while duration_s - total > 1e-9:
-        frame_s = min(source.next(), duration_s - total)
-        frames.append(frame_s)
-        total += frame_s
-    return frames
-
-
 def record(duration_s: float = 5.0, seed: int = 1, params: dict | None = None) -> dict:
     """The chain under naive and implicit-euler at 15-45 fps and the reference (1 ms steps), for duration_s (s)."""
-    frames = _frames(PROFILE, duration_s, seed)
+    frames = list(frames_within(PROFILE, duration_s, seed))
     reference_frames = [REFERENCE_FRAME_S] * int(round(duration_s / REFERENCE_FRAME_S))
     panels = [_record("implicit-euler", reference_frames, runs.reference_stepping(), params,
                       1.0 / REFERENCE_RECORD_HZ)]

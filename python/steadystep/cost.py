@@ -55,11 +55,6 @@ class Cost:
     status: str = "ok"        # "ok", or why the measurement stopped (a blow-up of a copy)
 
 
-def _frames(profile: str, count: int, seed: int) -> np.ndarray:
-    frames = np.asarray(frame_times(profile, count, seed), dtype=np.float64)
-    return frames[:count]
-
-
 def _steps_of(counter: runs.Scene, stepping: dict, frames: np.ndarray) -> np.ndarray:
     """The steps (s each) the stepper takes over frames, counted on counter (stepped ahead, untimed): a whole
     frame, n equal substeps, or n fixed steps, n as the stepper chose."""
@@ -83,17 +78,17 @@ def measure(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: in
     program = runs.Scene(scene, "naive", params=params)
     copies = (stepped, same_steps, counter, program)
     try:
-        first = float(_frames(profile, 1, seed)[0])
+        first = float(frame_times(profile, 1, seed)[0])
         for copy in copies:
             copy.frame(first)  # writes every softness once, as a program tunes it once
         # Calibrate: how many frames make a plain block of about BLOCK_TARGET_S.
-        probe_frames = _frames(profile, 20, seed + 1)
+        probe_frames = frame_times(profile, 20, seed + 1)
         wall = program.time_frames(probe_frames, plain=True)
         same_steps.time_frames(_steps_of(counter, stepping, probe_frames), plain=True)
         stepped.time_frames(probe_frames)
         per_frame = max(wall / len(probe_frames), 1e-7)
         block = int(min(MAX_BLOCK_FRAMES, max(5, BLOCK_TARGET_S / per_frame)))
-        frames = _frames(profile, block * repeats, seed + 2)
+        frames = frame_times(profile, block * repeats, seed + 2)
         steps_before = stepped.counters()["steps"]
         walls = {"policy": [], "same": [], "program": []}
         for r in range(repeats):

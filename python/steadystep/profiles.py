@@ -7,6 +7,7 @@ trace:FILE. Every random kind is seeded and reproducible.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -54,20 +55,33 @@ def frame_times(spec: str, count: int, seed: int = 1) -> np.ndarray:
     return Profile(spec, seed).frames(count)
 
 
-def frame_count(spec: str, duration_s: float, seed: int = 1, limit: int = MAX_RUN_FRAMES) -> int:
-    """The frames the profile hands out within duration_s (s), as a run plays them (the last one shortened to end
-    at duration_s), counted up to limit + 1. Raises SteadystepError for a bad spec, and naming the frame when the
-    profile hands out one that is not a finite positive duration."""
+def frames_within(spec: str, duration_s: float, seed: int = 1) -> Iterator[float]:
+    """The frame durations (s) the profile hands out within duration_s (s), as a run plays them: the last one
+    shortened to end at duration_s, a rounding remainder of at most 1e-9 of the duration not one more frame (as
+    run.c). Raises SteadystepError for a bad spec, and naming the frame when the profile hands out one that is not a
+    finite positive duration."""
     duration_s = number("duration_s", duration_s, "s")
     profile = Profile(spec, seed)
-    end_tolerance_s = 1e-9 * max(1.0, duration_s)  # as run.c: a rounding remainder is the end, not one more frame
+    end_tolerance_s = 1e-9 * max(1.0, duration_s)
     elapsed_s, count = 0.0, 0
     next_frame, handle = lib.ssProfile_Next, profile._profile  # looked up once: a run may have 10^7 frames
-    while duration_s - elapsed_s > end_tolerance_s and count <= limit:
+    while duration_s - elapsed_s > end_tolerance_s:
         frame_s = next_frame(handle)
         if not (math.isfinite(frame_s) and frame_s > 0):
             raise SteadystepError("out of range", f"profile = {shown(spec)}: frame {count + 1} lasts {frame_s!r} s, "
                                   "not a finite positive duration")
+        frame_s = min(frame_s, duration_s - elapsed_s)
         elapsed_s += frame_s
         count += 1
+        yield frame_s
+
+
+def frame_count(spec: str, duration_s: float, seed: int = 1, limit: int = MAX_RUN_FRAMES) -> int:
+    """How many frames frames_within hands out, counted up to limit + 1 (a profile may hand out more than a run may
+    take). Raises as frames_within."""
+    count = 0
+    for _ in frames_within(spec, duration_s, seed):
+        count += 1
+        if count > limit:
+            break
     return count

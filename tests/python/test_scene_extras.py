@@ -92,7 +92,7 @@ def test_plain_ode_at_the_same_steps_takes_the_steppers_own_steps(policy):
     stepping = runs.make_stepping(policy)
     counter = runs.Scene("chain", policy)
     try:
-        frames = cost._frames("uniform:15:45", 60, 3)
+        frames = frame_times("uniform:15:45", 60, 3)
         steps = cost._steps_of(counter, stepping, frames)
         assert len(steps) == counter.counters()["steps"]
         assert steps.sum() == pytest.approx(counter.time_s, rel=1e-12)
