@@ -4,7 +4,6 @@
  * Their sanity bound, a box's lowest corner below the floor, is checked here; each scene gives its depth bound (as a
  * fraction of the box's half side) and the reason for it. */
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 
 #include "error.h"
@@ -83,7 +82,7 @@ double ssBoxes_Check(const ssBoxes* boxes, double side_m, double of_half_side, c
     }
   }
   if (boxes->count == 0) return 0;
-  snprintf(worst, size, "box %d: lowest corner %.6g m below the floor, bound %g m (%g times its %g m half side)",
+  ssBoundMessage(worst, size, "box %d: lowest corner %.6g m below the floor, bound %g m (%g times its %g m half side)",
            deepest, deepest_m, bound_m, of_half_side, 0.5 * side_m);
   return deepest_m / bound_m;
 }

@@ -39,8 +39,10 @@ typedef struct ssSceneDesc {
   /* The followed quantities after a step, info.quantity_count of them. */
   void (*sample)(const void* state, double* out);
   /* The scene's sanity bounds after a step (scene.h): returns the largest value/bound ratio over its bounds (above 1
-   * means one is left; NaN values must not count, a blow-up is the stepper's to report) and writes into worst one
-   * line naming the bound, the body or joint and the value that reached it. May be NULL: no bounds. */
+   * means one is left; NaN values must not count, a blow-up is the stepper's to report) and, unless worst is NULL,
+   * writes into it one line naming the bound, the body or joint and the value that reached it (ssBoundMessage). The
+   * scene asks for the line only when a bound is left: formatting it after every step would cost more than the
+   * check. May be NULL: no bounds. */
   double (*check)(const void* state, char* worst, size_t size);
   /* The scene's drawing (ssScene_Points): writes at most capacity points (x y z) and returns how many it has.
    * May be NULL (no drawing). */
@@ -88,6 +90,13 @@ typedef struct ssBoxes {
 
 /* The sanity bound of a scene of boxes on the floor (scene.h): the largest ratio of a box's lowest corner below the
  * floor to the bound, of_half_side times the box's half side; writes the deepest box into worst. */
+/* A check's line into worst (printf format), or nothing when worst is NULL. */
+void ssBoundMessage(char* worst, size_t size, const char* format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 double ssBoxes_Check(const ssBoxes* boxes, double side_m, double of_half_side, char* worst, size_t size);
 /* How far the lowest corner of a box of side_m (m) is below z = 0 (m; negative when above). */
 double ssBoxDepth(dBodyID box, double side_m);

@@ -101,3 +101,15 @@ def test_plain_ode_at_the_same_steps_takes_the_steppers_own_steps(policy):
     finally:
         counter.close()
 
+
+
+def test_timed_frames_leave_the_labs_bounds_unchecked_and_frames_check_them_again():
+    """A program pays for the stepper, not for the lab's sanity bounds: ssScene_TimeFrames skips them."""
+    scene = runs.Scene("chain", "naive")
+    try:
+        scene.time_frames([2.0])  # tears the chain, as one 2 s frame does (test_cli's broken run)
+        assert scene.broken is None and scene.bound_use == 0
+        scene.frame(2.0)
+        assert scene.broken is not None and "hinge" in scene.broken and scene.bound_use > 1
+    finally:
+        scene.close()

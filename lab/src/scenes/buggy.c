@@ -6,7 +6,6 @@
  * (the hinge-2 rigid rows) to a stiff spring too, so that policy naive freezes all of them and policy spring maps
  * all of them; nothing is left with a fixed ERP/CFM that would blur the comparison. */
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 
 #include "error.h"
@@ -152,7 +151,7 @@ static double check(const void* state, char* worst, size_t size) {
                          BUGGY_HEIGHT_M * fabs(rotation[10])) - position[2];
   double sink_bound_m = BUGGY_MAX_SINK_OF_HALF_HEIGHT * 0.5 * BUGGY_HEIGHT_M;
   double use = sink_m / sink_bound_m;
-  snprintf(worst, size, "chassis: lowest corner %.6g m below the ground, bound %g m (half of its %g m half height)",
+  ssBoundMessage(worst, size, "chassis: lowest corner %.6g m below the ground, bound %g m (half of its %g m half height)",
            sink_m, sink_bound_m, 0.5 * BUGGY_HEIGHT_M);
   const double travel_bound_m = BUGGY_MAX_TRAVEL_M;
   const double gap_bound_m = BUGGY_MAX_GAP_OF_RADIUS * BUGGY_WHEEL_RADIUS_M;
@@ -167,12 +166,12 @@ static double check(const void* state, char* worst, size_t size) {
     double gap_m = sqrt(across[0] * across[0] + across[1] * across[1] + across[2] * across[2]);
     if (fabs(travel_m) / travel_bound_m > use) {
       use = fabs(travel_m) / travel_bound_m;
-      snprintf(worst, size, "wheel %d hinge-2: anchors %.6g m apart along the suspension axis, bound %g m (the wheel "
+      ssBoundMessage(worst, size, "wheel %d hinge-2: anchors %.6g m apart along the suspension axis, bound %g m (the wheel "
                "through the chassis)", i, fabs(travel_m), travel_bound_m);
     }
     if (gap_m / gap_bound_m > use) {
       use = gap_m / gap_bound_m;
-      snprintf(worst, size, "wheel %d hinge-2: anchors %.6g m apart across the suspension axis, bound %g m (%g of "
+      ssBoundMessage(worst, size, "wheel %d hinge-2: anchors %.6g m apart across the suspension axis, bound %g m (%g of "
                "the wheel radius)", i, gap_m, gap_bound_m, BUGGY_MAX_GAP_OF_RADIUS);
     }
   }

@@ -6,7 +6,6 @@
  * bound too, to a stiff spring: otherwise those rows would keep a fixed ERP/CFM and be the one part whose
  * stiffness still changed with the frame time. */
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 
 #include "error.h"
@@ -105,7 +104,7 @@ static double check(const void* state, char* worst, size_t size) {
       widest = i;
     }
   }
-  snprintf(worst, size, "hinge %d: anchors %.6g m apart, bound %g m (%g of a %g m link)", widest, widest_m, bound_m,
+  ssBoundMessage(worst, size, "hinge %d: anchors %.6g m apart, bound %g m (%g of a %g m link)", widest, widest_m, bound_m,
            CHAIN_MAX_GAP_OF_LINK, CHAIN_LINK_M);
   return widest_m / bound_m;
 }

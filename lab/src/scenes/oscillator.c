@@ -4,7 +4,6 @@
  * origin, attached, given its axis and only then moved to x0: the stop then sees an extension of exactly x0. The
  * slider's other five rows are rigid and have no motion to soften, so the world's ERP/CFM are left alone. */
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 
 #include "error.h"
@@ -90,7 +89,7 @@ static double check(const void* state, char* worst, size_t size) {
   double terms_j;
   double e_j = energy(osc, dJointGetSliderPosition(osc->slider), dJointGetSliderPositionRate(osc->slider), &terms_j);
   double bound_j = OSCILLATOR_MAX_ENERGY_GAIN * osc->energy0_j + 1e-9 * terms_j + 1e-12;
-  snprintf(worst, size, "body: energy %.6g J above rest, bound %.6g J (%g times the %.6g J at release): energy made "
+  ssBoundMessage(worst, size, "body: energy %.6g J above rest, bound %.6g J (%g times the %.6g J at release): energy made "
            "by the spring", e_j, bound_j, OSCILLATOR_MAX_ENERGY_GAIN, osc->energy0_j);
   return e_j / bound_j;
 }

@@ -175,6 +175,9 @@ SS_LAB_API int ssScene_Points(const ssScene* scene, double* xyz, int capacity);
  *  cost benchmark: collide, one dWorldQuickStep (or dWorldStep, per the stepping's solver) of the whole frame and
  *  empty the contacts, with every softness left as the stepper last wrote it (contacts softened as for the
  *  stepper's last step). A plain frame needs one ssScene_Frame first, so that every softness has been written.
+ *  Frames through the stepper are timed without the lab's sanity bounds (ssScene_Broken, ssScene_BoundUse skip
+ *  them), which a program does not pay; a plain frame checks only that the followed quantities stay finite, since
+ *  ODE aborts on a step from a non-finite state.
  *  Errors: SS_ERROR_OUT_OF_RANGE (scene, frames_s or wall_s NULL, count < 0, plain not 0 or 1, a plain frame
  *  before any ssScene_Frame, a frame outside [SS_MIN_STEP_S, SS_MAX_STEP_S] when plain); SS_ERROR_BLOWUP when a
  *  plain frame leaves a followed quantity not finite (the frames after it are not stepped); those of ssScene_Frame. */
