@@ -64,15 +64,11 @@ static void tuned_near_callback(void* data, dGeomID geom1, dGeomID geom2) {
     contact->surface.soft_cfm = recipe->soft_cfm;
     /* The tuned values come from a validated spring and the registry was adopted: softening cannot fail. */
     ssStepper_SoftenContact(call->stepper, contact, body1, body2);
-    if (contact->geom.depth > recipe->deepest_m) recipe->deepest_m = contact->geom.depth;
     dJointAttach(dJointCreateContact(recipe->world, recipe->contacts, contact), body1, body2);
-    ++recipe->contact_count;
   }
 }
 
 void ssTunedContactsCollide(ssTunedContacts* recipe, ssStepper* stepper) {
-  recipe->deepest_m = 0;
-  recipe->contact_count = 0;
   TunedCall call = {recipe, stepper};
   dSpaceCollide(recipe->space, &call, tuned_near_callback);
 }

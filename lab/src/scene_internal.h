@@ -103,8 +103,6 @@ typedef struct ssTunedContacts {
   int surface_mode;     /* dContact* mode bits: dContactSoftCFM alone takes the world's ERP */
   double mu;            /* Coulomb friction coefficient (dContactApprox1: force ratio) */
   double soft_erp, soft_cfm; /* tuned at SS_PROGRAM_TUNED_STEP_S */
-  double deepest_m;     /* out: the deepest contact of the last collide call (m) */
-  int contact_count;    /* out: contacts made by the last collide call */
 } ssTunedContacts;
 
 void ssTunedContactsCollide(ssTunedContacts* recipe, ssStepper* stepper);

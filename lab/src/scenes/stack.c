@@ -26,13 +26,13 @@
 #define STACK_MU 0.8
 
 /* Bottom to top: side (m) and mass in multiples of params.mass; at the default 0.1 kg, 20, 2, 0.2, 0.6, 0.1 and
- * 0.3 kg, 200 times apart. Heavier boxes stand on lighter ones (box 3 on box 2, box 5 on box 4, three times their
+ * 0.3 kg, 200 times apart (body_count < 6 stacks the first ones; more would put the 20 kg box on a 0.3 kg one). Heavier boxes stand on lighter ones (box 3 on box 2, box 5 on box 4, three times their
  * mass; box 2's contacts carry five times its weight). The push on the top box, 0.4 of its weight, is below what
  * slides it (mu = 0.8 of its weight) or tips it over the box beneath (its whole weight, for a cube pushed at its
  * centre), and the 1.0 N m it puts on the three boxes above box 2 is below the 1.5 N m their weight holds them with. */
 static const double stack_sides_m[] = {0.6, 0.5, 0.3, 0.4, 0.3, 0.3};
 static const double stack_masses[] = {200, 20, 2, 6, 1, 3};
-enum { STACK_KINDS = sizeof stack_masses / sizeof stack_masses[0] };
+enum { STACK_MAX_BOXES = sizeof stack_masses / sizeof stack_masses[0] };
 
 /* Sanity bounds, measured in test_bounds.cpp. (1) Two neighbours overlap (the lower box's top above the upper box's
  * bottom, from their z extents) by at most 0.07 m, a quarter of the smallest side. Between boxes the contacts sag
@@ -97,10 +97,10 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
 
   double bottom_m = 0;
   for (int i = 0; i < stack->count; ++i) {
-    double side_m = stack_sides_m[i % STACK_KINDS];
+    double side_m = stack_sides_m[i];
     dBodyID box = dBodyCreate(world->world);
     dMass mass;
-    dMassSetBoxTotal(&mass, params->mass * stack_masses[i % STACK_KINDS], side_m, side_m, side_m);
+    dMassSetBoxTotal(&mass, params->mass * stack_masses[i], side_m, side_m, side_m);
     dBodySetMass(box, &mass);
     dBodySetPosition(box, 0, 0, bottom_m + 0.5 * side_m);
     dGeomSetBody(dCreateBox(world->space, side_m, side_m, side_m), box);
@@ -108,7 +108,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
     boxes[i] = box;
     sides[i] = side_m;
   }
-  stack->push_n = STACK_PUSH_OF_WEIGHT * params->gravity * params->mass * stack_masses[(stack->count - 1) % STACK_KINDS];
+  stack->push_n = STACK_PUSH_OF_WEIGHT * params->gravity * params->mass * stack_masses[stack->count - 1];
   status = ssRegistry_Adopt(world->registry, SS_PROGRAM_TUNED_STEP_S, world->space, NULL);
   if (status != SS_OK) {
     destroy(stack);
@@ -188,7 +188,7 @@ const ssSceneDesc ssStackScene = {
     /* ERP 0.2 and soft CFM 1e-3 at 1/60 s, per contact point. */
     .defaults = {.spring = {.stiffness = 12000, .damping = 800}, .mass = 0.1, .x0 = 0, .gravity = 9.81,
                  .body_count = 6},
-    .max_body_count = 12,
+    .max_body_count = STACK_MAX_BOXES,
     .build = build,
     .before_step = before_step,
     .collide = collide,

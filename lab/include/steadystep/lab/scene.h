@@ -20,7 +20,7 @@
  *               ones on lighter ones; world ERP 0.2 and contacts' soft CFM 1e-3 (spring: per contact point);
  *               damping and auto-disable (20 steps) counted in steps, 40 QuickStep iterations; its top box pushed
  *               sideways for 3 s, then it comes to rest and sleeps (top x m, top z m, kinetic energy J);
- *               params.mass is the lightest box's mass, body_count the boxes (at most 12)
+ *               params.mass is the lightest box's mass, body_count the boxes from the bottom (at most 6)
  *   wall        a wall of 69 bricks (0.4 m, params.mass each) in six courses, hit at 12 m/s by a ball ten times a
  *               brick's mass and knocked over: hundreds of contacts a step; contacts' soft ERP 0.5 and soft CFM
  *               0.01, auto-disable after 10 steps (wall mean displacement m, ball x m, ball z m). Not demo_crash's
