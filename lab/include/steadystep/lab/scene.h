@@ -209,7 +209,9 @@ SS_LAB_API int ssScene_Points(const ssScene* scene, double* xyz, int capacity);
  *  scene's stepper (plain = 0, as ssScene_Frame), or (plain = 1) as a program without the library steps, for the
  *  cost benchmark: collide, one dWorldQuickStep (or dWorldStep, per the stepping's solver) of the whole frame and
  *  empty the contacts, with every softness left as the stepper last wrote it (contacts softened as for the
- *  stepper's last step). A plain frame needs one ssScene_Frame first, so that every softness has been written.
+ *  stepper's last step; the stack's push and the piston's motor reversals, added before each step through the
+ *  stepper, are not: the ram stays against the stop it last reached). A plain frame needs one ssScene_Frame first,
+ *  so that every softness has been written.
  *  Frames through the stepper are timed without the lab's sanity bounds (ssScene_Broken, ssScene_BoundUse skip
  *  them), which a program does not pay; a plain frame checks only that the followed quantities stay finite, since
  *  ODE aborts on a step from a non-finite state.
