@@ -1,13 +1,14 @@
 /* A wall of boxes knocked over by a heavy ball, written as ODE programs write one (after reading ODE's demo_crash):
  * a wall of bricks in offset courses on the ground, a cannon ball ten times a brick's mass fired into it, contacts
  * with a soft ERP and a soft CFM tuned at 60 fps, the world's ERP/CFM set as the demo sets them, auto-disable
- * counted in steps (the wall falls asleep before the ball arrives, and the hit wakes it); then adopted
+ * counted in steps (what comes to rest sleeps until something hits it); then adopted
  * (ssRegistry_Adopt) and each contact softened for its step by ssStepper_SoftenContact. Standing, the wall rests on
  * four contacts a brick (276 at the default 69, six courses); falling, it makes hundreds more between bricks.
  *
  * params.spring is the contacts' spring: the soft ERP and soft CFM are what it stands for at 1/60 s (the default,
- * k 4800 N/m and c 20 N*s/m per contact point, is demo_crash's soft ERP 0.8 and soft CFM 0.01). params.mass is a
- * brick's mass; params.body_count the bricks, laid course by course. */
+ * k 3000 N/m and c 50 N*s/m per contact point, is soft ERP 0.5 and soft CFM 0.01: demo_crash's CFM, and a lower ERP
+ * than its 0.8, with which the accurate mappings throw the standing wall apart, scene.h). params.mass is a brick's
+ * mass; params.body_count the bricks, laid course by course. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -31,7 +32,8 @@
 /* Sanity bounds, measured in test_bounds.cpp. (1) The energy above the lowest state (every brick and the ball
  * resting on the ground), kinetic plus potential, at most twice its value at the start: gravity is conservative,
  * nothing drives anything after the launch, and contacts, friction and damping only take energy away, so doubling
- * is energy made by the contacts (bricks shot apart). A run starts at half this bound. (2) No brick's lowest corner
+ * is energy made by the contacts (bricks shot apart). A run starts at half this bound. Without gravity pulling
+ * down (params.gravity <= 0) there is no resting state to measure from, and this bound is not checked. (2) No brick's lowest corner
  * more than its half side (0.2 m) below the floor, its centre not under it: bricks of the top course fall 2 m and
  * land at up to 6.3 m/s, 10.5 cm in a 1/60 s step before their first contact is found (where discrete collision
  * finds it, whatever the softness), while the standing wall sags by millimetres (five bricks on a bottom brick's
@@ -165,11 +167,14 @@ static void sample(const void* state, double* out) {
 
 static double check(const void* state, char* worst, size_t size) {
   const Wall* wall = state;
-  double energy_bound_j = WALL_MAX_ENERGY_GAIN * wall->energy_start_j;
-  double energy_j = energy(wall);
-  double use = energy_j / energy_bound_j;
-  ssBoundMessage(worst, size, "energy %.6g J above the resting state, bound %g J (twice its %g J at the start)",
-                 energy_j, energy_bound_j, wall->energy_start_j);
+  double use = 0;
+  if (wall->gravity > 0) {
+    double energy_bound_j = WALL_MAX_ENERGY_GAIN * wall->energy_start_j;
+    double energy_j = energy(wall);
+    use = energy_j / energy_bound_j;
+    ssBoundMessage(worst, size, "energy %.6g J above the resting state, bound %g J (twice its %g J at the start)",
+                   energy_j, energy_bound_j, wall->energy_start_j);
+  }
   const double depth_bound_m = WALL_MAX_DEPTH_OF_HALF_SIDE * 0.5 * WALL_SIDE_M;
   for (int i = 0; i < wall->count; ++i) {
     double depth_m = ssBoxDepth(wall->bricks[i], WALL_SIDE_M);

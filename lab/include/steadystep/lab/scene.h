@@ -50,7 +50,8 @@
  *               apart
  *   stack       neighbours overlapping by at most 0.07 m (a quarter of the smallest side); each box's centre at
  *               most a third of its side across from the one below (slid off or fallen)
- *   wall        energy above the resting state at most twice its value at the start (nothing drives the wall);
+ *   wall        energy above the resting state at most twice its value at the start (nothing drives the wall;
+ *               checked with gravity > 0, which gives a resting state);
  *               no brick's centre below the floor
  *   piston      the ram at most 0.06 m beyond a stop (a 1/15 s step at the motor's speed passes it by 5.3 cm), the
  *               arm at most 0.25 rad beyond its stops; the ram at most 0.01 m off its axis and the hinge's
