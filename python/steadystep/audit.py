@@ -15,8 +15,8 @@ For each followed quantity q, with A_q = max - min of q over the reference:
   times of (q_run - q_first)^2) / A_q, every run interpolated linearly onto those times;
 - deviation (from the reference) = sqrt(mean over all the variant's runs of the mean over the reference's times of
   (q_run - q_reference)^2) / A_q.
-Both are given over the whole run and over the window where the reference holds (check_reference); every claim of
-the recommendation uses the window. A variant with a failed run has spread and deviation inf.
+Both are given over the whole run and over the times where the reference holds (check_reference); every claim of
+the recommendation uses those. A variant with a failed run has spread and deviation inf.
 """
 
 from __future__ import annotations
@@ -80,7 +80,7 @@ class Audit:
     duration_s: float
     quantities: list[str]
     amplitudes: dict[str, float]
-    reference: dict                     # the check: window_end_s, holds, difference per quantity, fps
+    reference: dict                     # check_reference(): where the reference holds
     spread: dict = field(default_factory=dict)      # "whole" / "window" -> variant -> quantity -> value
     deviation: dict = field(default_factory=dict)   # likewise
     runs: list[dict] = field(default_factory=list)  # one per run: variant, profile, seed, status, steps, cost...
@@ -149,43 +149,65 @@ def _on(t: np.ndarray, run: Run, quantity: str) -> np.ndarray:
     return np.interp(t, run.columns[TIME_COLUMN], run.columns[quantity])
 
 
-def _rms_against(runs: list[Run], against: Run, quantity: str, until_s: float) -> float:
-    """sqrt(mean over runs of the mean over against's times up to until_s of (q_run - q_against)^2)."""
+def _rms_against(runs: list[Run], against: Run, quantity: str, holds=None) -> float:
+    """sqrt(mean over runs of the mean over against's times where the reference holds (holds(t); None: every time)
+    of (q_run - q_against)^2)."""
     t = against.columns[TIME_COLUMN]
-    inside = t <= until_s
+    inside = np.ones(len(t), bool) if holds is None else holds(t)
+    if not np.any(inside):
+        return math.nan
     truth = against.columns[quantity][inside]
     return float(np.sqrt(np.mean([np.mean((_on(t[inside], run, quantity) - truth) ** 2) for run in runs])))
 
 
 def check_reference(reference: Run, check: Run, quantities: list[str], amplitudes: dict, duration_s: float,
                     reference_fps: int, check_fps: int) -> dict:
-    """Where the reference holds: the two references' difference per quantity on the reference's times, its RMS over
-    a centred window, and the first time that exceeds REFERENCE_TOLERANCE of the range (the window's end)."""
+    """Where the reference holds: on the reference's times, the two references' difference per quantity over its
+    range, as an RMS over a centred moving window of REFERENCE_WINDOW_S (a fifth of the run if shorter); the
+    reference holds where that stays within REFERENCE_TOLERANCE for every quantity. A stretch where it holds that is
+    shorter than the moving window, between two where it does not, counts as not held (two chaotic runs that cross
+    by chance). Returns the stretches not held ([start, end] s), the time held, and the differences."""
     t = reference.columns[TIME_COLUMN]
     width_s = min(REFERENCE_WINDOW_S, duration_s / 5)
     half = max(1, int(round(width_s / 2 * reference_fps)))
-    end_s = duration_s
-    parted_by = None
-    difference, largest = {}, {}
+    holds = np.ones(len(t), bool)
+    moving, largest, parted_by = {}, {}, []
+    index = np.arange(len(t))
+    lo, hi = np.clip(index - half, 0, len(t)), np.clip(index + half + 1, 0, len(t))
     for q in quantities:
         d = (_on(t, check, q) - reference.columns[q]) / amplitudes[q] if amplitudes[q] > 0 else np.zeros_like(t)
         squares = np.concatenate(([0.0], np.cumsum(d ** 2)))
-        lo = np.clip(np.arange(len(t)) - half, 0, len(t))
-        hi = np.clip(np.arange(len(t)) + half + 1, 0, len(t))
-        moving = np.sqrt((squares[hi] - squares[lo]) / (hi - lo))
-        difference[q] = moving
-        largest[q] = float(np.max(moving)) if len(moving) else 0.0
-        over = np.flatnonzero(moving > REFERENCE_TOLERANCE)
-        if len(over) and t[over[0]] < end_s:
-            end_s, parted_by = float(t[over[0]]), q
-    inside = t <= end_s
-    floor = {q: float(np.sqrt(np.mean(((_on(t[inside], check, q) - reference.columns[q][inside])
-                                       / amplitudes[q]) ** 2))) if amplitudes[q] > 0 else 0.0 for q in quantities}
+        moving[q] = np.sqrt((squares[hi] - squares[lo]) / (hi - lo))
+        largest[q] = float(np.max(moving[q]))
+        if largest[q] > REFERENCE_TOLERANCE:
+            parted_by.append(q)
+            holds &= moving[q] <= REFERENCE_TOLERANCE
+    stretches = _stretches(t, ~holds)
+    for (_, end_a), (start_b, _) in zip(stretches, stretches[1:]):
+        if start_b - end_a < 2 * half / reference_fps:
+            holds[(t >= end_a) & (t <= start_b)] = False
+    not_held = _stretches(t, ~holds)
+    step = np.diff(t, append=t[-1])
+    held_s = float(np.sum(step[holds]))
+    floor = {q: float(np.sqrt(np.mean((_on(t[holds], check, q) - reference.columns[q][holds]) ** 2)) / amplitudes[q])
+             if amplitudes[q] > 0 and np.any(holds) else 0.0 for q in quantities}
     return {"reference_fps": reference_fps, "check_fps": check_fps, "tolerance": REFERENCE_TOLERANCE,
-            "window_s": 2 * half / reference_fps, "holds_whole_run": parted_by is None, "window_end_s": end_s,
-            "parted_by": parted_by, "usable": end_s >= MIN_WINDOW_FRACTION * duration_s,
+            "window_s": 2 * half / reference_fps, "holds_whole_run": not parted_by, "not_held": not_held,
+            "held_s": held_s, "parted_by": parted_by, "usable": held_s >= MIN_WINDOW_FRACTION * duration_s,
             "largest_moving_difference": largest, "difference_in_window": floor,
-            "_moving": {q: v for q, v in difference.items()}, "_t": t}
+            "_moving": moving, "_t": t, "_holds": holds}
+
+
+def _stretches(t: np.ndarray, mask: np.ndarray) -> list[list[float]]:
+    """The [first, last] times of each run of True in mask."""
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.astype(int), [0]))))
+    return [[float(t[a]), float(t[b - 1])] for a, b in zip(edges[::2], edges[1::2])]
+
+
+def holds_at(checked: dict):
+    """A function of times (s) that is True where the reference holds (both neighbours on its times hold)."""
+    t, holds = checked["_t"], checked["_holds"].astype(float)
+    return lambda times: np.interp(times, t, holds) >= 1.0
 
 
 def measure(program, variants: list[str], runs_per_variant, duration_s: float, done: dict) -> Audit:
@@ -207,16 +229,16 @@ def measure(program, variants: list[str], runs_per_variant, duration_s: float, d
     checked = check_reference(reference, check, quantities, amplitudes, duration_s, reference_fps, check_fps)
     result = Audit(program.name, None if program.own is None else Path(program.own[0]).name, variants,
                    list(runs_per_variant), duration_s, quantities, amplitudes, checked)
-    for window, until_s in (("whole", math.inf), ("window", checked["window_end_s"])):
+    for window, holds in (("whole", None), ("window", holds_at(checked))):
         result.spread[window], result.deviation[window] = {}, {}
         for variant in variants:
             runs = [done[variant, profile, seed] for profile, seed in runs_per_variant]
             failed = not all(run.ok for run in runs)
             result.spread[window][variant] = {
-                q: math.inf if failed else (_rms_against(runs[1:], runs[0], q, until_s) / amplitudes[q]
+                q: math.inf if failed else (_rms_against(runs[1:], runs[0], q, holds) / amplitudes[q]
                                             if len(runs) > 1 else math.nan) for q in quantities}
             result.deviation[window][variant] = {
-                q: math.inf if failed else _rms_against(runs, reference, q, until_s) / amplitudes[q]
+                q: math.inf if failed else _rms_against(runs, reference, q, holds) / amplitudes[q]
                 for q in quantities}
     for variant in variants:
         costs = []

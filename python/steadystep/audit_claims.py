@@ -63,8 +63,7 @@ def claims(result) -> list[dict]:
     out.append(_failed(result))
     if not result.reference["usable"]:
         return out + _served(result)
-    window = "the whole run" if result.reference["holds_whole_run"] else \
-        f"[0, {result.reference['window_end_s']:.3g} s]"
+    window = window_text(result.reference, result.duration_s)
     spread = {v: worst(result.spread["window"], v) for v in result.variants}
     deviation = {v: worst(result.deviation["window"], v) for v in result.variants}
     if any(math.isfinite(x) for x in spread.values()):
@@ -111,10 +110,22 @@ def claims(result) -> list[dict]:
     return out + _served(result)
 
 
+def window_text(reference: dict, duration_s: float) -> str:
+    """Where the motion claims are measured: the whole run, or the time the reference holds."""
+    if reference["holds_whole_run"]:
+        return "the whole run"
+    return f"the {reference['held_s']:.3g} s of {duration_s:g} s where the reference holds"
+
+
+def _stretch_text(stretches: list) -> str:
+    shown = [f"{a:.3g}-{b:.3g} s" for a, b in stretches[:4]]
+    return ", ".join(shown) + (f" and {len(stretches) - 4} more" if len(stretches) > 4 else "")
+
+
 def _reference(result) -> dict:
     r = result.reference
     data = {"kind": "reference", "table": "reference", "holds_whole_run": r["holds_whole_run"],
-            "window_end_s": r["window_end_s"], "parted_by": r["parted_by"], "usable": r["usable"],
+            "not_held": r["not_held"], "held_s": r["held_s"], "parted_by": r["parted_by"], "usable": r["usable"],
             "tolerance": r["tolerance"]}
     pair = (f"{REFERENCE_FPS_TEXT.format(r['reference_fps'])} and its check at {r['check_fps']} frames a second "
             f"(RMS over {r['window_s']:.3g} s windows)")
@@ -122,12 +133,12 @@ def _reference(result) -> dict:
         text = (f"The reference holds over the whole run: {pair} stay within {r['tolerance']:.0%} of each "
                 f"quantity's range (at most {_g(max(r['largest_moving_difference'].values()))}).")
     else:
-        text = (f"The reference holds only up to t = {r['window_end_s']:.3g} s: there {pair} part by more than "
-                f"{r['tolerance']:.0%} of the range of {r['parted_by']}, so the motion after it is sensitive to "
+        text = (f"The reference does not hold at {_stretch_text(r['not_held'])}: there {pair} part by more than "
+                f"{r['tolerance']:.0%} of the range of {', '.join(r['parted_by'])}, so the motion there depends on "
                 "the step itself (chaos, or an event such as an impact), not a frame-rate dependence to measure. ")
-        text += ("Every claim below is measured on [0, {:.3g} s].".format(r["window_end_s"]) if r["usable"] else
-                 f"That is less than {MIN_FRACTION_TEXT} of the run: no claim about the motion is made; audit a "
-                 "shorter duration.")
+        text += (f"Every claim below is measured on the other {r['held_s']:.3g} s." if r["usable"] else
+                 f"It holds for {r['held_s']:.3g} s, less than {MIN_FRACTION_TEXT} of the run: no claim about the "
+                 "motion is made; audit a shorter duration.")
     data["text"] = text
     return data
 

@@ -111,8 +111,8 @@ class Executable:
             if path.is_dir():
                 raise _bad(f"{flag} {command[0]}: is a directory, not a program")
             if not os.access(path, os.X_OK):
-                raise _bad(f"{flag} {command[0]}: is not executable (chmod +x it, or name the interpreter: "
-                           f"--own/PROGRAM is run as it is)")
+                raise _bad(f"{flag} {command[0]}: is not executable (chmod +x it, or put its interpreter "
+                           f"first: 'python3 {command[0]}')")
 
 
 @dataclass(frozen=True)
