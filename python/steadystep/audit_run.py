@@ -197,7 +197,8 @@ def _run_executable(program: Executable, variant: str, profile: str, seed: int, 
         started = time.perf_counter()
         try:
             process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=out, stderr=err,
-                                       start_new_session=True)  # its own group: a hung program is killed whole
+                                       start_new_session=True,  # its own group: a hung program is killed whole
+                                       preexec_fn=_die_with_parent)
         except OSError as error:
             raise _bad(f"{shown}: cannot be started: {error.strerror or error}") from None
         status, usage = _wait(process, program.time_limit_s, shown)
@@ -224,24 +225,38 @@ def _run_executable(program: Executable, variant: str, profile: str, seed: int, 
     return Run(variant, profile, seed, columns, run_status, cpu_s, wall_s)
 
 
+def _die_with_parent() -> None:
+    """In the child, before exec (Linux): killed when the process that started it dies, so that a worker stopped
+    by Ctrl-C or a failure elsewhere leaves no program running."""
+    import ctypes
+
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+
+
 def _wait(process: subprocess.Popen, time_limit_s: float, shown: str):
-    """(wait status, resource usage) of the process, killed with its group after time_limit_s (BadProgram)."""
+    """(wait status, resource usage) of the process, killed with its group after time_limit_s (BadProgram) or
+    when this wait is interrupted."""
     deadline = time.monotonic() + time_limit_s
     pause = 0.0005
-    while True:
-        pid, status, usage = os.wait4(process.pid, os.WNOHANG)
-        if pid == process.pid:
-            process.returncode = 0  # reaped here: Popen must not wait for it again
-            return status, usage
-        if time.monotonic() > deadline:
-            with contextlib.suppress(ProcessLookupError):
-                os.killpg(process.pid, signal.SIGKILL)
+    try:
+        while True:
+            pid, status, usage = os.wait4(process.pid, os.WNOHANG)
+            if pid == process.pid:
+                process.returncode = 0  # reaped here: Popen must not wait for it again
+                return status, usage
+            if time.monotonic() > deadline:
+                raise _bad(f"{shown}: did not finish within the time limit of {time_limit_s:g} s per run "
+                           "(--time-limit): killed")
+            time.sleep(pause)
+            pause = min(2 * pause, 0.02)
+    except BaseException:  # the time limit, or Ctrl-C: the program and its children go
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)
+        with contextlib.suppress(ChildProcessError):
             os.wait4(process.pid, 0)
-            process.returncode = -signal.SIGKILL
-            raise _bad(f"{shown}: did not finish within the time limit of {time_limit_s:g} s per run "
-                       "(--time-limit): killed")
-        time.sleep(pause)
-        pause = min(2 * pause, 0.02)
+        process.returncode = -signal.SIGKILL
+        raise
 
 
 def _signal_name(number: int) -> str:

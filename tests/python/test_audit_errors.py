@@ -72,10 +72,26 @@ def test_missing_and_not_executable(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+def test_usage_errors(tmp_path):
+    good = script(tmp_path, "good", GOOD)
+    refused(audit("--out", tmp_path / "out", *QUICK), "PROGRAM", "--python")
+    refused(audit("--python", tmp_path / "x.py", "--own", good, "--out", tmp_path / "out", *QUICK), "--own",
+            "no own stepping")
+    refused(audit(good, "--out", tmp_path / "out", "--profiles", "uniform:45:15"), "uniform:45:15")
+    refused(audit(good, "--out", tmp_path / "out", "--policies", "sideways"), "sideways")
+    refused(audit(good, "--out", tmp_path / "out", "--duration", "-1"), "-1")
+    assert not (tmp_path / "out").exists()
+    help_text = audit("--help")
+    assert help_text.returncode == 0 and "usage: steadystep audit" in help_text.stdout
+
+
 def test_a_hang_is_killed_at_the_time_limit(tmp_path):
-    program = script(tmp_path, "hang", "exec sleep 60\n")
+    program = script(tmp_path, "hang", "sleep 61.25 & wait\n")  # a child of its own too
     done = audit(program, "--out", tmp_path / "out", "--time-limit", "0.5", *QUICK)
     refused(done, "hang", "time limit of 0.5 s", "--time-limit", "killed")
+    # killed with its process group: neither the script nor its sleep left running
+    left = subprocess.run(["pgrep", "-f", f"{program}|sleep 61.25"], capture_output=True, text=True).stdout.split()
+    assert left == [], left
 
 
 def test_a_failed_frame_is_a_status_not_a_refusal(tmp_path):
