@@ -33,7 +33,7 @@ import numpy as np
 
 from steadystep import study
 from steadystep._native import SteadystepError, number, printable
-from steadystep.audit_run import (OPTIONAL_COLUMNS, OWN, SERVED_COLUMNS, STEP_COLUMN, TIME_COLUMN, BadProgram,
+from steadystep.audit_run import (OWN, SERVED_COLUMNS, STEP_COLUMN, TIME_COLUMN, BadProgram,
                                   Executable, PythonProgram, PythonWorld, Run)
 from steadystep.audit_run import run as run_program
 from steadystep.profiles import Profile, seed_value

@@ -55,7 +55,8 @@ def add_parser(commands, seed_type, executor_argument) -> None:
     parser.add_argument("--duration", type=_positive, default=audit.DEFAULT_DURATION_S, metavar="S",
                         help=f"simulated seconds per run (default {audit.DEFAULT_DURATION_S:g})")
     parser.add_argument("--time-limit", type=_positive, default=60.0, metavar="S",
-                        help="wall seconds a run may take before it is killed and the program refused (default 60)")
+                        help="wall seconds a run of an executable may take before it is killed and the program "
+                        "refused (default 60)")
     executor_argument(parser)
 
 
@@ -73,7 +74,7 @@ def command(args, argv) -> int:
         if args.own:
             raise SteadystepError("out of range", f"--own {args.own}: a --python program is stepped by the library "
                                   "and has no own stepping to compare")
-        program = PythonProgram(args.python, args.time_limit)
+        program = PythonProgram(args.python)
     else:
         words = shlex.split(args.program)
         if not words:

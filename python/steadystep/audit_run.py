@@ -23,7 +23,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import importlib.util
-import math
 import os
 import shlex
 import signal
@@ -119,8 +118,7 @@ class Executable:
 class PythonProgram:
     """A Python file defining build_world() and read_quantities(world) (the module's docstring)."""
 
-    path: str
-    time_limit_s: float = 60.0
+    path: str  # steps in the audit's own process (or worker): the time limit is for executables
 
     @property
     def name(self) -> str:
