@@ -64,14 +64,12 @@ static int record(const ssAuditFlags* flags, double time_s, const ssAuditFrame* 
   return ssAuditRow(flags, time_s, 2, values, frame);
 }
 
-/* What served the frame's rows and contacts, from its report (-1: a count this report does not give). */
+/* What served the frame's rows and contacts, from its report. */
 static ssAuditFrame counts(const ssFrameReport* report) {
-  ssAuditFrame frame = {report->steps, {-1, 0, 0, 0, -1, 0}};
-  frame.served.rows_handed_to_matched = report->apply.rows_exact_fallback;
-  frame.served.rows_handed_to_implicit_euler = report->apply.rows_implicit_euler_fallback;
-  frame.served.contacts_by_mapping = report->contacts_softened - report->contacts_implicit_euler_fallback;
-  frame.served.contacts_handed_to_implicit_euler = report->contacts_implicit_euler_fallback;
-  return frame;
+  const ssServedCounts *rows = &report->rows, *contacts = &report->contacts;
+  return (ssAuditFrame){report->steps,
+                        {rows->by_mapping, rows->handed_to_matched, rows->handed_to_implicit_euler,
+                         contacts->by_mapping, contacts->handed_to_matched, contacts->handed_to_implicit_euler}};
 }
 
 int main(int argc, char** argv) {

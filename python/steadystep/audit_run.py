@@ -136,8 +136,10 @@ class PythonProgram:
 class PythonWorld:
     """What a Python program's build_world() returns: its odepy world and what the stepper needs to step it.
 
-    world: the odepy dWorldID (required). registry: a steadystep Registry of it, or None: then the audit makes one
-    and adopts the world and everything space reaches as tuned at tuned_step_s (s). collide(stepper): called before
+    world: the odepy dWorldID (required). registry: a steadystep Registry of it, or None. space: the program's space,
+    or None: with it, the stepper adopts the world and everything the space reaches as tuned at tuned_step_s (s),
+    into registry or into one of its own. tuned_step_s: the step the program tuned its numbers for, which the
+    stepper also takes as its longest (and fixed) step. collide(stepper): called before
     each physics step (its near callback calls stepper.soften_contact). contact_group: emptied after each step.
     before_frame(time_s): the program's per-frame logic (forces, controls), called before each frame with the
     simulated time (s). close(): destroys what build_world made (the world last); the audit closes its stepper (and
@@ -331,8 +333,8 @@ def _run_python(program: PythonProgram, variant: str, profile: str, seed: int, d
     """The Python program's world stepped here by a Stepper under variant, a frame of the profile at a time."""
     import odepy
 
+    from steadystep.enums import Solver
     from steadystep.profiles import frames_within
-    from steadystep.registry import Registry
     from steadystep.stepper import Stepper
 
     if variant == OWN:
@@ -344,17 +346,16 @@ def _run_python(program: PythonProgram, variant: str, profile: str, seed: int, d
     built = _call_user(shown, "build_world", module.build_world)
     if not isinstance(built, PythonWorld):
         raise _bad(f"{shown}: build_world() returned {type(built).__name__}, not a steadystep.audit.PythonWorld")
-    registry, made_registry = built.registry, False
     stepper = None
     try:
-        if registry is None:
-            registry, made_registry = Registry(built.world), True
-            if built.space is not None:
-                registry.adopt(built.tuned_step_s, built.space)
-        options = dict(policy=variant, collide=built.collide, contact_group=built.contact_group)
-        if "solver" in Stepper.__init__.__code__.co_varnames:  # the API that requires the solver (api.md)
-            options["solver"] = built.solver
-        stepper = Stepper(built.world, registry, **options)
+        solver = {"quick": Solver.QUICK, "step": Solver.STEP}.get(built.solver)
+        if solver is None:
+            raise _bad(f"{shown}: PythonWorld.solver = {built.solver!r}: must be 'quick' (dWorldQuickStep) or "
+                       "'step' (dWorldStep)")
+        stepper = _call_user(shown, "the Stepper of build_world()'s PythonWorld", Stepper, built.world,
+                             built.registry, space=built.space,
+                             tuned_step_s=built.tuned_step_s, solver=solver,
+                             policy=variant, collide=built.collide, contact_group=built.contact_group)
         names, rows = None, []
         status = "ok"
         time_s, started_cpu, started = 0.0, time.process_time(), time.perf_counter()
@@ -367,7 +368,7 @@ def _run_python(program: PythonProgram, variant: str, profile: str, seed: int, d
                 parse_csv(",".join(names) + "\n", shown, allow_empty=True)  # the names checked as a CSV's
             rows.append([time_s, *(float(values[name]) for name in names[1:len(values) + 1]), *counts.values()])
 
-        record(_no_counts())
+        record({STEP_COLUMN: 0, **{name: 0 for name in SERVED_COLUMNS}})
         for frame_s in frames_within(profile, duration_s, seed):
             if built.before_frame is not None:
                 _call_user(shown, "before_frame", built.before_frame, time_s)
@@ -382,8 +383,6 @@ def _run_python(program: PythonProgram, variant: str, profile: str, seed: int, d
     finally:
         if stepper is not None:
             stepper.close()
-        if made_registry:
-            registry.close()
         if built.close is not None:
             _call_user(shown, "close", built.close)
         odepy.dCloseODE()
@@ -394,34 +393,16 @@ def _run_python(program: PythonProgram, variant: str, profile: str, seed: int, d
 
 
 def served_counts(report) -> dict:
-    """The frame's served counts (SERVED_COLUMNS) from a Stepper's FrameReport, whichever of the two report layouts
-    the library has: api.md's rows/contacts (every count), or the older one, which counts only the rows and
-    contacts handed on (rows served by the mapping itself are not counted there, so that column is left out)."""
-    rows, contacts = getattr(report, "rows", None), getattr(report, "contacts", None)
-    if rows is not None and contacts is not None:
-        return dict(zip(SERVED_COLUMNS, (rows.by_mapping, rows.handed_to_matched, rows.handed_to_implicit_euler,
-                                         contacts.by_mapping, contacts.handed_to_matched,
-                                         contacts.handed_to_implicit_euler)))
-    handed = report.contacts_implicit_euler_fallback
-    return {"rows_handed_to_matched": report.apply.rows_exact_fallback,
-            "rows_handed_to_implicit_euler": report.apply.rows_implicit_euler_fallback,
-            "contacts_by_mapping": report.contacts_softened - handed, "contacts_handed_to_implicit_euler": handed}
+    """The frame's served counts (SERVED_COLUMNS) from a Stepper's FrameReport."""
+    rows, contacts = report.rows, report.contacts
+    return dict(zip(SERVED_COLUMNS, (rows.by_mapping, rows.handed_to_matched, rows.handed_to_implicit_euler,
+                                     contacts.by_mapping, contacts.handed_to_matched,
+                                     contacts.handed_to_implicit_euler)))
 
 
-def _no_counts() -> dict:
-    """The t = 0 row's counts: the columns served_counts gives for this library's report, each 0."""
-    from steadystep.stepper import FrameReport
-
-    fields = {item.name for item in dataclasses.fields(FrameReport)}
-    names = SERVED_COLUMNS if {"rows", "contacts"} <= fields else (
-        "rows_handed_to_matched", "rows_handed_to_implicit_euler", "contacts_by_mapping",
-        "contacts_handed_to_implicit_euler")
-    return {STEP_COLUMN: 0, **{name: 0 for name in names}}
-
-
-def _call_user(shown: str, name: str, function, *args):
+def _call_user(shown: str, name: str, function, *args, **keywords):
     try:
-        return function(*args)
+        return function(*args, **keywords)
     except Exception as error:  # the user's code: its failure named in one line
         raise _bad(f"{shown}: {name}() raised {type(error).__name__}: {error}") from None
 
