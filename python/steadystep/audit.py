@@ -36,7 +36,7 @@ from steadystep._native import SteadystepError, number, printable
 from steadystep.audit_run import (OWN, SERVED_COLUMNS, STEP_COLUMN, TIME_COLUMN, BadProgram,
                                   Executable, PythonProgram, PythonWorld, Run)
 from steadystep.audit_run import run as run_program
-from steadystep.profiles import Profile, seed_value
+from steadystep.profiles import Profile, frame_count, seed_value
 
 __all__ = ["Audit", "BadProgram", "Executable", "PythonProgram", "PythonWorld", "audit", "write",
            "DEFAULT_PROFILES", "DEFAULT_SEEDS"]
@@ -51,7 +51,7 @@ CHECK_FPS = 4000       # the check of the reference: four times finer
 # fifth of the run, if shorter) stays within REFERENCE_TOLERANCE of the quantity's range, for every quantity.
 REFERENCE_TOLERANCE = 0.05
 REFERENCE_WINDOW_S = 1.0
-# A window shorter than this fraction of the run leaves too little to claim anything.
+# A reference that holds for less than this fraction of the run leaves too little to claim anything.
 MIN_WINDOW_FRACTION = 0.2
 # Costs within this fraction of the cheapest are not told apart by one set of runs.
 COST_TIE = 0.1
@@ -87,7 +87,7 @@ class Audit:
     cost: dict = field(default_factory=dict)        # variant -> cpu_ms_per_simulated_s (median over its runs)
     served: dict = field(default_factory=dict)      # variant -> column -> sum over its runs (columns present)
     claims: list[dict] = field(default_factory=list)
-    trajectories: dict = field(default_factory=dict)  # for the figures: name -> (t, {quantity: values})
+    trajectories: dict = field(default_factory=dict)  # for the figures: reference, check, each variant's first run
     elapsed_s: float = 0.0
 
 
@@ -160,6 +160,14 @@ def _rms_against(runs: list[Run], against: Run, quantity: str, holds=None) -> fl
     return float(np.sqrt(np.mean([np.mean((_on(t[inside], run, quantity) - truth) ** 2) for run in runs])))
 
 
+def _relative(rms: float, amplitude: float) -> float:
+    """rms over the reference's range; a quantity the reference holds still: 0 when the run does too, else inf (as
+    metrics.rms_deviation)."""
+    if amplitude > 0 or math.isnan(rms):
+        return rms / amplitude if amplitude > 0 else rms
+    return 0.0 if rms == 0 else math.inf
+
+
 def check_reference(reference: Run, check: Run, quantities: list[str], amplitudes: dict, duration_s: float,
                     reference_fps: int, check_fps: int) -> dict:
     """Where the reference holds: on the reference's times, the two references' difference per quantity over its
@@ -217,6 +225,12 @@ def measure(program, variants: list[str], runs_per_variant, duration_s: float, d
         if not run.ok:
             raise BadProgram("bad program", f"{program.name}: the {name} ({REFERENCE_POLICY}, {run.profile}) "
                              f"failed, so nothing can be measured: {run.status}")
+    for run in (reference, check):  # a program that ignores --profile would measure the same run everywhere
+        expected = frame_count(run.profile, duration_s, run.seed)
+        if run.frames and abs(run.frames - expected) > 1:
+            raise BadProgram("bad program", f"{program.name}: under --profile {run.profile} --duration "
+                             f"{duration_s:g} it printed {run.frames} frames, not the profile's {expected}: it does "
+                             "not follow --profile (one CSV row per frame of the profile, after a t = 0 row)")
     quantities = reference.quantities()
     for key, run in done.items():
         if run.quantities() != quantities:
@@ -235,10 +249,10 @@ def measure(program, variants: list[str], runs_per_variant, duration_s: float, d
             runs = [done[variant, profile, seed] for profile, seed in runs_per_variant]
             failed = not all(run.ok for run in runs)
             result.spread[window][variant] = {
-                q: math.inf if failed else (_rms_against(runs[1:], runs[0], q, holds) / amplitudes[q]
+                q: math.inf if failed else (_relative(_rms_against(runs[1:], runs[0], q, holds), amplitudes[q])
                                             if len(runs) > 1 else math.nan) for q in quantities}
             result.deviation[window][variant] = {
-                q: math.inf if failed else _rms_against(runs, reference, q, holds) / amplitudes[q]
+                q: math.inf if failed else _relative(_rms_against(runs, reference, q, holds), amplitudes[q])
                 for q in quantities}
     for variant in variants:
         costs = []

@@ -179,7 +179,7 @@ def page(result, out_dir: Path, command: str) -> str:
         "<h2>Spread across frame rates</h2>", _by_quantity(result, result.spread, "spread"),
         f"<p class=small>Spread: each run after the first ({html.escape(first[0])} seed {first[1]}) against the "
         "first of the same variant on the first's times, RMS over runs and time, divided by the reference's range A "
-        "(max − min). Window: up to where the reference holds (below). Bold: the smallest of a column; failed: a "
+        "(max − min). Window: the times where the reference holds (below). Bold: the smallest of a column; failed: a "
         "run of that variant failed.</p>",
         "<h2>Deviation from the fine-step reference</h2>", _by_quantity(result, result.deviation, "deviation"),
         "<p class=small>Deviation: every run of the variant against the reference on the reference's times, RMS "

@@ -36,8 +36,12 @@ def refused(done, *words) -> str:
     return lines[0]
 
 
-# A program that prints the protocol's CSV: a line x = t (m).
-GOOD = 'echo t_s,x_m; echo 0,0; echo 0.25,0.25; echo 0.5,0.5\n'
+# A program that prints the protocol's CSV under fixed:FPS profiles: a row per frame of x = t (m).
+GOOD = ('fps=30; d=1\n'
+        'while [ $# -gt 0 ]; do case "$1" in --profile) fps=${2#fixed:}; shift;; --duration) d=$2; shift;; esac; '
+        'shift; done\n'
+        'awk -v f="$fps" -v d="$d" \'BEGIN { print "t_s,x_m"; n = int(f * d + 0.5); '
+        'for (i = 0; i <= n; i++) printf "%.17g,%.17g\\n", i / f, i / f }\'\n')
 
 
 @pytest.mark.parametrize("name, body, words", [
@@ -92,6 +96,12 @@ def test_a_hang_is_killed_at_the_time_limit(tmp_path):
     # killed with its process group: neither the script nor its sleep left running
     left = subprocess.run(["pgrep", "-f", f"{program}|sleep 61.25"], capture_output=True, text=True).stdout.split()
     assert left == [], left
+
+
+def test_a_program_that_ignores_the_profile(tmp_path):
+    program = script(tmp_path, "deaf", "echo t_s,x_m; echo 0,0; echo 0.25,0.25; echo 0.5,0.5\n")
+    refused(audit(program, "--out", tmp_path / "out", *QUICK), "fixed:1000", "printed 2 frames, not the profile's 500",
+            "does not follow --profile")
 
 
 def test_a_failed_frame_is_a_status_not_a_refusal(tmp_path):

@@ -54,7 +54,7 @@ typedef struct ssAuditFlags {
   int counts;          /* ssAuditHeader's with_counts: the rows carry the optional count columns */
 } ssAuditFlags;
 
-/** The served counts of a frame, as the frame report gives them (api: ssFrameReport's rows and contacts). */
+/** The served counts of a frame, as its report gives them (ssFrameReport's rows and contacts, registry.h). */
 typedef struct ssAuditServed {
   int rows_by_mapping, rows_handed_to_matched, rows_handed_to_implicit_euler;
   int contacts_by_mapping, contacts_handed_to_matched, contacts_handed_to_implicit_euler;
