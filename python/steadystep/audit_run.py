@@ -6,7 +6,7 @@ A program takes part in one of two ways:
 - an executable (C, C++, anything) that takes ``--profile SPEC --seed N --duration S`` and, when it runs through the
   library, ``--policy NAME``, and prints CSV on stdout: a header ``t_s,<quantity>_<unit>,...`` then one row per
   frame (a row at t = 0 first is usual). Optional count columns (``steps``, ``rows_by_mapping``, ...:
-  OPTIONAL_COLUMNS) say what each frame did. Exit 0 when every frame stepped, 1 when a frame failed (the rows up to
+  OPTIONAL_COLUMNS) say what each frame did (-1 on every frame: not counted, left out). Exit 0 when every frame stepped, 1 when a frame failed (the rows up to
   it are kept, the run's status says so), anything else is a bad program. ``lab/include/steadystep/lab/audit_flags.h``
   parses the flags and prints the rows for a C program.
 - a Python file defining ``build_world()``, which builds its odepy world and returns a PythonWorld, and
@@ -15,7 +15,8 @@ A program takes part in one of two ways:
 
 A program that cannot take part raises BadProgram, one line naming the program, the run and what is wrong: it does
 not exist or is not executable, it refused the flags (exit 2), printed no CSV or malformed CSV, did not finish
-within the time limit (killed), or was killed by a signal (named).
+within the time limit (killed), or was killed by a signal (named); audit.measure adds a program that ignores
+--profile and runs that follow different quantities.
 """
 
 from __future__ import annotations
@@ -49,9 +50,6 @@ STDERR_SHOWN = 300  # characters of a program's stderr quoted in a message
 
 class BadProgram(SteadystepError):
     """A program that cannot take part in the audit; the message names the program, the run and the fault."""
-
-    def __init__(self, status: str, message: str = "", code: int = 0):
-        super().__init__(status, message, code)
 
 
 def _bad(message: str) -> BadProgram:
@@ -184,14 +182,14 @@ def run(program, variant: str, profile: str, seed: int, duration_s: float) -> Ru
     return _run_executable(program, variant, profile, seed, duration_s)
 
 
-def command_line(program: Executable, variant: str, profile: str, seed: int, duration_s: float) -> list[str]:
+def _command_line(program: Executable, variant: str, profile: str, seed: int, duration_s: float) -> list[str]:
     base = list(program.own if variant == OWN else program.command)
     flags = ["--profile", profile, "--seed", str(seed), "--duration", repr(float(duration_s))]
     return base + flags + ([] if variant == OWN else ["--policy", variant])
 
 
 def _run_executable(program: Executable, variant: str, profile: str, seed: int, duration_s: float) -> Run:
-    command = command_line(program, variant, profile, seed, duration_s)
+    command = _command_line(program, variant, profile, seed, duration_s)
     shown = shlex.join(command)
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
         started = time.perf_counter()
