@@ -3,7 +3,6 @@
 
 #include "error.h"
 #include "ode_bounds.h"
-#include "joint_rows.h"
 #include "registry_internal.h"
 #include "row_law.h"
 #include "steadystep/registry.h"

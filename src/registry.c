@@ -693,7 +693,8 @@ static int writeRows(ssRegistry* registry, ssMapping mapping) {
  * fail), so that the rows can then be counted and written in one pass. */
 static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* softness) {
   for (int j = 0; j < registry->law_count; ++j) {
-    ssStatus status = ssRowSoftness(&registry->laws[j], SS_MAPPING_IMPLICIT_EULER, NAN, step_s, 0, 0, NULL, &softness[j]);
+    ssStatus status =
+        ssRowSoftness(&registry->laws[j], SS_MAPPING_IMPLICIT_EULER, NAN, step_s, 0, 0, NULL, &softness[j]);
     if (status == SS_OK) status = ssCheckSoftnessForOde("softness", softness[j].erp, softness[j].cfm);
     if (status == SS_OK) continue;
     for (int i = 0; i < registry->joint_count; ++i)

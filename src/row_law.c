@@ -52,7 +52,7 @@ ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law) {
  * its own spring is not. ODE's row law is f = -(erp/(h·cfm))·x - (1/cfm)·v', so a constant load F along the row
  * rests at x = F/k' with the step's static stiffness
  *     k' = erp/(h·cfm) = m·(1 - z1)(1 - z2)/(h²·z1·z2)   (matched; z = e^(s·h), the poles)
- *        ≈ k·(1 + σh + O(h²)) for h·√(k/m), σh small, σ = c/2m,
+ *        ≈ k·(1 + σh)·sinc²(ω·h/2)                        (lightly damped; σ = c/2m, ω the frequency),
  * while implicit Euler (erp = hk/(hk + c), cfm = 1/(hk + c)) has k' = k exactly, at every step. A load the registry
  * knows (ssRegistry_SetJointLoad) is corrected: the registry adds F·(k'/k - 1) along the row, which moves the rest
  * back to F/k without touching the poles. A load it does not know is the weight a stacked contact carries, the
@@ -63,15 +63,15 @@ ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law) {
  * Where k' is far from k, h is not short against the row's own time scales (σh or ω·h of order 1: a contact of a
  * light box under a stiff, strongly damped law, a stop of a ram whose decay takes a fraction of a step), which is
  * also where the isolated row's effective mass describes the motion least: the mode of a box on four contact
- * points, or of a ram between its stop and its motor, is not one row's. So the rule, applied to every row and
- * contact whose load is not declared:
+ * points, or of a ram between its stop and its motor, is not one row's. So the rule, applied to every row whose
+ * load is not declared (contacts, whose load is never known, go further: contact.c):
  *     an accurate softness serves the row only if |k/k' - 1| <= SS_STATIC_RESPONSE_TOLERANCE (5 %),
  *     otherwise implicit Euler serves it (counted in handed_to_implicit_euler);
  * a pure damper (k = 0, motors) likewise with its static damping 1/cfm against c (a load drives it at F·cfm where
- * the damper moves at F/c; matched's 1/cfm = m(e^(ch/m) - 1)/h). Where one spring dominates one body at steps
- * short against it (the oscillator: k'/k - 1 = σh = 0.008 at 1/60 s, 0.033 at 1/15 s; a suspension with its load
- * declared) the accurate mappings keep serving; elsewhere the row moves under implicit Euler, as it would without
- * them. */
+ * the damper moves at F/c; matched's 1/cfm = m(e^(ch/m) - 1)/h). The rule keeps rows with σh up to about 0.05
+ * and ω·h up to about 0.75 (eight steps a period): where one spring dominates one body at steps short against it
+ * (the oscillator: σh = 0.008 at 1/60 s, 0.033 at 1/15 s; a suspension with its load declared) the accurate
+ * mappings keep serving; elsewhere the row moves under implicit Euler, as it would without them. */
 int ssKeepsStaticResponse(ssSpring spring, ssSoftness softness, double step_s) {
   if (spring.stiffness > 0) {
     double static_stiffness = softness.erp / (step_s * softness.cfm);

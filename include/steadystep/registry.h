@@ -127,8 +127,8 @@ SS_API ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body);
  *  natural frequency above the step's Nyquist frequency, no finite softness, a load correction beyond
  *  SS_MAX_FORCE_N, or, with no load declared (ssRegistry_SetJointLoad), a matched static stiffness
  *  erp/(step_s·cfm) more than 5 % from k, or a pure damper's 1/cfm more than 5 % from c: an undeclared load would
- *  rest elsewhere than the spring puts it; docs/exact-mappings.md) is written with implicit Euler and counted. Either everything is written or, on an error,
- *  nothing is. report may be NULL.
+ *  rest elsewhere than the spring puts it; docs/exact-mappings.md) is written with implicit Euler and counted.
+ *  Either everything is written or, on an error, nothing is. report may be NULL.
  *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (registry NULL, step_s, previous_step_s);
  *  SS_ERROR_UNSUPPORTED for an unknown mapping. */
 SS_API ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,

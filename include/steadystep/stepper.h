@@ -158,8 +158,8 @@ SS_API ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
  *  world's ERP/CFM, as the program tuned them at the registry's tuned step (ssRegistry_Adopt), become a spring; it
  *  is written back as soft_erp/soft_cfm for this step's length, both mode bits set. Under every mapping the
  *  implicit-Euler softness serves it: matched and exact serve no contact (its load is never known; ssContactSoften),
- *  and count it in the frame report's contacts.handed_to_implicit_euler. body1 and body2 are not read. A contact tuned with
- *  cfm = 0 stays hard (erp follows h as for adopted hard rows).
+ *  and count it in the frame report's contacts.handed_to_implicit_euler. body1 and body2 are not read. A contact
+ *  tuned with cfm = 0 stays hard (erp follows h as for adopted hard rows).
  *  Errors, with the contact unchanged: SS_ERROR_OUT_OF_RANGE (stepper or contact NULL, no tuned step: adopt
  *  first, or a tuned erp outside [0, 1] or cfm < 0); SS_ERROR_NOT_FINITE. */
 SS_API ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2);
