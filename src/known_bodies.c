@@ -199,7 +199,7 @@ static ssStatus describe(dBodyID body, const ssBodyBounds* bounds, const char* w
                     {"force", "N", dBodyGetForce(body)},
                     {"torque", "N*m", dBodyGetTorque(body)}};
   int checked = bounds->forces ? 5 : 3;
-  for (int q = 0; q < checked; ++q) {
+  for (int q = bounds->state ? 0 : 3; q < checked; ++q) {
     const dReal* v = quantities[q].value;
     if (isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2])) continue;
     return ssFail(q < 3 ? SS_ERROR_BLOWUP : SS_ERROR_NOT_FINITE, "body %p: %s (%g, %g, %g) %s %s: not finite",
@@ -225,24 +225,54 @@ static ssStatus describe(dBodyID body, const ssBodyBounds* bounds, const char* w
   return ssFail(SS_ERROR_BLOWUP, "body %p: failed a check %s", (void*)body, when); /* not reached */
 }
 
-ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, dBodyID* failed,
-                      int* first_joints_changed) {
+ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, dBodyID* failed) {
   const double max_speed2 = bounds->max_speed * bounds->max_speed;
   const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
-  int changed = 0;
   for (int k = 0; k < known->count; ++k) {
     dBodyID body = known->ids[k];
     /* every comparison is false for a NaN, and an infinity is beyond every bound: one test a number */
-    int ok = within(dBodyGetPosition(body), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(body)) <= max_speed2 &&
-             squared(dBodyGetAngularVel(body)) <= max_spin2;
+    int ok = !bounds->state ||
+             (within(dBodyGetPosition(body), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(body)) <= max_speed2 &&
+              squared(dBodyGetAngularVel(body)) <= max_spin2);
     if (ok && bounds->forces)
       ok = within(dBodyGetForce(body), SS_MAX_FORCE_N) && within(dBodyGetTorque(body), SS_MAX_FORCE_N);
     if (!ok) {
       *failed = body;
       return describe(body, bounds, when);
     }
-    if (first_joints_changed != NULL) changed |= firstJointChanged(dBodyGetJoint(body, 0), known->first_joints[k]);
   }
-  if (first_joints_changed != NULL) *first_joints_changed = changed;
+  return SS_OK;
+}
+
+static int anyNonZero(const double* values) {
+  return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
+}
+
+ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBodyID* failed, int* joints_changed) {
+  const double max_speed2 = bounds->max_speed * bounds->max_speed;
+  const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
+  *joints_changed = 0;
+  known->pushed_count = 0;
+  for (int k = 0; k < known->count; ++k) {
+    dBodyID id = known->ids[k];
+    if (firstJointChanged(dBodyGetJoint(id, 0), known->first_joints[k])) {
+      *joints_changed = 1;
+      return SS_OK;
+    }
+    const dReal* force = dBodyGetForce(id);
+    const dReal* torque = dBodyGetTorque(id);
+    int ok = within(dBodyGetPosition(id), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(id)) <= max_speed2 &&
+             squared(dBodyGetAngularVel(id)) <= max_spin2 && within(force, SS_MAX_FORCE_N) &&
+             within(torque, SS_MAX_FORCE_N);
+    if (!ok) {
+      *failed = id;
+      return describe(id, bounds, "before the frame");
+    }
+    ssKnownBody* body = &known->bodies[k];
+    double* f = body->frame_force;
+    f[0] = force[0], f[1] = force[1], f[2] = force[2], f[3] = torque[0], f[4] = torque[1], f[5] = torque[2];
+    body->pushed = anyNonZero(f) || (known->carrying && anyNonZero(body->carried));
+    if (body->pushed) known->pushed[known->pushed_count++] = k;
+  }
   return SS_OK;
 }

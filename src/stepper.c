@@ -396,22 +396,6 @@ static int anyNonZero(const double* values) {
   return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
 }
 
-/* Reads the forces the program added for this frame, and marks the bodies that have one or carried momentum. */
-static void captureForces(ssStepper* stepper) {
-  ssKnownBodies* known = &stepper->known;
-  for (int i = 0; i < known->count; ++i) {
-    const dReal* force = dBodyGetForce(known->ids[i]);
-    const dReal* torque = dBodyGetTorque(known->ids[i]);
-    ssKnownBody* body = &known->bodies[i];
-    memcpy(body->frame_force, (double[6]){force[0], force[1], force[2], torque[0], torque[1], torque[2]},
-           sizeof body->frame_force);
-    body->pushed = anyNonZero(body->frame_force) || (known->carrying && anyNonZero(body->carried));
-  }
-  known->pushed_count = 0;
-  for (int i = 0; i < known->count; ++i)
-    if (known->bodies[i].pushed) known->pushed[known->pushed_count++] = i;
-}
-
 /* Before each of a frame's `steps` steps of step_s: each pushed body gets the force that delivers its frame's
  * momentum F·frame_s (plus what was carried) evenly over the frame's simulated time. A frame of one step of its own
  * length with nothing carried leaves the program's forces as it added them (F·h/h may differ from F in its last
@@ -456,13 +440,12 @@ static ssStatus latch(ssStepper* stepper, ssStatus status) {
   return status;
 }
 
-/* Every known body's state (and with_forces its accumulators) within limits.h and the stepping's speeds. */
-static ssStatus checkKnown(ssStepper* stepper, int with_forces, const char* when, ssFrameReport* report,
-                           int* first_joints_changed) {
+/* Every known body's state and forces (as asked) within limits.h and the stepping's speeds. */
+static ssStatus checkKnown(ssStepper* stepper, int state, int forces, const char* when, ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
-  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, with_forces};
+  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, state, forces};
   dBodyID failed = 0;
-  ssStatus status = ssKnownCheck(&stepper->known, &bounds, when, &failed, first_joints_changed);
+  ssStatus status = ssKnownCheck(&stepper->known, &bounds, when, &failed);
   if (status != SS_OK) report->failed_body = failed;
   return status;
 }
@@ -509,7 +492,8 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
   char when[64];
   for (int i = 0; i < steps; ++i) {
     double previous_step_s = use_history ? stepper->previous_step_s : 0;
-    ssStatus status = i == 0 ? SS_OK : findNew(stepper, 0); /* made in the last step's callbacks */
+    /* bodies made in the last step's callbacks (joints made there are found before the next frame) */
+    ssStatus status = i == 0 ? SS_OK : findNew(stepper, 0);
     if (status != SS_OK) return status;
     putForces(stepper, frame_s, steps, step_s);
     if (i == 0 || apply_every_step || stepper->apply_due) {
@@ -524,10 +508,13 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
       if (def->contact_group) dJointGroupEmpty(def->contact_group);
       return SS_OK;
     }
-    /* the boundary: whatever the program or its callbacks did, ODE gets a state and forces it can step */
+    /* the boundary: whatever the program or its callbacks did, ODE gets a state and forces it can step. Without
+     * callbacks only the stepper wrote since the last check (after the last step, or before the frame): the
+     * frame's checked forces spread over its steps, and load corrections within SS_MAX_FORCE_N */
     snprintf(when, sizeof when, "before step %d of %d", i + 1, steps);
+    int called_back = def->before_step || def->collide;
     if ((status = refreshKnown(stepper)) != SS_OK ||
-        (status = checkKnown(stepper, 1, when, report, NULL)) != SS_OK)
+        (called_back && (status = checkKnown(stepper, 1, 1, when, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, step_s)
                                                       : dWorldQuickStep(def->world, step_s);
@@ -537,10 +524,8 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     addServed(&report->rows, &applied.rows);
     report->step_s = step_s;
     report->simulated_s += step_s;
-    int joints_changed = 0;
     snprintf(when, sizeof when, "after step %d of %d", i + 1, steps);
-    if ((status = checkKnown(stepper, 0, when, report, &joints_changed)) != SS_OK) return latch(stepper, status);
-    if (joints_changed && (status = findNew(stepper, 1)) != SS_OK) return status;
+    if ((status = checkKnown(stepper, 1, 0, when, report)) != SS_OK) return latch(stepper, status);
     stepper->previous_step_s = use_history ? step_s : 0;
     if (def->step_done) def->step_done(def->step_done_context, step_s);
     if (stepper->destroy_requested) return SS_OK;
@@ -601,15 +586,23 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
   return status;
 }
 
-/* Before the frame: what was made since the last one found, the frame's forces read, and every known body's state
- * and forces checked before any callback runs (a collide callback's dSpaceCollide is where a body beyond
- * SS_MAX_POSITION_M would abort). Nothing is touched on an error. */
+/* Before the frame, in one pass over the known bodies: joints made since the last frame found, every known body's
+ * state and forces checked before any callback runs (a collide callback's dSpaceCollide is where a body beyond
+ * SS_MAX_POSITION_M would abort), and the frame's forces read. Nothing is touched on an error. */
 static ssStatus startFrame(ssStepper* stepper, ssFrameReport* report) {
-  ssStatus status = findNew(stepper, 1);
-  if (status != SS_OK) return status;
-  if ((status = checkKnown(stepper, 1, "before the frame", report, NULL)) != SS_OK) return latch(stepper, status);
-  captureForces(stepper);
-  return SS_OK;
+  const ssStepping* stepping = &stepper->def.stepping;
+  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, 1, 1};
+  ssStatus status = findNew(stepper, 0);
+  for (int joints_changed = 1; status == SS_OK && joints_changed;) {
+    dBodyID failed = 0;
+    status = ssKnownStartFrame(&stepper->known, &bounds, &failed, &joints_changed);
+    if (status != SS_OK) {
+      report->failed_body = failed;
+      return latch(stepper, status);
+    }
+    if (joints_changed) status = findNew(stepper, 1);
+  }
+  return status;
 }
 
 ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* report) {

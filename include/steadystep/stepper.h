@@ -35,10 +35,11 @@
  * Known bodies: the bodies of the registry (bound, adopted), those given to ssStepper_WatchBody, and every body
  * reachable from those through joints other than contacts. They are the ones whose forces are kept for the whole
  * frame and whose state and forces are checked at every step. With def.space, bodies and joints made later are
- * found before the next step and adopted at the tuned step: before each frame and each step the stepper looks at
- * the adopted spaces (their geom count and first geom: a geom added to any of them, a nested space too) and at every
- * known body's first joint (ODE attaches a new joint at the head of its body's list), one read each, and walks the
- * spaces or the joints only when one changed. What nothing reaches the stepper cannot see: a body with no geom in
+ * found and adopted at the tuned step: before each frame and each step the stepper looks at the adopted spaces
+ * (their geom count and first geom: a geom added to any of them, a nested space too), and before each frame at
+ * every known body's first joint (ODE attaches a new joint at the head of its body's list), one read each, and
+ * walks the spaces or the joints only when one changed. A body made in a callback is found before the next step; a
+ * joint made in a callback, before the next frame. What nothing reaches the stepper cannot see: a body with no geom in
  * the space and no joint to a known body (a bob hung from the static world, a free projectile without a geom).
  * Its forces would act on the first substep only: make it known with ssStepper_WatchBody (or adopt it,
  * ssRegistry_AdoptBody, into the registry). ssStepper_Adopted and ssStepper_KnownBodyCount tell what was reached,
