@@ -358,8 +358,7 @@ static ssStatus walkSpaces(ssStepper* stepper) {
       if (dGeomIsSpace(geom)) continue; /* listed above, walked below */
       dBodyID body = dGeomGetBody(geom);
       if (body == 0 || ssKnownContains(&stepper->known, body)) continue;
-      ssStatus status = adoptBody(stepper, body);
-      if (status == SS_OK) status = refreshKnown(stepper);
+      ssStatus status = adoptBody(stepper, body); /* idempotent: a body of two geoms, or reached twice, once */
       if (status != SS_OK) return status;
     }
     /* the nested spaces, breadth first: those of spaces walked so far that are not listed yet */
@@ -373,7 +372,7 @@ static ssStatus walkSpaces(ssStepper* stepper) {
         if (!listed) next = (dSpaceID)geom;
       }
   }
-  return SS_OK;
+  return refreshKnown(stepper);
 }
 
 /* Finds what was made since the last look, before a step: bodies in the adopted spaces, joints attached to known
@@ -424,7 +423,8 @@ static void carryForces(ssStepper* stepper, double frame_s) {
   }
 }
 
-/* After a frame's steps: every body that carried momentum was pushed for them (captureForces), so none carries now. */
+/* After a frame's steps: every body that carried momentum was pushed for them (ssKnownStartFrame), so none carries
+ * now. */
 static void clearCarried(ssStepper* stepper) {
   for (int p = 0; p < stepper->known.pushed_count; ++p)
     memset(stepper->known.bodies[stepper->known.pushed[p]].carried, 0, sizeof stepper->known.bodies[0].carried);
