@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -199,7 +200,7 @@ static ssStatus describe(dBodyID body, const ssBodyBounds* bounds, const char* w
                     {"force", "N", dBodyGetForce(body)},
                     {"torque", "N*m", dBodyGetTorque(body)}};
   int checked = bounds->forces ? 5 : 3;
-  for (int q = bounds->state ? 0 : 3; q < checked; ++q) {
+  for (int q = 0; q < checked; ++q) {
     const dReal* v = quantities[q].value;
     if (isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2])) continue;
     return ssFail(q < 3 ? SS_ERROR_BLOWUP : SS_ERROR_NOT_FINITE, "body %p: %s (%g, %g, %g) %s %s: not finite",
@@ -225,20 +226,22 @@ static ssStatus describe(dBodyID body, const ssBodyBounds* bounds, const char* w
   return ssFail(SS_ERROR_BLOWUP, "body %p: failed a check %s", (void*)body, when); /* not reached */
 }
 
-ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, dBodyID* failed) {
+ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
+                      dBodyID* failed) {
   const double max_speed2 = bounds->max_speed * bounds->max_speed;
   const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
   for (int k = 0; k < known->count; ++k) {
     dBodyID body = known->ids[k];
     /* every comparison is false for a NaN, and an infinity is beyond every bound: one test a number */
-    int ok = !bounds->state ||
-             (within(dBodyGetPosition(body), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(body)) <= max_speed2 &&
-              squared(dBodyGetAngularVel(body)) <= max_spin2);
+    int ok = within(dBodyGetPosition(body), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(body)) <= max_speed2 &&
+             squared(dBodyGetAngularVel(body)) <= max_spin2;
     if (ok && bounds->forces)
       ok = within(dBodyGetForce(body), SS_MAX_FORCE_N) && within(dBodyGetTorque(body), SS_MAX_FORCE_N);
     if (!ok) {
       *failed = body;
-      return describe(body, bounds, when);
+      char named[64];
+      snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
+      return describe(body, bounds, named);
     }
   }
   return SS_OK;

@@ -55,16 +55,16 @@ void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces)
 /* What a check reads of a body, and its bounds. */
 typedef struct ssBodyBounds {
   double max_speed, max_angular_speed; /* m/s, rad/s */
-  int state;                           /* the position and velocities */
   int forces;                          /* the force and torque accumulators, within SS_MAX_FORCE_N */
 } ssBodyBounds;
 
-/* Checks every listed body, one pass over the packed handles: with bounds->state its position within
- * SS_MAX_POSITION_M and velocities finite and within the bounds, with bounds->forces its accumulators. On the first failure records the message (the
- * body, the quantity, its value, `when`), sets *failed to the body and returns SS_ERROR_BLOWUP (a state not
+/* Checks every listed body, one pass over the packed handles: its position within SS_MAX_POSITION_M, velocities
+ * finite and within the bounds, and with bounds->forces its accumulators. On the first failure records the message (the
+ * body, the quantity, its value, "`when` step `step` of `steps`", formatted then only), sets *failed to the body and returns SS_ERROR_BLOWUP (a state not
  * finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a force or torque) or
  * SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). */
-ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, dBodyID* failed);
+ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
+                      dBodyID* failed);
 
 /* Before a frame, one pass: *joints_changed says whether a body's first joint changed (then nothing else was done:
  * the caller rebuilds the list and calls again); else every body is checked as ssKnownCheck with state and forces,

@@ -441,11 +441,12 @@ static ssStatus latch(ssStepper* stepper, ssStatus status) {
 }
 
 /* Every known body's state and forces (as asked) within limits.h and the stepping's speeds. */
-static ssStatus checkKnown(ssStepper* stepper, int state, int forces, const char* when, ssFrameReport* report) {
+static ssStatus checkKnown(ssStepper* stepper, int forces, const char* when, int index, int steps,
+                           ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
-  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, state, forces};
+  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, forces};
   dBodyID failed = 0;
-  ssStatus status = ssKnownCheck(&stepper->known, &bounds, when, &failed);
+  ssStatus status = ssKnownCheck(&stepper->known, &bounds, when, index + 1, steps, &failed);
   if (status != SS_OK) report->failed_body = failed;
   return status;
 }
@@ -489,7 +490,6 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
   int use_history = mapping == SS_MAPPING_EXACT && stepping->frozen_step_s == 0;
   if (stepping->quick_iterations > 0) dWorldSetQuickStepNumIterations(def->world, stepping->quick_iterations);
   ssApplyReport applied;
-  char when[64];
   for (int i = 0; i < steps; ++i) {
     double previous_step_s = use_history ? stepper->previous_step_s : 0;
     /* bodies made in the last step's callbacks (joints made there are found before the next frame) */
@@ -511,10 +511,9 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     /* the boundary: whatever the program or its callbacks did, ODE gets a state and forces it can step. Without
      * callbacks only the stepper wrote since the last check (after the last step, or before the frame): the
      * frame's checked forces spread over its steps, and load corrections within SS_MAX_FORCE_N */
-    snprintf(when, sizeof when, "before step %d of %d", i + 1, steps);
     int called_back = def->before_step || def->collide;
     if ((status = refreshKnown(stepper)) != SS_OK ||
-        (called_back && (status = checkKnown(stepper, 1, 1, when, report)) != SS_OK))
+        (called_back && (status = checkKnown(stepper, 1, "before", i, steps, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, step_s)
                                                       : dWorldQuickStep(def->world, step_s);
@@ -524,8 +523,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     addServed(&report->rows, &applied.rows);
     report->step_s = step_s;
     report->simulated_s += step_s;
-    snprintf(when, sizeof when, "after step %d of %d", i + 1, steps);
-    if ((status = checkKnown(stepper, 1, 0, when, report)) != SS_OK) return latch(stepper, status);
+    if ((status = checkKnown(stepper, 0, "after", i, steps, report)) != SS_OK) return latch(stepper, status);
     stepper->previous_step_s = use_history ? step_s : 0;
     if (def->step_done) def->step_done(def->step_done_context, step_s);
     if (stepper->destroy_requested) return SS_OK;
@@ -591,7 +589,7 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
  * SS_MAX_POSITION_M would abort), and the frame's forces read. Nothing is touched on an error. */
 static ssStatus startFrame(ssStepper* stepper, ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
-  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, 1, 1};
+  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, 1};
   ssStatus status = findNew(stepper, 0);
   for (int joints_changed = 1; status == SS_OK && joints_changed;) {
     dBodyID failed = 0;
