@@ -209,8 +209,8 @@ typedef struct ssRun ssRun;
 typedef enum ssRunOutcome {
   SS_RUN_NONE = -1,      /* only for run = NULL */
   SS_RUN_COMPLETED = 0,  /* ran for duration_s within every sanity bound */
-  SS_RUN_BLEW_UP = 1,    /* ended early by SS_ERROR_BLOWUP or SS_ERROR_SPEED_LIMIT (ssRun_Status says which):
-                          * the state became non-finite or absurdly fast */
+  SS_RUN_BLEW_UP = 1,    /* ended early by SS_ERROR_BLOWUP, SS_ERROR_SPEED_LIMIT or SS_ERROR_POSITION_LIMIT
+                          * (ssRun_Status says which): the state became non-finite, absurdly fast or far */
   SS_RUN_BROKEN = 2,     /* ended early at the first step outside a sanity bound (ssScene_Broken): finite but
                           * physically wrong */
 } ssRunOutcome;
