@@ -176,7 +176,9 @@ void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces)
 
 /* ---- the check ---- */
 
-static int within(const dReal* v, double bound) { return fabs(v[0]) <= bound && fabs(v[1]) <= bound && fabs(v[2]) <= bound; }
+static int within(const dReal* v, double bound) {
+  return fabs(v[0]) <= bound && fabs(v[1]) <= bound && fabs(v[2]) <= bound;
+}
 
 static double squared(const dReal* v) { return v[0] * v[0] + v[1] * v[1] + v[2] * v[2]; }
 

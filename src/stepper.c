@@ -64,8 +64,8 @@ static ssStatus validateDef(const ssStepperDef* def) {
   if (def == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "def = NULL: a definition is required");
   if (def->world == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "world = NULL: a world is required");
   if (def->registry != NULL && ssRegistryWorld(def->registry) != def->world)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "registry of world %p: not def.world = %p", (void*)ssRegistryWorld(def->registry),
-                  (void*)def->world);
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "registry of world %p: not def.world = %p",
+                  (void*)ssRegistryWorld(def->registry), (void*)def->world);
   if (def->space != 0 && def->tuned_step_s == 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "tuned_step_s = 0 s: with a space, say which step the program was tuned for");
   if (def->tuned_step_s != 0) {
@@ -83,8 +83,10 @@ static ssStatus resolveSteps(ssStepping* stepping, double tuned_step_s) {
                         : stepping->cut == SS_CUT_FIXED && stepping->fixed_step_s == 0 ? "fixed_step_s"
                                                                                         : NULL;
   if (missing == NULL) return SS_OK;
-  return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.%s = 0 s (the tuned step), but there is no tuned step: set "
-                                       "def.tuned_step_s, adopt into the registry, or give stepping.%s", missing, missing);
+  return ssFail(SS_ERROR_OUT_OF_RANGE,
+                "stepping.%s = 0 s (the tuned step), but there is no tuned step: set def.tuned_step_s, adopt into "
+                "the registry, or give stepping.%s",
+                missing, missing);
 }
 
 /* The step length a step's softness is computed for: its own, or the frozen one. */

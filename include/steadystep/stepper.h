@@ -167,7 +167,7 @@ SS_API ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out);
  *  it is deferred to the end of that ssStepper_Step (see the top). */
 SS_API void ssStepper_Destroy(ssStepper* stepper);
 
-/** Advances the world by one frame of frame_s seconds (0 <= frame_s <= SS_MAX_FRAME_S; 0 does nothing). report may
+/** Advances the world by one frame of frame_s seconds (0 <= frame_s <= SS_MAX_FRAME_S; 0 takes no step). report may
  *  be NULL.
  *  Forces and torques that the program added to known bodies before this call act for the whole frame: they are
  *  put back before every substep (ODE clears them after each step), and under SS_CUT_FIXED they are scaled so

@@ -144,9 +144,9 @@ def reference_stepping() -> dict:
 
 
 # How a run ends (RunResult.status): "ok" ran to the end within the scene's sanity bounds; "blow-up", "speed limit"
-# and "position limit" ended early with a state that was not finite, absurdly fast or absurdly far; "broken" ended early, finite but
-# physically wrong: a step left one of the scene's sanity bounds (scene.h: a torn joint, a box through the floor,
-# energy made). Only "ok" is a run to measure: a report counts every other status as failed.
+# and "position limit" ended early with a state that was not finite, absurdly fast or absurdly far; "broken" ended
+# early, finite but physically wrong: a step left one of the scene's sanity bounds (scene.h: a torn joint, a box
+# through the floor, energy made). Only "ok" is a run to measure: a report counts every other status as failed.
 BLOW_UP_STATUSES = frozenset({"blow-up", "speed limit", "position limit"})
 BROKEN = "broken"
 

@@ -163,14 +163,15 @@ class Stepper:
         self._stepping = stepping
 
     def step(self, frame_s: float) -> FrameReport:
-        """Advances the world by one frame of frame_s seconds (0 <= frame_s <= 3600; 0 does nothing). Forces the
-        program added to known bodies before this call act for the whole frame. Raises SteadystepError with the
+        """Advances the world by one frame of frame_s seconds (0 <= frame_s <= 3600; 0 takes no step). Forces the
+        program added to known bodies before this call act for the whole frame (a frame of 0 s reads and clears
+        them: F·0 = 0). Raises SteadystepError with the
         library's message (the world left as it was for a refused frame); for a body refused at the boundary
         before the frame or a step (a state or force ODE cannot step, Status.POSITION_LIMIT, ...) or one that blew
         up or ran away in a step (Status.BLOWUP, Status.SPEED_LIMIT) the error's `report` is the FrameReport, whose
-        failed_body names the body, and every later frame is refused (Status.FAILED) until reset(). An exception raised by a callback
-        is raised here, after the frame, with the frame's FrameReport (or its error) as its `steadystep_report`
-        (or `__context__`)."""
+        failed_body names the body, and every later frame is refused (Status.FAILED) until reset(). An exception
+        raised by a callback is raised here, after the frame, with the frame's FrameReport (or its error) as its
+        `steadystep_report` (or `__context__`)."""
         handle = self._between_frames("step")
         frame_s = number("frame_s", frame_s, "s")
         report = ffi.new("ssFrameReport*")

@@ -14,9 +14,9 @@
  *
  * Promises checked: the process never aborts; a refusal names something (ssLastError) and changes nothing (binding
  * count, body states for frame refusals); a frame reported OK leaves every body's state finite; a blow-up names the
- * body, and the stepper then refuses frames until ssStepper_Reset; so does a state or force refused at the
- * boundary (before the frame or a step), by name; re-entering is refused with SS_ERROR_REENTERED. Masses stay within [1e-3, 1e3] kg: the program,
- * not the library, hands them to ODE. */
+ * body, and the stepper then refuses frames until ssStepper_Reset; so does a state or force refused at the boundary
+ * (before the frame or a step), by name; re-entering is refused with SS_ERROR_REENTERED. Masses stay within [1e-3, 1e3]
+ * kg: the program, not the library, hands them to ODE. */
 #include <ode/ode.h>
 
 #include "fuzz_input.h"

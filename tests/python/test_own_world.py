@@ -369,7 +369,8 @@ def test_an_exception_in_a_callback_is_raised_by_step_and_the_stepper_goes_on(wo
         if len(calls) == 2:
             raise KeyError("from before_step")
 
-    stepper = ss.Stepper(world, None, before_step=before, policy="implicit-euler", solver=ss.Solver.QUICK, tuned_step_s=1 / 60)
+    stepper = ss.Stepper(world, None, before_step=before, policy="implicit-euler", solver=ss.Solver.QUICK,
+                         tuned_step_s=1 / 60)
     stepper.watch_body(body)
     with pytest.raises(KeyError, match="from before_step") as raised:
         stepper.step(0.05)  # 3 substeps: the second raises, the third is taken without the callback

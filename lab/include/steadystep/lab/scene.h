@@ -109,9 +109,9 @@ SS_LAB_API ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
 SS_LAB_API ssStatus ssLabStepping(const char* policy, ssStepping* out);
 
 /** The stepping of a reference run: implicit Euler with substeps of at most step_s (s, in the step range; e.g.
- *  1/1000), fixed_step_s also step_s, solver SS_SOLVER_QUICK, the other fields as ssDefaultStepping. Run it under the profile "fixed:N"
- *  with N = 1/step_s (e.g. "fixed:1000") so that every frame is one step. step_s is not checked here:
- *  ssScene_Create refuses a bad one. */
+ *  1/1000), fixed_step_s also step_s, solver SS_SOLVER_QUICK, the other fields as ssDefaultStepping. Run it under the
+ *  profile "fixed:N" with N = 1/step_s (e.g. "fixed:1000") so that every frame is one step. step_s is not checked
+ *  here: ssScene_Create refuses a bad one. */
 SS_LAB_API ssStepping ssReferenceStepping(double step_s);
 
 typedef struct ssScene ssScene;
