@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "array.h"
+#include "binding_index.h"
 #include "error.h"
 #include "ode_bounds.h"
 #include "joint_rows.h"
@@ -76,6 +77,8 @@ struct ssRegistry {
   int joint_count, joint_capacity;
   ssBodyBinding* bodies;
   int body_count, body_capacity;
+  ssBindingIndex joint_index; /* (joint, rowTag) -> position in joints */
+  ssBindingIndex body_index;  /* (body, 0) -> position in bodies */
   unsigned generation; /* changes whenever the set of bound joints or bodies does */
   unsigned revision;   /* changes whenever any binding does */
   /* the last Apply: under implicit Euler, the same step with the same bindings writes nothing new */
@@ -128,6 +131,8 @@ void ssRegistry_Destroy(ssRegistry* registry) {
   free(registry->hot_rows);
   free(registry->bodies);
   free(registry->body_cache);
+  ssIndexFree(&registry->joint_index);
+  ssIndexFree(&registry->body_index);
   free(registry);
 }
 
@@ -171,6 +176,7 @@ enum { kPrefetchAhead = 8 };
 
 /* Room for `more` joint bindings, in an array aligned to cache lines (JointBinding's groups are lines). */
 static int reserveJoints(ssRegistry* registry, int more) {
+  if (!ssIndexReserve(&registry->joint_index, (size_t)registry->joint_count + (size_t)more)) return 0;
   if (registry->joint_count + more <= registry->joint_capacity) return 1;
   int wanted = registry->joint_capacity ? 2 * registry->joint_capacity : 8;
   if (wanted < registry->joint_count + more) wanted = registry->joint_count + more;
@@ -193,18 +199,28 @@ static int reserveJoints(ssRegistry* registry, int more) {
   return 1;
 }
 
+/* A joint row's tag in the index: its parameter set and axis (1..3). */
+static int rowTag(ssJointParam param, int axis) { return 4 * (int)param + axis; }
+
 static JointBinding* findJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis) {
-  for (int i = 0; i < registry->joint_count; ++i) {
-    JointBinding* existing = &registry->joints[i];
-    if (existing->joint == joint && existing->param == param && existing->axis == axis) return existing;
-  }
-  return NULL;
+  int position = ssIndexFind(&registry->joint_index, joint, rowTag(param, axis));
+  return position >= 0 ? &registry->joints[position] : NULL;
 }
 
 int ssRegistryHasJoint(const ssRegistry* registry, dJointID joint) {
-  for (int i = 0; i < registry->joint_count; ++i)
-    if (registry->joints[i].joint == joint) return 1;
+  for (int param = SS_PARAM_JOINT; param <= SS_PARAM_SUSPENSION; ++param)
+    for (int axis = 1; axis <= 3; ++axis)
+      if (ssIndexFind(&registry->joint_index, joint, rowTag((ssJointParam)param, axis)) >= 0) return 1;
   return 0;
+}
+
+/* After the joints array was compacted: every position in the index again. */
+static void reindexJoints(ssRegistry* registry) {
+  ssIndexClear(&registry->joint_index);
+  for (int i = 0; i < registry->joint_count; ++i) {
+    const JointBinding* binding = &registry->joints[i];
+    ssIndexPut(&registry->joint_index, binding->joint, rowTag(binding->param, binding->axis), i);
+  }
 }
 
 int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam param, int axis) {
@@ -212,6 +228,7 @@ int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam par
 }
 
 static void materializeWritten(ssRegistry* registry);
+static int reserve(void** items, int count, int more, int* capacity, size_t size);
 
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass) {
@@ -242,6 +259,7 @@ ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointPar
   }
   if (!reserveJoints(registry, 1))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding a joint");
+  ssIndexPut(&registry->joint_index, joint, rowTag(param, axis), registry->joint_count);
   registry->joints[registry->joint_count++] = binding;
   registry->generation += 1;
   return SS_OK;
@@ -290,15 +308,21 @@ ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
     if (registry->joints[i].joint != joint) registry->joints[kept++] = registry->joints[i];
   if (kept == registry->joint_count) return ssFail(SS_ERROR_NOT_FOUND, "joint %p: not bound", (void*)joint);
   registry->joint_count = kept;
+  reindexJoints(registry);
   registry->generation += 1;
   registry->revision += 1;
   return SS_OK;
 }
 
 ssBodyBinding* ssRegistryFindBody(ssRegistry* registry, dBodyID body) {
-  for (int i = 0; i < registry->body_count; ++i)
-    if (registry->bodies[i].body == body) return &registry->bodies[i];
-  return NULL;
+  int position = ssIndexFind(&registry->body_index, body, 0);
+  return position >= 0 ? &registry->bodies[position] : NULL;
+}
+
+static int reserveBodies(ssRegistry* registry, int more) {
+  return ssIndexReserve(&registry->body_index, (size_t)registry->body_count + (size_t)more) &&
+         reserve((void**)&registry->bodies, registry->body_count, more, &registry->body_capacity,
+                 sizeof(ssBodyBinding));
 }
 
 int ssRegistryHasBody(ssRegistry* registry, dBodyID body) { return ssRegistryFindBody(registry, body) != NULL; }
@@ -307,8 +331,8 @@ int ssRegistryHasBody(ssRegistry* registry, dBodyID body) { return ssRegistryFin
 static ssBodyBinding* bodyBinding(ssRegistry* registry, dBodyID body) {
   ssBodyBinding* binding = ssRegistryFindBody(registry, body);
   if (binding != NULL) return binding;
-  if (!ssReserveOne((void**)&registry->bodies, registry->body_count, &registry->body_capacity, sizeof(ssBodyBinding)))
-    return NULL;
+  if (!reserveBodies(registry, 1)) return NULL;
+  ssIndexPut(&registry->body_index, body, 0, registry->body_count);
   binding = &registry->bodies[registry->body_count++];
   registry->generation += 1;
   registry->revision += 1;
@@ -352,14 +376,14 @@ ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double i
 
 ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body) {
   REQUIRE_REGISTRY(registry);
-  for (int i = 0; i < registry->body_count; ++i) {
-    if (registry->bodies[i].body != body) continue;
-    registry->bodies[i] = registry->bodies[--registry->body_count];
-    registry->generation += 1;
-    registry->revision += 1;
-    return SS_OK;
-  }
-  return ssFail(SS_ERROR_NOT_FOUND, "body %p: not bound", (void*)body);
+  int position = ssIndexFind(&registry->body_index, body, 0);
+  if (position < 0) return ssFail(SS_ERROR_NOT_FOUND, "body %p: not bound", (void*)body);
+  ssIndexRemove(&registry->body_index, body, 0);
+  registry->bodies[position] = registry->bodies[--registry->body_count];
+  if (position < registry->body_count) ssIndexPut(&registry->body_index, registry->bodies[position].body, 0, position);
+  registry->generation += 1;
+  registry->revision += 1;
+  return SS_OK;
 }
 
 /* Prefixes the current message with what failed, so that a caller of Apply learns which binding it was. */
@@ -814,7 +838,8 @@ dWorldID ssRegistryWorld(const ssRegistry* registry) { return registry->world; }
 
 static int reserve(void** items, int count, int more, int* capacity, size_t size) {
   if (count + more <= *capacity) return 1;
-  int wanted = count + more;
+  int wanted = *capacity ? 2 * *capacity : 8; /* doubling: bodies bound one by one cost O(1) each */
+  if (wanted < count + more) wanted = count + more;
   void* larger = realloc(*items, (size_t)wanted * size);
   if (larger == NULL) return 0;
   *items = larger;
@@ -823,9 +848,7 @@ static int reserve(void** items, int count, int more, int* capacity, size_t size
 }
 
 ssStatus ssRegistryReserve(ssRegistry* registry, int more_joints, int more_bodies) {
-  if (!reserveJoints(registry, more_joints) ||
-      !reserve((void**)&registry->bodies, registry->body_count, more_bodies, &registry->body_capacity,
-               sizeof(ssBodyBinding)))
+  if (!reserveJoints(registry, more_joints) || !reserveBodies(registry, more_bodies))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory reserving %d joint rows and %d bodies", more_joints,
                   more_bodies);
   return SS_OK;
