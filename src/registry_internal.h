@@ -53,4 +53,29 @@ void ssRegistryForgetWorldAdoption(ssRegistry* registry);
 ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
                             double step_s, double previous_step_s, int* implicit_euler_fallback);
 
+/* The last contact's softness, for the contacts that follow with the same numbers. A program softens every contact
+ * of a step with one or a few surfaces: a contact whose tuned erp/cfm, tuned step, mapping and step (and, for the
+ * exact mapping, previous step) are the last one's reuses its law and, where the softness does not depend on the
+ * bodies (implicit Euler, naive, hard rows) or the effective mass is the same, its softness, with no conversion and
+ * no check repeated: they were made, and passed, for the same inputs. */
+typedef struct ssContactCache {
+  double tuned_erp, tuned_cfm, tuned_step_s; /* NAN: empty */
+  ssRowLaw law;
+  ssMapping mapping;
+  double step_s, previous_step_s, mass; /* mass: NAN where the softness does not read it */
+  int has_softness;
+  ssSoftness softness;
+  int implicit_euler_fallback;
+} ssContactCache;
+
+/* An empty cache. */
+ssContactCache ssContactCacheEmpty(void);
+
+/* Softens contact as the law that tuned_erp and tuned_cfm stand for at tuned_step_s (ssRowLawFromTuned), for a step
+ * of step_s under mapping, through the cache. Errors, with contact unchanged: those of ssRowLawFromTuned and
+ * ssContactSoftenLaw. */
+ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID body1, dBodyID body2,
+                               double tuned_erp, double tuned_cfm, double tuned_step_s, ssMapping mapping,
+                               double step_s, double previous_step_s, int* implicit_euler_fallback);
+
 #endif

@@ -42,9 +42,7 @@ struct ssStepper {
   int* pushed; /* indices into known of the bodies with a force or carried momentum this frame */
   int pushed_count;
   ssStepInfo current;
-  /* a program softens many contacts with the same tuned numbers: the last ones' law is kept */
-  ssSoftness contact_tuned;
-  ssRowLaw contact_law;
+  ssContactCache contact_cache; /* a program softens many contacts with the same numbers */
   ssFrameReport* report; /* the frame being stepped, for ssStepper_SoftenContact's counts */
   /* the first failure, latched until ssStepper_Reset */
   ssStatus failed_status;
@@ -90,7 +88,7 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   if (stepper == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating a stepper");
   stepper->def = *def;
   resolveSpeeds(&stepper->def.stepping);
-  stepper->contact_tuned = (ssSoftness){NAN, NAN};
+  stepper->contact_cache = ssContactCacheEmpty();
   describeNextStep(stepper);
   *out = stepper;
   return SS_OK;
@@ -217,17 +215,10 @@ ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID 
   const dSurfaceParameters* surface = &contact->surface;
   double erp = (surface->mode & dContactSoftERP) ? surface->soft_erp : world.erp;
   double cfm = (surface->mode & dContactSoftCFM) ? surface->soft_cfm : world.cfm;
-  if (erp != stepper->contact_tuned.erp || cfm != stepper->contact_tuned.cfm) {
-    ssRowLaw law;
-    ssStatus status = ssRowLawFromTuned("contact", erp, cfm, tuned_step_s, &law);
-    if (status != SS_OK) return status;
-    stepper->contact_tuned = (ssSoftness){erp, cfm};
-    stepper->contact_law = law;
-  }
   const ssStepInfo* step = &stepper->current;
   int fell_back = 0;
-  ssStatus status = ssContactSoftenLaw(contact, body1, body2, &stepper->contact_law, step->mapping,
-                                       step->softness_step_s, step->previous_step_s, &fell_back);
+  ssStatus status = ssContactSoftenCached(&stepper->contact_cache, contact, body1, body2, erp, cfm, tuned_step_s,
+                                          step->mapping, step->softness_step_s, step->previous_step_s, &fell_back);
   if (status != SS_OK) return status;
   if (stepper->report != NULL) {
     stepper->report->contacts_softened += 1;
