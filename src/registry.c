@@ -557,11 +557,13 @@ static double bindingMass(ssRegistry* registry, const JointBinding* binding, con
   return measure ? rowMass(registry, binding) : binding->mass;
 }
 
-/* Whether two bindings drive rows along the same axis of the same joint (a stop and a motor). */
+/* Whether two bindings drive rows along the same axis of the same joint (a stop and a motor) and have the same mass:
+ * given alike, or measured for both (a hard row measures none, so its NAN is not the other's mass). */
 static int sharesRow(const JointBinding* a, const JointBinding* b) {
   int a_limit = a->param == SS_PARAM_STOP || a->param == SS_PARAM_MOTOR;
   int b_limit = b->param == SS_PARAM_STOP || b->param == SS_PARAM_MOTOR;
-  return a->joint == b->joint && a->axis == b->axis && a_limit && b_limit;
+  return a->joint == b->joint && a->axis == b->axis && a_limit && b_limit && a->effective_mass == b->effective_mass &&
+         !a->law.hard && !b->law.hard;
 }
 
 /* ODE counts steps: a count of seconds in steps of h, where a whole number of steps computed with rounding error
@@ -623,7 +625,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     const ssRowLaw* law = binding->law_slot >= 0 ? &registry->laws[binding->law_slot] : &binding->law;
     const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
     /* a stop and a motor on one axis move the same mass: computed once */
-    int same_row = before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
+    int same_row = before != NULL && sharesRow(before, binding);
     double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
     last_mass = mass;
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
@@ -683,6 +685,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
         status = ssSoftnessFromSpring(*spring, step_s, &binding->pending);
         if (status != SS_OK) return failBinding(status, binding);
         binding->computed_fallback = (ssRowFallback){0, 1};
+        binding->computed_step_s = NAN; /* not reused: the next Apply decides again from the accurate softness */
         counts->rows_implicit_euler_fallback += 1;
         correction = 0;
       }
@@ -747,8 +750,7 @@ static void writeRowsByLaw(ssRegistry* registry, double step_s, int measure, con
       JointBinding* binding = &registry->joints[i];
       PREFETCH_ROWS(registry, i, 2);
       const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
-      int same_row =
-          before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
+      int same_row = before != NULL && sharesRow(before, binding);
       binding->mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
       row->mass = binding->mass;
       last_mass = binding->mass;
@@ -882,6 +884,16 @@ int ssRegistry_JointBindingCount(const ssRegistry* registry) { return registry !
 int ssRegistryBodyBindingCount(const ssRegistry* registry) { return registry->body_count; }
 
 unsigned ssRegistryGeneration(const ssRegistry* registry) { return registry->generation; }
+
+ssJointRowBinding ssRegistryJointRowAt(const ssRegistry* registry, int i) {
+  const JointBinding* binding = &registry->joints[i];
+  return (ssJointRowBinding){binding->joint, binding->param,          binding->axis,
+                             binding->law,   binding->effective_mass, binding->load};
+}
+
+ssBodyBinding* ssRegistryBodyAt(ssRegistry* registry, int i) { return &registry->bodies[i]; }
+
+double ssRegistryWorldMass(const ssRegistry* registry) { return registry->world_mass; }
 
 /* Every bound body, with repeats, without allocating. */
 static void visitBodiesRepeated(const ssRegistry* registry, void (*visit)(void* context, dBodyID body),

@@ -53,6 +53,25 @@ void ssRegistryForgetWorldAdoption(ssRegistry* registry);
 ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
                             double step_s, double previous_step_s, int* implicit_euler_fallback);
 
+/* One bound joint row as bound, for the reference Apply (apply_reference.h): no cache, no derived state. */
+typedef struct ssJointRowBinding {
+  dJointID joint;
+  ssJointParam param;
+  int axis;
+  ssRowLaw law;
+  double effective_mass; /* 0: measured from the bodies */
+  double load;           /* 0: none declared */
+} ssJointRowBinding;
+
+/* The i-th bound joint row (0 <= i < ssRegistry_JointBindingCount), in the order Apply writes them. */
+ssJointRowBinding ssRegistryJointRowAt(const ssRegistry* registry, int i);
+
+/* The i-th body binding (0 <= i < ssRegistryBodyBindingCount). */
+ssBodyBinding* ssRegistryBodyAt(ssRegistry* registry, int i);
+
+/* The effective mass the world's rows are bound with (kg; 1 when none was given). */
+double ssRegistryWorldMass(const ssRegistry* registry);
+
 /* The last contact's softness, for the contacts that follow with the same numbers. A program softens every contact
  * of a step with one or a few surfaces: a contact whose tuned erp/cfm, tuned step, mapping and step (and, for the
  * exact mapping, previous step) are the last one's reuses its law and, where the softness does not depend on the
