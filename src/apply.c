@@ -185,6 +185,10 @@ static void rebuildApplyCache(ssRegistry* registry) {
 /* What the body opposes to its rows in this Apply: from the cache, computed on its first use in the Apply, or into
  * *local for a body the cache does not know (the joint was attached elsewhere since: the cache is rebuilt next). */
 static const ssBodyInverse* bodyInverse(ssRegistry* registry, int slot, dBodyID body, ssBodyInverse* local) {
+  if (registry->disabled_caches & SS_CACHE_BODIES) {
+    ssBodyInverseOf(body, local);
+    return local;
+  }
   if (slot >= 0 && registry->body_cache[slot].body == body) {
     BodyCache* cached = &registry->body_cache[slot];
     if (cached->stamp != registry->apply_stamp) {
@@ -255,12 +259,13 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     const ssRowLaw* law = binding->law_slot >= 0 ? &registry->laws[binding->law_slot] : &binding->law;
     const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
     /* a stop and a motor on one axis move the same mass: computed once */
-    int same_row = before != NULL && sharesRow(before, binding);
+    int same_row = before != NULL && !(registry->disabled_caches & SS_CACHE_SAME_AXIS) && sharesRow(before, binding);
     double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
     last_mass = mass;
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
-    if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_epoch == registry->reuse_epoch &&
+    if (mapping != SS_MAPPING_IMPLICIT_EULER && !(registry->disabled_caches & SS_CACHE_REUSE) &&
+        binding->computed_epoch == registry->reuse_epoch &&
         binding->computed_mapping == mapping && binding->mass == mass && binding->computed_step_s == step_s &&
         binding->computed_previous_s == previous_s) {
       countRow(law, mass, step_s, &binding->computed_fallback, counts);
@@ -286,10 +291,12 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
         binding->computed_step_s = NAN;
         return failBinding(status, binding);
       }
-      shared[shared_next] =
-          (SharedSoftness){law, binding->law_slot, mass, binding->pending, binding->computed_fallback};
-      shared_next = (shared_next + 1) % kSharedSize;
-      if (shared_count < kSharedSize) shared_count += 1;
+      if (!(registry->disabled_caches & SS_CACHE_SHARED)) {
+        shared[shared_next] =
+            (SharedSoftness){law, binding->law_slot, mass, binding->pending, binding->computed_fallback};
+        shared_next = (shared_next + 1) % kSharedSize;
+        if (shared_count < kSharedSize) shared_count += 1;
+      }
     }
     *unwritten += !sameSoftness(&binding->pending, &binding->written);
     binding->computed_mapping = mapping; /* implicit Euler: an accurate mapping never reuses this pending */
@@ -380,7 +387,8 @@ static void writeRowsByLaw(ssRegistry* registry, double step_s, int measure, con
       JointBinding* binding = &registry->joints[i];
       PREFETCH_ROWS(registry, i, 2);
       const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
-      int same_row = before != NULL && sharesRow(before, binding);
+      int same_row =
+          before != NULL && !(registry->disabled_caches & SS_CACHE_SAME_AXIS) && sharesRow(before, binding);
       binding->mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
       row->mass = binding->mass;
       last_mass = binding->mass;
@@ -411,7 +419,8 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
 
   /* implicit Euler depends on h alone: a step as long as the last one, with nothing rebound since, has every row
    * written already (a program with constant frames pays nothing here) */
-  if (mapping == SS_MAPPING_IMPLICIT_EULER && registry->applied_mapping == mapping &&
+  if (mapping == SS_MAPPING_IMPLICIT_EULER && !(registry->disabled_caches & SS_CACHE_SAME_STEP) &&
+      registry->applied_mapping == mapping &&
       registry->applied_step_s == step_s && registry->applied_revision == registry->revision) {
     if (report != NULL) *report = registry->applied_counts;
     return SS_OK;
@@ -431,7 +440,8 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     if (status != SS_OK) return failBinding(status, NULL);
   }
   int measure = mapping != SS_MAPPING_IMPLICIT_EULER || registry->report_mass_age == 0;
-  int by_law = mapping == SS_MAPPING_IMPLICIT_EULER && registry->rows_outside_laws == 0;
+  int by_law = mapping == SS_MAPPING_IMPLICIT_EULER && !(registry->disabled_caches & SS_CACHE_BY_LAW) &&
+               registry->rows_outside_laws == 0;
   ssSoftness law_softness[kLawTableSize];
   if (!by_law) ssApplyMaterializeWritten(registry); /* computeRows and writeRows compare each row's own */
   int unwritten = 0; /* rows whose pending differs from what ODE holds: with none (constant steps), no second pass */
@@ -461,4 +471,10 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   registry->applied_counts = counts;
   if (report != NULL) *report = counts;
   return SS_OK;
+}
+
+void ssRegistryDisableCaches(ssRegistry* registry, unsigned mask) {
+  ssApplyMaterializeWritten(registry);
+  registry->disabled_caches = mask;
+  registry->revision += 1; /* the caches are rebuilt and nothing computed with others is reused */
 }

@@ -72,6 +72,20 @@ ssBodyBinding* ssRegistryBodyAt(ssRegistry* registry, int i);
 /* The effective mass the world's rows are bound with (kg; 1 when none was given). */
 double ssRegistryWorldMass(const ssRegistry* registry);
 
+/* Apply's caches (apply.c states each one's invariant), for measuring what each buys and testing Apply without it. */
+enum {
+  SS_CACHE_SAME_STEP = 1 << 0, /* implicit Euler at the last step with nothing rebound: nothing to write */
+  SS_CACHE_BY_LAW = 1 << 1,    /* implicit Euler: one softness per law of the table, rows written by law */
+  SS_CACHE_BODIES = 1 << 2,    /* each body's inverse mass and inertia computed once per Apply */
+  SS_CACHE_SHARED = 1 << 3,    /* within an Apply, rows with the same law and mass share one softness */
+  SS_CACHE_REUSE = 1 << 4,     /* accurate mappings: a row's softness kept while its inputs are the same */
+  SS_CACHE_SAME_AXIS = 1 << 5, /* a stop and a motor on one axis share the mass measured for the first */
+  SS_CACHE_ALL = (1 << 6) - 1
+};
+
+/* Turns off the caches in mask (and on the others). The values Apply writes are the same either way. */
+void ssRegistryDisableCaches(ssRegistry* registry, unsigned mask);
+
 /* The last contact's softness, for the contacts that follow with the same numbers. A program softens every contact
  * of a step with one or a few surfaces: a contact whose tuned erp/cfm, tuned step, mapping and step (and, for the
  * exact mapping, previous step) are the last one's reuses its law and, where the softness does not depend on the

@@ -99,6 +99,7 @@ struct ssRegistry {
    * rows' written until the other passes (or a rebinding) need theirs back (materializeWritten) */
   int written_by_law;
   ssSoftness law_written[kLawTableSize];
+  unsigned disabled_caches; /* SS_CACHE_* turned off, to measure what each buys (ssRegistryDisableCaches) */
 };
 
 #define REQUIRE_REGISTRY(registry) \

@@ -269,7 +269,7 @@ int ssApplyDifferential(const uint8_t* data, size_t size, char* message, size_t 
   int failed = 0;
   for (int n = 0; n < kMaxOps && reader.at < reader.size && !failed; ++n) {
     check.op = n;
-    Operation op = {next(&reader) % 11, next(&reader), next(&reader), next(&reader), next(&reader)};
+    Operation op = {next(&reader) % 12, next(&reader), next(&reader), next(&reader), next(&reader)};
     if (op.kind == 6 || op.kind == 7) { /* Apply: the most frequent */
       ssMapping mapping = (ssMapping)(op.a % 3);
       double step_s = kSteps[op.b % 8];
@@ -309,6 +309,10 @@ int ssApplyDifferential(const uint8_t* data, size_t size, char* message, size_t 
       }
       check.counts->steps += 1;
       failed = compareStates(&check, &twins[0], &twins[1]);
+      continue;
+    }
+    if (op.kind == 11) { /* some of Apply's caches off, or all on again: the values written stay the same */
+      ssRegistryDisableCaches(twins[0].registry, op.a % 2 ? 0 : op.b & SS_CACHE_ALL);
       continue;
     }
     for (int t = 0; t < 2; ++t) {
