@@ -35,11 +35,11 @@ typedef struct Computed {
   double correction;
 } Computed;
 
-static void count(const ssRowLaw* law, double mass, double step_s, const ssRowFallback* fallback,
-                  ssApplyReport* report) {
-  report->rows_exact_fallback += fallback->exact_to_matched;
-  report->rows_implicit_euler_fallback += fallback->to_implicit_euler;
-  if (!law->hard) report->rows_over_nyquist += ssOverNyquist(law->spring, mass, step_s);
+/* Each row counted once, by who served it. */
+static void count(const ssRowFallback* fallback, ssApplyReport* report) {
+  if (fallback->to_implicit_euler) report->rows.handed_to_implicit_euler += 1;
+  else if (fallback->exact_to_matched) report->rows.handed_to_matched += 1;
+  else report->rows.by_mapping += 1;
 }
 
 static ssStatus computeRow(const ssJointRowBinding* row, ssMapping mapping, double step_s, double previous_s,
@@ -49,18 +49,20 @@ static ssStatus computeRow(const ssJointRowBinding* row, ssMapping mapping, doub
   ssStatus status = ssRowSoftness(&row->law, mapping, mass, step_s, previous_s, &fallback, &out->softness);
   if (status == SS_OK) status = ssCheckSoftnessForOde("softness", out->softness.erp, out->softness.cfm);
   if (status != SS_OK) return status;
-  count(&row->law, mass, step_s, &fallback, report);
   out->correction = 0;
   const ssSpring* spring = &row->law.spring;
-  if (mapping == SS_MAPPING_IMPLICIT_EULER || row->load == 0 || row->law.hard || spring->stiffness == 0) return SS_OK;
-  double correction = row->load * (out->softness.erp / (step_s * out->softness.cfm) / spring->stiffness - 1);
-  if (fabs(correction) <= SS_MAX_FORCE_N) {
-    out->correction = correction;
-    return SS_OK;
+  if (mapping != SS_MAPPING_IMPLICIT_EULER && row->load != 0 && !row->law.hard && spring->stiffness != 0) {
+    double correction = row->load * (out->softness.erp / (step_s * out->softness.cfm) / spring->stiffness - 1);
+    if (fabs(correction) <= SS_MAX_FORCE_N) {
+      out->correction = correction;
+    } else { /* no accurate softness that carries the load: implicit Euler, whose static stiffness is k */
+      fallback = (ssRowFallback){0, 1};
+      status = ssSoftnessFromSpring(*spring, step_s, &out->softness);
+      if (status != SS_OK) return status;
+    }
   }
-  /* no accurate softness that carries the load: implicit Euler, whose static stiffness is k */
-  report->rows_implicit_euler_fallback += 1;
-  return ssSoftnessFromSpring(*spring, step_s, &out->softness);
+  count(&fallback, report);
+  return SS_OK;
 }
 
 static double stepsIn(double seconds, double step_s) { return ceil(seconds / step_s - 1e-9); }
@@ -108,7 +110,7 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
   if (status != SS_OK) return status;
   if (ssMappingName(mapping) == NULL) return ssFail(SS_ERROR_UNSUPPORTED, "mapping = %d: unknown", (int)mapping);
   double previous_s = mapping == SS_MAPPING_EXACT ? previous_step_s : 0;
-  ssApplyReport counts = {0, 0, 0, 0};
+  ssApplyReport counts = {{0, 0, 0}, 0};
   ssRowLaw world_law;
   ssSoftness world = {0, 0};
   int world_bound = ssRegistryWorldBound(registry, &world_law);
@@ -118,7 +120,7 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
     status = ssRowSoftness(&world_law, mapping, mass, step_s, previous_s, &fallback, &world);
     if (status == SS_OK) status = ssCheckSoftnessForOde("softness", world.erp, world.cfm);
     if (status != SS_OK) return status;
-    count(&world_law, mass, step_s, &fallback, &counts);
+    count(&fallback, &counts);
   }
   int rows = ssRegistry_JointBindingCount(registry);
   Computed* computed = malloc((size_t)(rows > 0 ? rows : 1) * sizeof *computed);
@@ -132,10 +134,10 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
     return status;
   }
   dWorldID world_id = ssRegistryWorld(registry);
-  if (world_bound) {
-    if (dWorldGetERP(world_id) != world.erp) dWorldSetERP(world_id, world.erp);
-    if (dWorldGetCFM(world_id) != world.cfm) dWorldSetCFM(world_id, world.cfm);
-    counts.rows_written += 1;
+  if (world_bound && (dWorldGetERP(world_id) != world.erp || dWorldGetCFM(world_id) != world.cfm)) {
+    dWorldSetERP(world_id, world.erp);
+    dWorldSetCFM(world_id, world.cfm);
+    counts.row_writes += 1;
   }
   for (int i = 0; i < rows; ++i) {
     ssJointRowBinding row = ssRegistryJointRowAt(registry, i);
@@ -145,14 +147,17 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
     ssJointRowWriterOf(row.joint, row.param, row.axis, &writer);
     /* a motor row has no erp: ODE holds only its cfm */
     int erp_differs = writer.erp_number >= 0 && erp != computed[i].softness.erp;
-    if (erp_differs || cfm != computed[i].softness.cfm)
+    /* a row bound since the last Apply is written whatever ODE holds (registry.h: binding again rewrites it) */
+    if (row.unwritten || erp_differs || cfm != computed[i].softness.cfm) {
       ssRowWrite(&writer, row.joint, computed[i].softness.erp, computed[i].softness.cfm);
+      ssRegistrySetRowWritten(registry, i, computed[i].softness);
+      counts.row_writes += 1;
+    }
   }
   for (int i = 0; i < rows; ++i) {
     ssJointRowBinding row = ssRegistryJointRowAt(registry, i);
     if (computed[i].correction != 0) ssJointAddRowForce(row.joint, row.param, row.axis, computed[i].correction);
   }
-  counts.rows_written += rows;
   free(computed);
   for (int i = 0; i < ssRegistryBodyBindingCount(registry); ++i)
     writeBody(ssRegistryBodyAt(registry, i), world_id, step_s);

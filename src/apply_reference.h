@@ -11,8 +11,8 @@
 extern "C" {
 #endif
 
-/* ssRegistry_Apply's contract, computed plainly. report's rows_over_nyquist counts every row with its mass measured
- * now (Apply's may lag by a few implicit-Euler Applies). Errors: those of ssRegistry_Apply, with nothing written. */
+/* ssRegistry_Apply's contract, computed plainly; row_writes counts the parameter sets written: those whose value ODE
+ * did not hold already, and those bound since the last Apply. Errors: those of ssRegistry_Apply, with nothing written. */
 ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
                                   ssApplyReport* report);
 

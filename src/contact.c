@@ -16,13 +16,11 @@ static double contactMass(const dContact* contact, dBodyID body1, dBodyID body2)
 }
 
 /* The softness of a law for one contact whose mass (NAN where the mapping does not read it) is known: computed and
- * checked against what ODE takes. */
+ * checked against what ODE takes; *handed_on says whether the accurate mapping handed it on. */
 static ssStatus contactSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s,
-                                double previous_step_s, ssSoftness* softness, int* implicit_euler_fallback) {
-  ssRowFallback fallback;
-  ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, &fallback, softness);
+                                double previous_step_s, ssSoftness* softness, ssRowFallback* handed_on) {
+  ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, handed_on, softness);
   if (status == SS_OK) status = ssCheckSoftnessForOde("contact", softness->erp, softness->cfm);
-  *implicit_euler_fallback = fallback.to_implicit_euler;
   return status;
 }
 
@@ -36,14 +34,14 @@ static void writeSoftness(dContact* contact, ssSoftness softness) {
 static int readsMass(const ssRowLaw* law, ssMapping mapping) { return mapping != SS_MAPPING_IMPLICIT_EULER && !law->hard; }
 
 ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
-                            double step_s, double previous_step_s, int* implicit_euler_fallback) {
+                            double step_s, double previous_step_s, ssRowFallback* handed_on) {
   double mass = readsMass(law, mapping) ? contactMass(contact, body1, body2) : NAN;
   ssSoftness softness;
-  int fell_back = 0;
-  ssStatus status = contactSoftness(law, mapping, mass, step_s, previous_step_s, &softness, &fell_back);
+  ssRowFallback fallback;
+  ssStatus status = contactSoftness(law, mapping, mass, step_s, previous_step_s, &softness, &fallback);
   if (status != SS_OK) return status;
   writeSoftness(contact, softness);
-  if (implicit_euler_fallback != NULL) *implicit_euler_fallback = fell_back;
+  if (handed_on != NULL) *handed_on = fallback;
   return SS_OK;
 }
 
@@ -56,7 +54,7 @@ ssContactCache ssContactCacheEmpty(void) {
 
 ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID body1, dBodyID body2,
                                double tuned_erp, double tuned_cfm, double tuned_step_s, ssMapping mapping,
-                               double step_s, double previous_step_s, int* implicit_euler_fallback) {
+                               double step_s, double previous_step_s, ssRowFallback* handed_on) {
   if (tuned_erp != cache->tuned_erp || tuned_cfm != cache->tuned_cfm || tuned_step_s != cache->tuned_step_s) {
     ssRowLaw law;
     ssStatus status = ssRowLawFromTuned("contact", tuned_erp, tuned_cfm, tuned_step_s, &law);
@@ -74,8 +72,8 @@ ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID
              previous_step_s == cache->previous_step_s && (isnan(mass) ? isnan(cache->mass) : mass == cache->mass);
   if (!same) {
     ssSoftness softness;
-    int fell_back = 0;
-    ssStatus status = contactSoftness(&cache->law, mapping, mass, step_s, previous_step_s, &softness, &fell_back);
+    ssRowFallback fallback;
+    ssStatus status = contactSoftness(&cache->law, mapping, mass, step_s, previous_step_s, &softness, &fallback);
     if (status != SS_OK) return status;
     cache->has_softness = 1;
     cache->mapping = mapping;
@@ -83,10 +81,10 @@ ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID
     cache->previous_step_s = previous_step_s;
     cache->mass = mass;
     cache->softness = softness;
-    cache->implicit_euler_fallback = fell_back;
+    cache->handed_on = fallback;
   }
   writeSoftness(contact, cache->softness);
-  if (implicit_euler_fallback != NULL) *implicit_euler_fallback = cache->implicit_euler_fallback;
+  if (handed_on != NULL) *handed_on = cache->handed_on;
   return SS_OK;
 }
 

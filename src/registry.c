@@ -370,8 +370,16 @@ unsigned ssRegistryGeneration(const ssRegistry* registry) { return registry->gen
 
 ssJointRowBinding ssRegistryJointRowAt(const ssRegistry* registry, int i) {
   const JointBinding* binding = &registry->joints[i];
-  return (ssJointRowBinding){binding->joint, binding->param,          binding->axis,
-                             binding->law,   binding->effective_mass, binding->load};
+  /* while the by-law pass stands for the rows' own written, the law's is what the row was given */
+  int by_law = registry->written_by_law && binding->law_slot >= 0;
+  ssSoftness written = by_law ? registry->law_written[binding->law_slot] : binding->written;
+  return (ssJointRowBinding){binding->joint,          binding->param, binding->axis, binding->law,
+                             binding->effective_mass, binding->load,  isnan(written.erp) && isnan(written.cfm)};
+}
+
+void ssRegistrySetRowWritten(ssRegistry* registry, int i, ssSoftness softness) {
+  ssApplyMaterializeWritten(registry);
+  registry->joints[i].written = softness;
 }
 
 ssBodyBinding* ssRegistryBodyAt(ssRegistry* registry, int i) { return &registry->bodies[i]; }

@@ -48,10 +48,10 @@ ssSoftness ssRegistryTunedWorld(const ssRegistry* registry);
 /* Undoes ssRegistry_AdoptWorld, when the rest of an adoption failed. */
 void ssRegistryForgetWorldAdoption(ssRegistry* registry);
 
-/* ssContactSoften for a law, without checking its arguments; *implicit_euler_fallback (may be NULL) says whether the
- * accurate mapping handed the contact to the implicit-Euler mapping. */
+/* ssContactSoften for a law, without checking its arguments; *fallback (may be NULL) says whether the accurate
+ * mapping handed the contact on (to matched, or to implicit Euler). */
 ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
-                            double step_s, double previous_step_s, int* implicit_euler_fallback);
+                            double step_s, double previous_step_s, ssRowFallback* fallback);
 
 /* One bound joint row as bound, for the reference Apply (apply_reference.h): no cache, no derived state. */
 typedef struct ssJointRowBinding {
@@ -61,10 +61,14 @@ typedef struct ssJointRowBinding {
   ssRowLaw law;
   double effective_mass; /* 0: measured from the bodies */
   double load;           /* 0: none declared */
+  int unwritten;         /* nothing written since it was bound: the next Apply writes it whatever ODE holds */
 } ssJointRowBinding;
 
 /* The i-th bound joint row (0 <= i < ssRegistry_JointBindingCount), in the order Apply writes them. */
 ssJointRowBinding ssRegistryJointRowAt(const ssRegistry* registry, int i);
+
+/* Records that the i-th row was given softness (the reference Apply's part of the registry's state). */
+void ssRegistrySetRowWritten(ssRegistry* registry, int i, ssSoftness softness);
 
 /* The i-th body binding (0 <= i < ssRegistryBodyBindingCount). */
 ssBodyBinding* ssRegistryBodyAt(ssRegistry* registry, int i);
@@ -98,7 +102,7 @@ typedef struct ssContactCache {
   double step_s, previous_step_s, mass; /* mass: NAN where the softness does not read it */
   int has_softness;
   ssSoftness softness;
-  int implicit_euler_fallback;
+  ssRowFallback handed_on;
 } ssContactCache;
 
 /* An empty cache. */
@@ -109,6 +113,6 @@ ssContactCache ssContactCacheEmpty(void);
  * ssContactSoftenLaw. */
 ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID body1, dBodyID body2,
                                double tuned_erp, double tuned_cfm, double tuned_step_s, ssMapping mapping,
-                               double step_s, double previous_step_s, int* implicit_euler_fallback);
+                               double step_s, double previous_step_s, ssRowFallback* handed_on);
 
 #endif

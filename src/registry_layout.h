@@ -20,8 +20,8 @@ typedef struct JointBinding {
   ssJointParam param;
   int axis;
   int law_slot; /* the law in the registry's table; -1: not there, read law */
-  /* the mass the last Apply gave the row (NAN: none): the input of its softness under the accurate mappings, and
-   * under implicit Euler, which needs it only for the Nyquist report, the one measured every few Applies */
+  /* the mass the last Apply of an accurate mapping gave the row (NAN: none), the input of its softness (implicit
+   * Euler reads no mass) */
   double mass;
 
   ssSoftness pending; /* computed in the general first pass */
@@ -45,7 +45,6 @@ typedef struct JointBinding {
 typedef struct HotRow {
   dJointID joint;
   ssParamSetter set; /* the row's writer: NULL for a row without softness */
-  double mass;
   int16_t erp_number, cfm_number; /* ODE's parameter numbers (below 0x400); erp_number -1: none */
   int16_t law_slot;
 } HotRow;
@@ -89,7 +88,6 @@ struct ssRegistry {
   int body_cache_stale;
   unsigned apply_stamp;
   int loaded_rows; /* bindings with a load, counted with the body cache: Apply skips the load passes without */
-  int report_mass_age; /* implicit-Euler Applies until the report's masses are computed again; 0 after a rebinding */
   /* the distinct laws of the bindings (programs bind many rows to a few springs), rebuilt with the body cache */
   ssRowLaw laws[kLawTableSize];
   int law_count;

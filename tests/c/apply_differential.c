@@ -288,15 +288,17 @@ int ssApplyDifferential(const uint8_t* data, size_t size, char* message, size_t 
       last_step_s = step_s;
       if (fast == SS_OK) failed = compareWritten(&check, &twins[0], &twins[1]);
       if (fast == SS_OK && !failed) {
-        if (reports[0].rows_written != reports[1].rows_written)
-          failed = differ(&check, "rows_written, mapping", (int)mapping, reports[0].rows_written,
-                          reports[1].rows_written);
-        else if (reports[0].rows_exact_fallback != reports[1].rows_exact_fallback)
-          failed = differ(&check, "rows_exact_fallback, mapping", (int)mapping, reports[0].rows_exact_fallback,
-                          reports[1].rows_exact_fallback);
-        else if (reports[0].rows_implicit_euler_fallback != reports[1].rows_implicit_euler_fallback)
-          failed = differ(&check, "rows_implicit_euler_fallback, mapping", (int)mapping,
-                          reports[0].rows_implicit_euler_fallback, reports[1].rows_implicit_euler_fallback);
+        const ssServedCounts* rows[2] = {&reports[0].rows, &reports[1].rows};
+        if (reports[0].row_writes != reports[1].row_writes)
+          failed = differ(&check, "row_writes, mapping", (int)mapping, reports[0].row_writes, reports[1].row_writes);
+        else if (rows[0]->by_mapping != rows[1]->by_mapping)
+          failed = differ(&check, "rows.by_mapping, mapping", (int)mapping, rows[0]->by_mapping, rows[1]->by_mapping);
+        else if (rows[0]->handed_to_matched != rows[1]->handed_to_matched)
+          failed = differ(&check, "rows.handed_to_matched, mapping", (int)mapping, rows[0]->handed_to_matched,
+                          rows[1]->handed_to_matched);
+        else if (rows[0]->handed_to_implicit_euler != rows[1]->handed_to_implicit_euler)
+          failed = differ(&check, "rows.handed_to_implicit_euler, mapping", (int)mapping,
+                          rows[0]->handed_to_implicit_euler, rows[1]->handed_to_implicit_euler);
       }
       continue;
     }

@@ -3,9 +3,8 @@
  * than Apply's law table holds (springs, dampers, undamped and hard rows, rows above Nyquist), loads, unbinding,
  * rebinding, attachment and mass changes, kinematic bodies, every mapping, many steps, and Apply's caches turned off
  * and on. After every Apply, every bound or unbound parameter the worlds' joints have, the world's ERP/CFM, damping
- * and the forces added for loads must be equal bit for bit, as must the statuses and the reports (bar
- * rows_over_nyquist); after every ODE step, every body's state. Shared by the GoogleTest (test_apply.cpp) and the
- * fuzz target (tests/fuzz/fuzz_apply.c). */
+ * and the forces added for loads must be equal bit for bit, as must the statuses and the reports; after every ODE
+ * step, every body's state. Shared by the GoogleTest (test_apply.cpp) and the fuzz target (tests/fuzz/fuzz_apply.c). */
 #ifndef STEADYSTEP_APPLY_DIFFERENTIAL_H
 #define STEADYSTEP_APPLY_DIFFERENTIAL_H
 
