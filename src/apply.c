@@ -18,10 +18,12 @@
  *      hot_rows[i] mirrors joints[i]'s joint, writer and law_slot.
  *  - joints[i].written is what ODE holds for the row (NAN after a binding: written at the next Apply), except while
  *    written_by_law: then a row with law_slot >= 0 holds law_written[law_slot] (the by-law pass writes no row's
- *    own); ssApplyMaterializeWritten puts those back before anything reads or moves the rows' own.
+ *    own); ssApplyMaterializeWritten puts those back before anything reads or moves the rows' own. A row without
+ *    an erp (a motor's) holds only its cfm: its rows are compared on the cfm alone (sameWrite).
  *  - joints[i].pending, once computed, is the softness of the row's law for (computed_mapping, mass,
- *    computed_step_s, computed_previous_s), valid while computed_epoch == reuse_epoch; every implicit-Euler Apply
- *    changes reuse_epoch, and a binding, a load or a load's fallback voids it (computed_step_s = NAN).
+ *    computed_step_s, computed_previous_s) where computed_mapping is an accurate one (implicit Euler's general pass
+ *    leaves its own there and says so in computed_mapping); a binding, a load or a load's fallback voids it
+ *    (computed_step_s = NAN). The mappings are pure functions of these inputs, so equal inputs reuse it.
  *  - Within one Apply only: the shared-softness ring maps (law, mass) to a softness computed in this Apply, and a
  *    stop and a motor on one axis (sharesRow) share the mass measured for the first. */
 #include <math.h>
@@ -261,7 +263,6 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
     if (mapping != SS_MAPPING_IMPLICIT_EULER && !(registry->disabled_caches & SS_CACHE_REUSE) &&
-        binding->computed_epoch == registry->reuse_epoch &&
         binding->computed_mapping == mapping && binding->mass == mass && binding->computed_step_s == step_s &&
         binding->computed_previous_s == previous_s) {
       countRow(&binding->computed_fallback, counts);
@@ -296,7 +297,6 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     *unwritten += !sameWrite(binding->writer.erp_number, &binding->pending, &binding->written);
     binding->computed_mapping = mapping; /* implicit Euler: an accurate mapping never reuses this pending */
     if (mapping == SS_MAPPING_IMPLICIT_EULER) continue;
-    binding->computed_epoch = registry->reuse_epoch;
     binding->computed_step_s = step_s;
     binding->computed_previous_s = previous_s;
   }
@@ -442,7 +442,6 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   if (status != SS_OK) return status;
 
   /* Nothing below can fail. */
-  if (mapping == SS_MAPPING_IMPLICIT_EULER) registry->reuse_epoch += 1;
   if (registry->world_bound && (dWorldGetERP(registry->world) != registry->world_pending.erp ||
                                 dWorldGetCFM(registry->world) != registry->world_pending.cfm)) {
     dWorldSetERP(registry->world, registry->world_pending.erp);

@@ -31,7 +31,6 @@ typedef struct JointBinding {
   int body_slot[2]; /* the joint's bodies in the registry's body cache; -1: none or not known */
   int joint_type;   /* dJointGetType, resolved at bind time: a joint's type never changes */
   ssMapping computed_mapping;
-  unsigned computed_epoch; /* the registry's reuse_epoch when computed: an implicit-Euler Apply since voids it */
   ssRowFallback computed_fallback;
 
   ssRowLaw law;
@@ -92,7 +91,6 @@ struct ssRegistry {
   ssRowLaw laws[kLawTableSize];
   int law_count;
   int rows_outside_laws; /* bindings whose law did not fit in the table */
-  unsigned reuse_epoch;  /* changes at every implicit-Euler Apply, which leaves the rows' pending behind */
   /* after a by-law pass, every row in the law table holds its law's softness in ODE: law_written stands for the
    * rows' written until the other passes (or a rebinding) need theirs back (materializeWritten) */
   int written_by_law;
