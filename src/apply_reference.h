@@ -12,7 +12,8 @@ extern "C" {
 #endif
 
 /* ssRegistry_Apply's contract, computed plainly; row_writes counts the parameter sets written: those whose value ODE
- * did not hold already, and those bound since the last Apply. Errors: those of ssRegistry_Apply, with nothing written. */
+ * did not hold already, and those bound since the last Apply. Errors: those of ssRegistry_Apply, with nothing
+ * written. */
 ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
                                   ssApplyReport* report);
 

@@ -31,7 +31,9 @@ static void writeSoftness(dContact* contact, ssSoftness softness) {
 }
 
 /* Whether the softness of law under mapping reads the contact's effective mass. */
-static int readsMass(const ssRowLaw* law, ssMapping mapping) { return mapping != SS_MAPPING_IMPLICIT_EULER && !law->hard; }
+static int readsMass(const ssRowLaw* law, ssMapping mapping) {
+  return mapping != SS_MAPPING_IMPLICIT_EULER && !law->hard;
+}
 
 ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
                             double step_s, double previous_step_s, ssRowFallback* handed_on) {
@@ -87,7 +89,6 @@ ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID
   if (handed_on != NULL) *handed_on = cache->handed_on;
   return SS_OK;
 }
-
 
 ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpring spring, ssMapping mapping,
                          double step_s, double previous_step_s) {

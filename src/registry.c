@@ -5,15 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "array.h"
-#include "binding_index.h"
 #include "error.h"
 #include "ode_bounds.h"
-#include "joint_rows.h"
-#include "registry_internal.h"
-#include "row_law.h"
-#include "steadystep/adopt.h"
 #include "registry_layout.h"
+#include "steadystep/adopt.h"
 #include "steadystep/registry.h"
 
 ssRegistry* ssRegistry_Create(dWorldID world) {
@@ -60,7 +55,6 @@ ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effe
   ssRegistryBindWorldLaw(registry, law, effective_mass);
   return SS_OK;
 }
-
 
 /* Room for `more` joint bindings, in an array aligned to cache lines (JointBinding's groups are lines). */
 static int reserveJoints(ssRegistry* registry, int more) {
