@@ -35,15 +35,15 @@ static int readsMass(const ssRowLaw* law, ssMapping mapping) {
   return mapping != SS_MAPPING_IMPLICIT_EULER && !law->hard;
 }
 
-ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
-                            double step_s, double previous_step_s, ssRowFallback* handed_on) {
+/* ssContactSoften for a law, its arguments checked. */
+static ssStatus softenByLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
+                            double step_s, double previous_step_s) {
   double mass = readsMass(law, mapping) ? contactMass(contact, body1, body2) : NAN;
   ssSoftness softness;
   ssRowFallback fallback;
   ssStatus status = contactSoftness(law, mapping, mass, step_s, previous_step_s, &softness, &fallback);
   if (status != SS_OK) return status;
   writeSoftness(contact, softness);
-  if (handed_on != NULL) *handed_on = fallback;
   return SS_OK;
 }
 
@@ -99,5 +99,5 @@ ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpri
   if (status == SS_OK && previous_step_s != 0) status = ssCheckStepLength("previous_step_s", previous_step_s);
   if (status != SS_OK) return status;
   ssRowLaw law = ssRowLawOfSpring(spring);
-  return ssContactSoftenLaw(contact, body1, body2, &law, mapping, step_s, previous_step_s, NULL);
+  return softenByLaw(contact, body1, body2, &law, mapping, step_s, previous_step_s);
 }

@@ -48,11 +48,6 @@ ssSoftness ssRegistryTunedWorld(const ssRegistry* registry);
 /* Undoes ssRegistry_AdoptWorld, when the rest of an adoption failed. */
 void ssRegistryForgetWorldAdoption(ssRegistry* registry);
 
-/* ssContactSoften for a law, without checking its arguments; *fallback (may be NULL) says whether the accurate
- * mapping handed the contact on (to matched, or to implicit Euler). */
-ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
-                            double step_s, double previous_step_s, ssRowFallback* fallback);
-
 /* One bound joint row as bound, for the reference Apply (apply_reference.h): no cache, no derived state. */
 typedef struct ssJointRowBinding {
   dJointID joint;
@@ -109,8 +104,9 @@ typedef struct ssContactCache {
 ssContactCache ssContactCacheEmpty(void);
 
 /* Softens contact as the law that tuned_erp and tuned_cfm stand for at tuned_step_s (ssRowLawFromTuned), for a step
- * of step_s under mapping, through the cache. Errors, with contact unchanged: those of ssRowLawFromTuned and
- * ssContactSoftenLaw. */
+ * of step_s under mapping, through the cache; *handed_on (may be NULL) says whether the accurate mapping handed the
+ * contact on (to matched, or to implicit Euler). Errors, with contact unchanged: those of ssRowLawFromTuned and
+ * ssContactSoften. */
 ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID body1, dBodyID body2,
                                double tuned_erp, double tuned_cfm, double tuned_step_s, ssMapping mapping,
                                double step_s, double previous_step_s, ssRowFallback* handed_on);
