@@ -25,7 +25,9 @@
  *    leaves its own there and says so in computed_mapping); a binding, a load or a load's fallback voids it
  *    (computed_step_s = NAN). The mappings are pure functions of these inputs, so equal inputs reuse it.
  *  - Within one Apply only: the shared-softness ring maps (law, mass) to a softness computed in this Apply, and a
- *    stop and a motor on one axis (sharesRow) share the mass measured for the first. */
+ *    stop and a motor on one axis (sharesRow) share the mass measured for the first.
+ *  - disabled_caches turns caches off one by one (ssRegistryDisableCaches): bench_apply measures what each buys,
+ *    and the differential check requires the same values either way. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
