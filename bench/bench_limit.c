@@ -182,8 +182,8 @@ int main(int argc, char** argv) {
   for (int s = 0; s < kSizes; ++s) {
     int bodies = kBodies[s];
     /* about the same time at every size: ODE's step grows with the bodies */
-    int frames = (int)(200000 / bodies);
-    frames = frames < 40 ? 40 : frames > 4000 ? 4000 : frames;
+    int frames = (int)(400000 / bodies);
+    frames = frames < 100 ? 100 : frames > 4000 ? 4000 : frames;
     frames = (frames + kBlock - 1) / kBlock * kBlock;
     static double seconds[kParts][kMaxRepeats];
     measure(bodies, frames, repeats, seconds);
