@@ -1,5 +1,6 @@
 /* Soft contacts: a contact's normal row as a spring, softened for each step in the near callback. */
 #include <math.h>
+#include <string.h>
 
 #include "error.h"
 #include "ode_bounds.h"
@@ -26,21 +27,73 @@
  * few contacts otherwise than implicit Euler moves every quantity by as much as the mapping could gain: in the
  * lab's wall, serving the ball's landing (26 contact-steps of 35 000, each with k'/k within 4 %) made the wall's
  * displacement 1.06 and the ball's x 1.15 times implicit Euler's deviation at fixed:60. So under MATCHED and
- * EXACT every contact is served by implicit Euler and counted as handed to it; the accurate mappings keep the
+ * EXACT every contact is served by implicit Euler and counted as handed to it (no effective mass is measured,
+ * and the softness depends on the step alone, which the cache below reuses); the accurate mappings keep the
  * rows where one spring dominates one body (row_law.c's rule). */
-ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
-                            double step_s, double previous_step_s, ssRowFallback* handed_on) {
-  (void)body1, (void)body2, (void)previous_step_s;
-  ssSoftness softness;
-  ssRowFallback fallback = {0, 0};
-  ssStatus status = ssRowSoftness(law, SS_MAPPING_IMPLICIT_EULER, NAN, step_s, 0, 0, NULL, &softness);
-  fallback.to_implicit_euler = !law->hard && (mapping == SS_MAPPING_MATCHED || mapping == SS_MAPPING_EXACT);
-  if (status == SS_OK) status = ssCheckSoftnessForOde("contact", softness.erp, softness.cfm);
-  if (status != SS_OK) return status;
+/* The softness of a law for one contact: implicit Euler's for this step under every mapping, computed and checked
+ * against what ODE takes; *handed_on says whether an accurate mapping was asked for and handed the contact on. */
+static ssStatus contactSoftness(const ssRowLaw* law, ssMapping mapping, double step_s, ssSoftness* softness,
+                                ssRowFallback* handed_on) {
+  ssStatus status = ssRowSoftness(law, SS_MAPPING_IMPLICIT_EULER, NAN, step_s, 0, 0, NULL, softness);
+  if (status == SS_OK) status = ssCheckSoftnessForOde("contact", softness->erp, softness->cfm);
+  *handed_on = (ssRowFallback){0, 0};
+  handed_on->to_implicit_euler = !law->hard && (mapping == SS_MAPPING_MATCHED || mapping == SS_MAPPING_EXACT);
+  return status;
+}
+
+static void writeSoftness(dContact* contact, ssSoftness softness) {
   contact->surface.mode |= dContactSoftERP | dContactSoftCFM;
   contact->surface.soft_erp = softness.erp;
   contact->surface.soft_cfm = softness.cfm;
-  if (handed_on != NULL) *handed_on = fallback;
+}
+
+/* ssContactSoften for a law, its arguments checked. */
+static ssStatus softenByLaw(dContact* contact, const ssRowLaw* law, ssMapping mapping, double step_s) {
+  ssSoftness softness;
+  ssRowFallback fallback;
+  ssStatus status = contactSoftness(law, mapping, step_s, &softness, &fallback);
+  if (status != SS_OK) return status;
+  writeSoftness(contact, softness);
+  return SS_OK;
+}
+
+ssContactCache ssContactCacheEmpty(void) {
+  ssContactCache cache;
+  memset(&cache, 0, sizeof cache);
+  cache.tuned_erp = cache.tuned_cfm = cache.tuned_step_s = NAN;
+  return cache;
+}
+
+ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID body1, dBodyID body2,
+                               double tuned_erp, double tuned_cfm, double tuned_step_s, ssMapping mapping,
+                               double step_s, double previous_step_s, ssRowFallback* handed_on) {
+  if (tuned_erp != cache->tuned_erp || tuned_cfm != cache->tuned_cfm || tuned_step_s != cache->tuned_step_s) {
+    ssRowLaw law;
+    ssStatus status = ssRowLawFromTuned("contact", tuned_erp, tuned_cfm, tuned_step_s, &law);
+    if (status != SS_OK) return status;
+    *cache = ssContactCacheEmpty();
+    cache->tuned_erp = tuned_erp;
+    cache->tuned_cfm = tuned_cfm;
+    cache->tuned_step_s = tuned_step_s;
+    cache->law = law;
+  }
+  (void)body1, (void)body2, (void)previous_step_s; /* no contact's softness reads them (above) */
+  int same = cache->has_softness && mapping == cache->mapping && step_s == cache->step_s;
+  if (!same) {
+    ssSoftness softness;
+    ssRowFallback fallback;
+    ssStatus status = contactSoftness(&cache->law, mapping, step_s, &softness, &fallback);
+    if (status != SS_OK) return status;
+    cache->has_softness = 1;
+    cache->mapping = mapping;
+    cache->step_s = step_s;
+    cache->previous_step_s = 0;
+    cache->mass = NAN;
+    cache->softness = softness;
+    cache->handed_on = fallback;
+  }
+  writeSoftness(contact, cache->softness);
+  if (handed_on != NULL) *handed_on = cache->handed_on;
   return SS_OK;
 }
 
@@ -53,5 +106,6 @@ ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpri
   if (status == SS_OK && previous_step_s != 0) status = ssCheckStepLength("previous_step_s", previous_step_s);
   if (status != SS_OK) return status;
   ssRowLaw law = ssRowLawOfSpring(spring);
-  return ssContactSoftenLaw(contact, body1, body2, &law, mapping, step_s, previous_step_s, NULL);
+  (void)body1, (void)body2;
+  return softenByLaw(contact, &law, mapping, step_s);
 }
