@@ -357,9 +357,11 @@ static void clearCarried(ssStepper* stepper) {
 /* Checks one body after a step; returns SS_OK or records the failure. A runaway is stopped while its numbers are
  * still finite: ODE 0.16 aborts inside the next step when a rotation becomes non-finite (dxNormalize4). */
 static ssStatus checkBody(const ssStepper* stepper, dBodyID body) {
-  const dReal* position = dBodyGetPosition(body);
-  const dReal* velocity = dBodyGetLinearVel(body);
-  const dReal* spin = dBodyGetAngularVel(body);
+  /* in double whatever dReal is: a float speed's square overflows from 2e19 m/s, which is still a finite runaway */
+  const dReal* p = dBodyGetPosition(body);
+  const dReal* v = dBodyGetLinearVel(body);
+  const dReal* w = dBodyGetAngularVel(body);
+  const double position[3] = {p[0], p[1], p[2]}, velocity[3] = {v[0], v[1], v[2]}, spin[3] = {w[0], w[1], w[2]};
   /* a NaN or an infinity anywhere makes the sum non-finite: one test for nine numbers */
   double sum = position[0] + position[1] + position[2] + velocity[0] + velocity[1] + velocity[2] + spin[0] + spin[1] +
                spin[2];

@@ -55,6 +55,7 @@
 #ifndef STEADYSTEP_LIMITS_H
 #define STEADYSTEP_LIMITS_H
 
+#include <float.h>
 #include <ode/precision.h> /* dSINGLE or dDOUBLE: the precision of the ODE the library is built with */
 
 /** The shortest step (s) the library hands to dWorldStep or dWorldQuickStep: a nanosecond, in both precisions.
@@ -74,6 +75,18 @@
  *  1e299 in double, 1e29 in single, at SS_MIN_STEP_S). The smallest cfm is 0: a hard row, as programs tune it;
  *  every conversion returns cfm > 0. */
 #define SS_MAX_CFM 1e20
+
+/** The smallest positive cfm handed to ODE: the smallest normal dReal (FLT_MIN, 1.2e-38, in single precision;
+ *  DBL_MIN, 2.2e-308, in double). A spring's cfm computed below it would reach ODE as 0 or a denormal: a hard row,
+ *  or a softness that has lost its digits. A mapping that computes one has no softness in this precision and falls
+ *  back as for any result ODE cannot take (exact to matched to implicit Euler, counted); a spring whose
+ *  implicit-Euler cfm at SS_MAX_STEP_S would be below it (h·k + c above 8.5e37 N·s/m in single) is refused when it
+ *  is bound. */
+#if defined(dSINGLE)
+#define SS_MIN_POSITIVE_CFM FLT_MIN
+#else
+#define SS_MIN_POSITIVE_CFM DBL_MIN
+#endif
 
 /** The largest |erp| (non-dimensional) handed to ODE: 1e9 in both precisions. The matched and exact mappings may
  *  exceed 1 (ODE accepts that; their cfm keeps the row stable). This bound keeps erp·error/h² finite at

@@ -7,6 +7,7 @@
 
 #include "ode_fixture.h"
 #include "oscillator_rig.h"
+#include "precision.h"
 
 namespace {
 
@@ -40,8 +41,8 @@ TEST_F(StepperTest, NaiveTakesOneStepWithSoftnessFrozenAtTheReference) {
     ASSERT_EQ(ssStepper_Step(rig.stepper, frame_s, &report), SS_OK);
     EXPECT_EQ(report.steps, 1);
     EXPECT_DOUBLE_EQ(report.step_s, frame_s);
-    EXPECT_DOUBLE_EQ(dJointGetSliderParam(rig.slider, dParamStopERP), reference.erp);
-    EXPECT_DOUBLE_EQ(dJointGetSliderParam(rig.slider, dParamStopCFM), reference.cfm);
+    EXPECT_DOUBLE_EQ(dJointGetSliderParam(rig.slider, dParamStopERP), AsDReal(reference.erp));
+    EXPECT_DOUBLE_EQ(dJointGetSliderParam(rig.slider, dParamStopCFM), AsDReal(reference.cfm));
   }
 }
 
