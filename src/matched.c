@@ -64,7 +64,8 @@ static ssStatus finish(double a, double erp, double step_s, double mass, ssSoftn
   double cfm = a * step_s / mass;
   if (!(isfinite(erp) && isfinite(cfm) && cfm >= SS_MIN_POSITIVE_CFM && cfm <= SS_MAX_CFM && fabs(erp) <= SS_MAX_ERP))
     return ssFail(SS_ERROR_NO_FINITE_MAPPING,
-                  "step_s = %g s gives erp = %g, cfm = %g: not a usable softness (finite, |erp| <= %g, %g <= cfm <= %g)",
+                  "step_s = %g s gives erp = %g, cfm = %g: not a usable softness "
+                  "(finite, |erp| <= %g, %g <= cfm <= %g)",
                   step_s, erp, cfm, SS_MAX_ERP, SS_MIN_POSITIVE_CFM, SS_MAX_CFM);
   *out = (ssSoftness){.erp = erp, .cfm = cfm};
   return SS_OK;

@@ -92,8 +92,8 @@
  *  exceed 1 (ODE accepts that; their cfm keeps the row stable). This bound keeps erp·error/h² finite at
  *  SS_MIN_STEP_S for any error below 1e270 m (double; 3e11 m in single). A row with erp far above 2 and a small
  *  cfm is unstable and grows by about |erp| a step: at erp = 1e9, cfm = 0 the probe aborts within 30 steps in
- *  double and goes non-finite within 5 in single, so a stepper must stop such a runaway while it is still finite (SS_MAX_SAFE_SPEED). ODE
- *  aborts from about erp = 1e50 within 10 steps in double. */
+ *  double and goes non-finite within 5 in single, so a stepper must stop such a runaway while it is still finite
+ *  (SS_MAX_SAFE_SPEED). ODE aborts from about erp = 1e50 within 10 steps in double. */
 #define SS_MAX_ERP 1e9
 
 #if defined(dSINGLE)

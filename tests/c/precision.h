@@ -23,8 +23,9 @@ inline double ReadBackTolerance(double tolerance, double value) {
   return std::max(tolerance, std::fabs(value) * kDRealEpsilon);
 }
 
-// A tolerance stated for a quantity ODE integrated in double, for dReal: scaled by ε(dReal)/ε(double) (2^29 in
-// float, 1 in double) and at most `floor` (which a float build still meets; a double build keeps its own).
+// A tolerance for a quantity ODE integrated over many steps (positions, velocities): `tolerance` as stated for a
+// double build; in a float build at least `single_precision_tolerance`, since every step rounds the state to float
+// (ε = 1.2e-7 relative) and the roundings add up. Each test states its float tolerance beside what it measured.
 inline double IntegratedTolerance(double tolerance, double single_precision_tolerance) {
   return kSinglePrecision ? std::max(tolerance, single_precision_tolerance) : tolerance;
 }

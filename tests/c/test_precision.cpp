@@ -54,7 +54,8 @@ TEST(Precision, AnAccurateMappingWhoseCfmUnderflowsTheDRealFallsBackToImplicitEu
   }
   // The pure function says why, by name.
   ssSoftness untouched = {0.25, 0.5};
-  EXPECT_EQ(ssMatchedSoftness(kOverDamped, kMass, kStep, &untouched), representable ? SS_OK : SS_ERROR_NO_FINITE_MAPPING);
+  EXPECT_EQ(ssMatchedSoftness(kOverDamped, kMass, kStep, &untouched),
+            representable ? SS_OK : SS_ERROR_NO_FINITE_MAPPING);
   if (!representable) {
     EXPECT_NE(std::string(ssLastError()).find("not a usable softness"), std::string::npos) << ssLastError();
     EXPECT_EQ(untouched.erp, 0.25);
@@ -88,7 +89,8 @@ TEST_F(PrecisionOde, ASpringWhoseCfmWouldUnderflowAtTheLongestStepIsRefusedByNam
   dJointAttach(slider, body, 0);
   ssRegistry* registry = ssRegistry_Create(world);
   // cfm = 1/(h·k + c) is smallest at SS_MAX_STEP_S: k puts it at half and at twice SS_MIN_POSITIVE_CFM there.
-  const double too_stiff = 2 / (SS_MAX_STEP_S * SS_MIN_POSITIVE_CFM), stiff = 0.5 / (SS_MAX_STEP_S * SS_MIN_POSITIVE_CFM);
+  const double too_stiff = 2 / (SS_MAX_STEP_S * SS_MIN_POSITIVE_CFM);
+  const double stiff = 0.5 / (SS_MAX_STEP_S * SS_MIN_POSITIVE_CFM);
   EXPECT_EQ(ssRegistry_BindJoint(registry, slider, SS_PARAM_STOP, 1, ssSpring{too_stiff, 1}, kMass),
             SS_ERROR_NO_FINITE_MAPPING);
   EXPECT_NE(std::string(ssLastError()).find("k = "), std::string::npos) << ssLastError();
