@@ -51,10 +51,12 @@ static int any_faster(const dBodyID* bodies, double limit) {
 int main(int argc, char** argv) {
   double step_s, erp, cfm, mass, inertia, steps, speed = 1, force = 0, runaway_speed = 0;
   if (argc < 8 || argc > 11 || (argc >= 9 && !parse(argv[8], &speed)) || (argc >= 10 && !parse(argv[9], &force)) ||
-      (argc == 11 && !parse(argv[10], &runaway_speed)) || (strcmp(argv[1], "quick") != 0 && strcmp(argv[1], "step") != 0) || !parse(argv[2], &step_s) ||
+      (argc == 11 && !parse(argv[10], &runaway_speed)) ||
+      (strcmp(argv[1], "quick") != 0 && strcmp(argv[1], "step") != 0) || !parse(argv[2], &step_s) ||
       !parse(argv[3], &erp) || !parse(argv[4], &cfm) || !parse(argv[5], &mass) || !parse(argv[6], &inertia) ||
       !parse(argv[7], &steps)) {
-    fprintf(stderr, "usage: ode_probe quick|step STEP_S ERP CFM MASS_KG INERTIA STEPS [SPEED [FORCE [RUNAWAY_SPEED]]]\n");
+    fprintf(stderr,
+            "usage: ode_probe quick|step STEP_S ERP CFM MASS_KG INERTIA STEPS [SPEED [FORCE [RUNAWAY_SPEED]]]\n");
     return 2;
   }
   dInitODE2(0);
