@@ -30,6 +30,7 @@
  * EXACT every contact is served by implicit Euler and counted as handed to it (no effective mass is measured,
  * and the softness depends on the step alone, which the cache below reuses); the accurate mappings keep the
  * rows where one spring dominates one body (row_law.c's rule). */
+
 /* The softness of a law for one contact: implicit Euler's for this step under every mapping, computed and checked
  * against what ODE takes; *handed_on says whether an accurate mapping was asked for and handed the contact on. */
 static ssStatus contactSoftness(const ssRowLaw* law, ssMapping mapping, double step_s, ssSoftness* softness,
