@@ -156,8 +156,9 @@ def build_parser() -> argparse.ArgumentParser:
     compare.add_argument("--scenes", nargs="+", metavar="SCENE", help="default: every scene")
     compare.add_argument("--profiles", nargs="+", metavar="SPEC", default=list(DEFAULT_PROFILES),
                          help=f"frame-time profiles (default: {' '.join(DEFAULT_PROFILES)})")
+    from steadystep.runs import policy_names  # the library's names: no second list here
     compare.add_argument("--policies", nargs="+", metavar="POLICY",
-                         help="default: naive spring fixed, and also matched exact for the oscillator")
+                         help=f"default: every policy ({' '.join(policy_names())})")
     compare.add_argument("--duration", type=_measured_duration, default=5.0, metavar="S",
                          help=f"simulated seconds per run, at least {MIN_MEASURED_DURATION_S:g} (default 5); the "
                          f"reference's 1 ms steps bound it to {MAX_RUN_STEPS / 1000:.0f} s")
@@ -182,7 +183,6 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("scene", metavar="SCENE", help="oscillator, buggy, drop, chain or pile")
     run.add_argument("--profile", required=True, metavar="SPEC",
                      help="fixed:FPS, uniform:MIN:MAX, jitter:FPS:MS, hitch:FPS:EVERY:S, vsync:A:B or trace:FILE")
-    from steadystep.runs import policy_names  # the library's names: no second list here
     run.add_argument("--policy", required=True, metavar="P", help=", ".join(policy_names()))
     run.add_argument("--duration", type=_positive_float, default=5.0, metavar="S",
                      help=f"seconds (default 5), at most {MAX_RUN_STEPS:.0e} steps of --max-step")
@@ -198,8 +198,9 @@ def build_parser() -> argparse.ArgumentParser:
                                 "range widened by that range on both sides. A trial at --low may take at most "
                                 f"{MAX_RUN_STEPS:.0e} steps.")
     probe.add_argument("scene", metavar="SCENE", help="oscillator, buggy, drop, chain or pile")
-    probe.add_argument("--policies", nargs="+", metavar="POLICY", default=["naive", "implicit-euler", "matched", "exact"],
-                       help="default: naive spring matched exact")
+    probe_policies = ["naive", "implicit-euler", "matched", "exact"]
+    probe.add_argument("--policies", nargs="+", metavar="POLICY", default=probe_policies,
+                       help=f"default: {' '.join(probe_policies)}")
     probe.add_argument("--duration", type=_measured_duration, default=3.0, metavar="S",
                        help=f"seconds per trial, at least {MIN_MEASURED_DURATION_S:g} (default 3)")
     probe.add_argument("--low", type=_positive_float, default=0.001, metavar="S",

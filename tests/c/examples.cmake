@@ -55,3 +55,16 @@ set_tests_properties(example_stack_csv_header PROPERTIES PASS_REGULAR_EXPRESSION
 add_test(NAME example_stack_bad_boxes
          COMMAND sh -c "\"$1\" --boxes 0 2>&1; echo exit $?" sh $<TARGET_FILE:steadystep_example_stack_steadystep>)
 set_tests_properties(example_stack_bad_boxes PROPERTIES PASS_REGULAR_EXPRESSION "--boxes 0: [^\n]*\nexit 2\n")
+
+# The README's code: its C block compiled as C and as C++ against the library (stubs for the program around it in
+# tests/c/readme_snippet.sh, not in the README), and its diff the output of the command it names (scripts/readme-diff
+# rewrites it).
+if(NOT STEADYSTEP_SANITIZE)  # a sanitized library needs its runtime linked first, as for the install test
+  add_test(NAME readme_c_block_compiles_as_c_and_cpp
+           COMMAND sh ${PROJECT_SOURCE_DIR}/tests/c/readme_snippet.sh ${PROJECT_SOURCE_DIR}/README.md
+                   ${CMAKE_C_COMPILER} ${CMAKE_CXX_COMPILER} ${CMAKE_CURRENT_BINARY_DIR}/readme_snippet
+                   $<TARGET_FILE:steadystep> ${PROJECT_SOURCE_DIR}/include ${ODE_CFLAGS} ${ODE_LDFLAGS})
+endif()
+find_package(Python3 COMPONENTS Interpreter REQUIRED)
+add_test(NAME readme_diff_is_current
+         COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/scripts/readme-diff --check)

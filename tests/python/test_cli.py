@@ -33,6 +33,18 @@ def test_every_command_has_help():
         assert result.returncode == 0 and "usage: steadystep" in result.stdout
 
 
+def test_help_names_policies_the_library_knows():
+    # "spring" was the implicit-Euler policy's name in 0.1.0: help texts must name the policies that exist
+    from steadystep.runs import policy_names
+    known = set(policy_names())
+    for command in ("compare", "probe"):
+        text = " ".join(steadystep(command, "--help").stdout.split())
+        default = text.rsplit("--policies POLICY [POLICY ...]", 1)[1].split("default:", 1)[1].split("--", 1)[0]
+        listed = default.split("(", 1)[1].split(")", 1)[0] if "(" in default else default  # "every policy (...)"
+        named = listed.split()
+        assert named and set(named) <= known, (command, named)
+
+
 def test_figure_writes_png_and_svg(tmp_path):
     result = steadystep("figure", "--out", tmp_path / "figs", "--duration", "2")
     assert result.returncode == 0, result.stderr
