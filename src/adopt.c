@@ -163,11 +163,13 @@ static int worldLaw(const Plan* plan, ssRowLaw* law) {
 }
 
 /* Refuses a body of another world than the registry's: ODE would step it with another world, and the registry would
- * rewrite numbers the registry's world never reads. */
-static ssStatus requireSameWorld(const Plan* plan, const char* what, dBodyID body) {
+ * rewrite numbers the registry's world never reads. joint: the joint it was reached through, or 0. */
+static ssStatus requireSameWorld(const Plan* plan, dJointID joint, dBodyID body) {
   dWorldID world = dBodyGetWorld(body);
   if (world == plan->world) return SS_OK;
-  return ssFail(SS_ERROR_OUT_OF_RANGE, "%s: body %p is of world %p, not of the registry's world %p", what,
+  char through[64] = "";
+  if (joint != 0) snprintf(through, sizeof through, "%s joint %p: ", ssJointTypeName(joint), (void*)joint);
+  return ssFail(SS_ERROR_OUT_OF_RANGE, "%sbody %p is of world %p, not of the registry's world %p", through,
                 (void*)body, (void*)world, (void*)plan->world);
 }
 
@@ -178,15 +180,15 @@ static int pushPending(Plan* plan, dBodyID body) {
 }
 
 static ssStatus planBody(Plan* plan, dBodyID body) {
-  char what[64];
-  snprintf(what, sizeof what, "body %p", (void*)body);
-  ssStatus status = requireSameWorld(plan, what, body);
-  if (status != SS_OK) return status;
   int added = addSeen(&plan->seen, body);
   if (added < 0) return outOfMemory();
   if (added == 0) return SS_OK;
+  ssStatus status = requireSameWorld(plan, 0, body);
+  if (status != SS_OK) return status;
   if (!pushPending(plan, body)) return outOfMemory();
   if (ssRegistryHasBody(plan->registry, body)) return SS_OK;
+  char what[64];
+  snprintf(what, sizeof what, "body %p", (void*)body);
   PlannedBody planned;
   memset(&planned, 0, sizeof planned);
   planned.binding.body = body;
@@ -270,11 +272,9 @@ static ssStatus planJoint(Plan* plan, dJointID joint) {
   if (type <= dJointTypeNone || type > dJointTypeTransmission)
     return ssFail(SS_ERROR_UNSUPPORTED, "joint %p: type %d is not one ODE 0.16 knows", (void*)joint, type);
   /* ODE 0.16 has no getter for a joint's world: its bodies tell (a joint attached to none acts on nothing) */
-  char what[64];
-  snprintf(what, sizeof what, "%s joint %p", ssJointTypeName(joint), (void*)joint);
   for (int side = 0; side < 2; ++side) {
     dBodyID body = dJointGetBody(joint, side);
-    ssStatus status = body != 0 ? requireSameWorld(plan, what, body) : SS_OK;
+    ssStatus status = body != 0 ? requireSameWorld(plan, joint, body) : SS_OK;
     if (status != SS_OK) return status;
   }
   if (type == dJointTypeContact || type == dJointTypeNull || type == dJointTypePlane2D) {
