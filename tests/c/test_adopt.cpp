@@ -391,6 +391,7 @@ TEST_F(AdoptTest, ContactsSoftenedAtTheFrozenTunedStepGetTheProgramsOwnNumbers) 
   def.collide = ProbeCollide;
   def.collide_context = &probe;
   def.contact_group = probe.group;
+  def.stepping.solver = SS_SOLVER_QUICK;
   ASSERT_EQ(ssSteppingForPolicy("naive", tuned_step, &def.stepping), SS_OK);
   ssStepper* stepper = nullptr;
   ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK) << ssLastError();
@@ -554,6 +555,16 @@ TEST_F(AdoptTest, ObjectsOfAnotherWorldAreRefusedByName) {
   expect_named(ssRegistry_AdoptBody(registry, foreign, nullptr), "AdoptBody");
   expect_named(ssRegistry_AdoptJoint(registry, foreign_ball, nullptr), "AdoptJoint");
   EXPECT_EQ(ssRegistry_JointBindingCount(registry), 0);
+
+  // a registry of this world given to a stepper of the other
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = other;
+  def.registry = registry;
+  def.stepping.solver = SS_SOLVER_QUICK;
+  ssStepper* stepper = nullptr;
+  EXPECT_EQ(ssStepper_Create(&def, &stepper), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(stepper, nullptr);
+  EXPECT_NE(std::string(ssLastError()).find("registry of world"), std::string::npos) << ssLastError();
   dWorldDestroy(other);
 }
 
