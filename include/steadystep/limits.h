@@ -71,8 +71,8 @@
 
 /** The most auto-disable samples the registry writes into a body or the world's defaults: 1000. A window of S
  *  samples tuned at h0 lasts S·h0 seconds, which takes ceil(S·h0/h) samples at a step h, and ODE allocates two
- *  vectors (64 bytes) a sample for every body: 5 samples tuned at 1/60 s stepped at SS_MIN_STEP_S would be 10^8
- *  samples, 6 GB a body. 1000 samples are 64 kB a body. Beyond the bound (steps shorter than the window / 1000, e.g.
+ *  vectors (64 bytes) a sample for every body: 5 samples tuned at 1/60 s stepped at SS_MIN_STEP_S would be 8·10^7
+ *  samples, 5 GB a body. 1000 samples are 64 kB a body. Beyond the bound (steps shorter than the window / 1000, e.g.
  *  under 83 µs for 5 samples at 1/60 s), the velocities are averaged over the last 1000 steps, a window shorter than
  *  the tuned one; the idle time still holds. A program's own count is written back as it was at the step it was
  *  tuned for (adopt.h), whatever its size. */
