@@ -300,13 +300,11 @@ TEST_F(AdoptTest, AtTheTunedStepEveryNumberIsTheProgramsOwnAtOthersItsRateInSeco
     EXPECT_EQ(dJointGetHingeParam(hinge, dParamCFM), 7.7e-3);
     EXPECT_EQ(dWorldGetLinearDamping(world), 0.0013);
     EXPECT_EQ(dWorldGetAngularDamping(world), 0.0071);
-    for (dBodyID b : {body}) {
-      EXPECT_EQ(dBodyGetLinearDamping(b), 0.0013);
-      EXPECT_EQ(dBodyGetAngularDamping(b), 0.0071);
-      EXPECT_EQ(dBodyGetAutoDisableSteps(b), 10);
-      EXPECT_EQ(dBodyGetAutoDisableTime(b), 0.0);
-      EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(b), 7u);
-    }
+    EXPECT_EQ(dBodyGetLinearDamping(body), 0.0013);
+    EXPECT_EQ(dBodyGetAngularDamping(body), 0.0071);
+    EXPECT_EQ(dBodyGetAutoDisableSteps(body), 10);
+    EXPECT_EQ(dBodyGetAutoDisableTime(body), 0.0);
+    EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(body), 7u);
     EXPECT_EQ(dWorldGetAutoDisableSteps(world), 10);
     EXPECT_EQ(dWorldGetAutoDisableTime(world), 0.0);
     EXPECT_EQ(dWorldGetAutoDisableAverageSamplesCount(world), 7u);
