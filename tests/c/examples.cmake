@@ -76,10 +76,15 @@ set_tests_properties(example_stack_bad_boxes PROPERTIES PASS_REGULAR_EXPRESSION 
 # tests/c/readme_snippet.sh, not in the README), and its diff the output of the command it names (scripts/readme-diff
 # rewrites it).
 if(NOT STEADYSTEP_SANITIZE)  # a sanitized library needs its runtime linked first, as for the install test
+  set(readme_ode_runpath "")  # an ODE outside the system's directories (STEADYSTEP_ODE_PREFIX) is found at run time
+  foreach(dir ${ODE_LIBRARY_DIRS})
+    list(APPEND readme_ode_runpath "-Wl,-rpath,${dir}")
+  endforeach()
   add_test(NAME readme_c_block_compiles_as_c_and_cpp
            COMMAND sh ${PROJECT_SOURCE_DIR}/tests/c/readme_snippet.sh ${PROJECT_SOURCE_DIR}/README.md
                    ${CMAKE_C_COMPILER} ${CMAKE_CXX_COMPILER} ${CMAKE_CURRENT_BINARY_DIR}/readme_snippet
-                   $<TARGET_FILE:steadystep> ${PROJECT_SOURCE_DIR}/include ${ODE_CFLAGS} ${ODE_LDFLAGS})
+                   $<TARGET_FILE:steadystep> ${PROJECT_SOURCE_DIR}/include ${ODE_CFLAGS} ${ODE_LDFLAGS}
+                   ${readme_ode_runpath})
 endif()
 find_package(Python3 COMPONENTS Interpreter REQUIRED)
 add_test(NAME readme_diff_is_current

@@ -318,7 +318,7 @@ TEST_F(AdoptTest, AtTheTunedStepEveryNumberIsTheProgramsOwnAtOthersItsRateInSeco
     ASSERT_EQ(ssRegistry_Apply(registry, mapping, tuned_step, 0, nullptr), SS_OK) << ssLastError();
     // the accurate mappings have their own softness for soft rows; hard rows and bodies are theirs alike
     if (mapping == SS_MAPPING_IMPLICIT_EULER) expect_as_tuned("implicit Euler at the tuned step, first");
-    EXPECT_EQ(dJointGetHingeParam(hinge, dParamStopERP), 0.47) << ssMappingName(mapping);
+    EXPECT_EQ(dJointGetHingeParam(hinge, dParamStopERP), AsDReal(0.47)) << ssMappingName(mapping);
     EXPECT_EQ(dBodyGetAutoDisableTime(body), 0.0) << ssMappingName(mapping);
   }
 
@@ -414,8 +414,8 @@ TEST_F(AdoptTest, ContactsSoftenedAtTheFrozenTunedStepGetTheProgramsOwnNumbers) 
       ASSERT_EQ(ssStepper_Step(stepper, frame_s, nullptr), SS_OK) << ssLastError();
       ASSERT_FALSE(probe.softened.empty());
       for (const dSurfaceParameters& surface : probe.softened) {
-        EXPECT_EQ(surface.soft_erp, (c.mode & dContactSoftERP) ? c.erp : 0.27) << frame_s;
-        EXPECT_EQ(surface.soft_cfm, c.cfm) << frame_s;
+        EXPECT_EQ(surface.soft_erp, AsDReal((c.mode & dContactSoftERP) ? c.erp : 0.27)) << frame_s;
+        EXPECT_EQ(surface.soft_cfm, AsDReal(c.cfm)) << frame_s;
       }
     }
   }
