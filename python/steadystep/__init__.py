@@ -28,9 +28,15 @@ __all__ = [
     "make_executor", "matched_softness", "policy_names", "softness_for", "softness_from_spring",
     "spring_from_frequency", "spring_from_softness", "sweep",
 ]
-try:  # the installed package's version, which the build read from CMakeLists.txt's project()
-    from importlib.metadata import version as _version
 
-    __version__ = _version("steadystep")
-except Exception:  # a source tree without installed metadata
-    __version__ = "unknown"
+
+def __getattr__(name: str):
+    # __version__ on demand: importlib.metadata costs about as much as the rest of the binding's import.
+    if name == "__version__":
+        try:  # the installed package's version, which the build read from CMakeLists.txt's project()
+            from importlib.metadata import version
+
+            return version("steadystep")
+        except Exception:  # a source tree without installed metadata
+            return "unknown"
+    raise AttributeError(f"module 'steadystep' has no attribute {name!r}")

@@ -20,6 +20,7 @@ from matplotlib.lines import Line2D
 
 from steadystep import article, runs
 from steadystep._native import SteadystepError, number, printable
+from steadystep.enums import Status
 from steadystep.limits import MIN_MEASURED_DURATION_S
 from steadystep.profiles import seed_value
 from steadystep.files import save_figure
@@ -83,7 +84,7 @@ def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> lis
     """
     duration_s, seed = number("duration_s", duration_s, "s"), seed_value(seed)
     if not duration_s >= MIN_MEASURED_DURATION_S:
-        raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: the figure needs at least "
+        raise SteadystepError(Status.OUT_OF_RANGE, f"duration_s = {duration_s:g} s: the figure needs at least "
                               f"{MIN_MEASURED_DURATION_S:g} s")
     one_step_per_frame = {"max_step_s": 1.0 / 15.0}
     for profile in ("fixed:30", "uniform:15:45"):

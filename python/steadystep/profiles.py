@@ -12,6 +12,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from steadystep._native import SteadystepError, c_string, check, ffi, integer, lib, number, shown
+from steadystep.enums import Status
 from steadystep.limits import MAX_RUN_FRAMES
 
 DEFAULT_PROFILES = ("fixed:30", "uniform:15:45", "jitter:30:3", "hitch:60:30:0.1", "vsync:60:30")
@@ -68,7 +69,7 @@ def frames_within(spec: str, duration_s: float, seed: int = 1) -> Iterator[float
     while duration_s - elapsed_s > end_tolerance_s:
         frame_s = next_frame(handle)
         if not (math.isfinite(frame_s) and frame_s > 0):
-            raise SteadystepError("out of range", f"profile = {shown(spec)}: frame {count + 1} lasts {frame_s!r} s, "
+            raise SteadystepError(Status.OUT_OF_RANGE, f"profile = {shown(spec)}: frame {count + 1} lasts {frame_s!r} s, "
                                   "not a finite positive duration")
         frame_s = min(frame_s, duration_s - elapsed_s)
         elapsed_s += frame_s

@@ -17,9 +17,9 @@ import dataclasses
 from dataclasses import dataclass
 
 from steadystep import _handles
-from steadystep._native import SteadystepError, check, ffi, integer, last_error, lib, number, shown, status_name
+from steadystep._native import SteadystepError, check, ffi, integer, last_error, lib, number, shown
 from steadystep.convert import Spring
-from steadystep.enums import JointParam, Mapping
+from steadystep.enums import JointParam, Mapping, Status
 
 
 def from_struct(cls, cdata):
@@ -61,7 +61,7 @@ def _spring(spring) -> dict:
     try:
         k, c = spring
     except (TypeError, ValueError):
-        raise SteadystepError("out of range", f"spring = {shown(spring)}: must be a Spring(k N/m, c N·s/m)") from None
+        raise SteadystepError(Status.OUT_OF_RANGE, f"spring = {shown(spring)}: must be a Spring(k N/m, c N·s/m)") from None
     return {"stiffness": number("k", k, "N/m"), "damping": number("c", c, "N·s/m")}
 
 
@@ -88,8 +88,8 @@ class Registry:
         self._world = _handles.handle("world", "world", world)
         created = lib.ssRegistry_Create(self._world)
         if created == ffi.NULL:
-            raise SteadystepError(status_name(lib.SS_ERROR_OUT_OF_RANGE if self._world == ffi.NULL
-                                              else lib.SS_ERROR_OUT_OF_MEMORY), last_error())
+            raise SteadystepError(Status.OUT_OF_RANGE if self._world == ffi.NULL else Status.OUT_OF_MEMORY,
+                                  last_error())
         self._registry = ffi.gc(created, lib.ssRegistry_Destroy)
 
     @property
@@ -99,7 +99,7 @@ class Registry:
 
     def _handle(self):
         if self._registry is None:
-            raise SteadystepError("out of range", "registry: used after close()")
+            raise SteadystepError(Status.OUT_OF_RANGE, "registry: used after close()")
         return self._registry
 
     def close(self) -> None:

@@ -60,7 +60,7 @@ class FrameReport:
 
 def _checked_callable(name: str, value):
     if value is not None and not callable(value):
-        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be callable or None")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{name} = {shown(value)}: must be callable or None")
     return value
 
 
@@ -80,7 +80,7 @@ class Stepper:
                  collide: Callable[["Stepper"], object] | None = None,
                  step_done: Callable[[float], object] | None = None, contact_group=None):
         if registry is not None and not isinstance(registry, Registry):
-            raise SteadystepError("out of range", f"registry = {shown(registry)}: must be a steadystep.Registry or "
+            raise SteadystepError(Status.OUT_OF_RANGE, f"registry = {shown(registry)}: must be a steadystep.Registry or "
                                   "None")
         if reference_step_s is None:
             tuned = registry.tuned_step_s if registry is not None else 0.0
@@ -121,12 +121,12 @@ class Stepper:
 
     def _handle(self):
         if self._stepper is None:
-            raise SteadystepError("out of range", "stepper: used after close()")
+            raise SteadystepError(Status.OUT_OF_RANGE, "stepper: used after close()")
         return self._stepper
 
     def _between_frames(self, what: str):
         if self._in_frame:
-            raise SteadystepError("out of range", f"stepper.{what}: called from a callback of the same stepper, "
+            raise SteadystepError(Status.OUT_OF_RANGE, f"stepper.{what}: called from a callback of the same stepper, "
                                   "inside its frame")
         return self._handle()
 
