@@ -20,42 +20,39 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 from steadystep import _handles
-from steadystep._native import SteadystepError, check, ffi, lib, number, shown
+from steadystep._native import SimulationFailure, SteadystepError, check, ffi, last_error, lib, number, shown
 from steadystep.enums import Mapping, Status
-from steadystep.registry import ApplyReport, Registry, from_struct
+from steadystep._structs import StructView, address_of
+from steadystep.registry import Registry
 from steadystep.stepping import Stepping, stepping_from
 
 
-@dataclass(frozen=True)
-class StepInfo:
-    """The physics step about to be taken (ssStepInfo), as current_step() gives it inside the callbacks."""
+class StepInfo(StructView, c_type="ssStepInfo", convert={"mapping": Mapping}):
+    """The physics step about to be taken (ssStepInfo), as current_step() gives it inside the callbacks: mapping
+    (the Mapping this step's softness is written with), step_s (the length of the step about to be taken, s),
+    softness_step_s (the step length the softness is for, s: step_s, or stepping.frozen_step_s), previous_step_s
+    (the step before, for Mapping.EXACT, s; 0 when there is no usable history), index (0-based, within the frame),
+    count (steps this frame takes). Fields as stepper.h declares them, read-only."""
 
-    mapping: Mapping = field(metadata={"convert": Mapping})  # the mapping this step's softness is written with
-    step_s: float            # the length of the step about to be taken (s)
-    softness_step_s: float   # the step length the softness is for (s): step_s, or stepping.frozen_step_s
-    previous_step_s: float   # the step before, for Mapping.EXACT (s); 0 when there is no usable history
-    index: int               # 0-based index of this step within the frame
-    count: int               # steps this frame takes
+    __slots__ = ()
 
 
-@dataclass(frozen=True)
-class FrameReport:
-    """What one frame did (ssFrameReport)."""
+class FrameReport(StructView, c_type="ssFrameReport", convert={"failed_body": address_of}):
+    """What one frame did (ssFrameReport), with the fields and meanings stepper.h gives them, read-only and read
+    from the C report when asked for (FIELDS lists them; as_dict() copies them). failed_body is the address of
+    the body that failed, else 0 (compare with ctypes.cast(body, c_void_p).value)."""
 
-    steps: int                   # physics steps taken
-    step_s: float                # length of the last step taken (s); 0 when none
-    simulated_s: float           # time simulated this frame (s)
-    carried_s: float             # time carried to the next frame (s): FIXED's accumulator, or a too-short frame
-    dropped_s: float             # FIXED: time dropped by max_steps_per_frame (s)
-    interpolation: float         # FIXED: accumulator / fixed_step_s in [0, 1), to blend the last two states
-    apply: ApplyReport = field(metadata={"struct": ApplyReport})  # summed over the frame's steps
-    contacts_softened: int       # contacts softened with soften_contact
-    contacts_implicit_euler_fallback: int  # of those, served by the implicit-Euler mapping
-    failed_body: int = field(metadata={"convert": lambda body: int(ffi.cast("uintptr_t", body))})
-    # the address of the body that blew up or ran too fast, else 0 (compare with ctypes.cast(body, c_void_p).value)
+    __slots__ = ()
+
+
+# The per-frame path, looked up once.
+_FRAME_REPORT = ffi.typeof("ssFrameReport*")
+_new_frame_report = ffi.new
+_step_frame = lib.ssStepper_Step
+# A stepper call from its own callbacks (until status.h has SS_ERROR_REENTERED: out of range).
+REENTERED = getattr(lib, "SS_ERROR_REENTERED", lib.SS_ERROR_OUT_OF_RANGE)
 
 
 def _checked_callable(name: str, value):
@@ -92,7 +89,7 @@ class Stepper:
                       "step_done": _checked_callable("step_done", step_done)}
         self._pending: BaseException | None = None  # the first exception a callback raised in this frame
         self._in_frame = False
-        self._report = None
+        self._stepper = None
 
         definition = ffi.new("ssStepperDef*", lib.ssDefaultStepperDef())
         definition.world = _handles.handle("world", "world", world)
@@ -112,7 +109,11 @@ class Stepper:
                                                   lambda context, step_s: _call(me, "step_done", step_s))
         out = ffi.new("ssStepper**")
         check(lib.ssStepper_Create(definition, out))
-        self._stepper = ffi.gc(out[0], lib.ssStepper_Destroy)
+        # The destructor holds the C registry, so that however the two are collected, the stepper goes first.
+        kept = registry._registry if registry is not None else None
+        self._stepper = ffi.gc(out[0], lambda stepper, kept=kept: lib.ssStepper_Destroy(stepper))
+        if registry is not None:
+            registry._add_stepper(self)
 
     def _callback(self, ctype: str, function):
         made = ffi.callback(ctype, function)
@@ -121,14 +122,26 @@ class Stepper:
 
     def _handle(self):
         if self._stepper is None:
-            raise SteadystepError(Status.OUT_OF_RANGE, "stepper: used after close()")
+            raise self._refused(SteadystepError(Status.OUT_OF_RANGE, "stepper: used after close()"))
         return self._stepper
 
     def _between_frames(self, what: str):
         if self._in_frame:
-            raise SteadystepError(Status.OUT_OF_RANGE, f"stepper.{what}: called from a callback of the same stepper, "
-                                  "inside its frame")
+            raise self._refused(SteadystepError(REENTERED, f"stepper.{what}: called from a callback of the same "
+                                                "stepper, inside its frame"))
         return self._handle()
+
+    def _refused(self, error: BaseException) -> BaseException:
+        """error, also kept for step() to raise when it happens inside a frame: a call made from odepy's near
+        callback (soften_contact, ...) raises into ctypes, which prints the exception and goes on."""
+        if self._in_frame and self._pending is None:
+            self._pending = error
+        return error
+
+    @property
+    def closed(self) -> bool:
+        """Whether close() was called (or the stepper was never made)."""
+        return self._stepper is None
 
     @property
     def registry(self) -> Registry | None:
@@ -149,30 +162,34 @@ class Stepper:
 
     def step(self, frame_s: float) -> FrameReport:
         """Advances the world by one frame of frame_s seconds (0 <= frame_s <= 3600; 0 does nothing). Forces the
-        program added to known bodies before this call act for the whole frame. Raises SteadystepError with the
-        library's message (the world left as it was for a refused frame); for a blow-up or a runaway
-        (Status.BLOWUP, Status.SPEED_LIMIT) the error's `report` is the FrameReport, whose failed_body names the
-        body, and every later frame is refused (Status.FAILED) until reset(). An exception raised by a callback
-        is raised here, after the frame, with the frame's FrameReport (or its error) as its `steadystep_report`
-        (or `__context__`)."""
-        handle = self._between_frames("step")
-        frame_s = number("frame_s", frame_s, "s")
-        report = ffi.new("ssFrameReport*")
-        self._pending = None
+        program added to known bodies before this call act for the whole frame. Returns the frame's FrameReport.
+        Raises SteadystepError with the library's message (the world left as it was for a refused frame); for a
+        failed simulation (SimulationFailure: Status.BLOWUP, SPEED_LIMIT ...) the error's `report` is the
+        FrameReport, whose failed_body names the body, and every later frame is refused (Status.FAILED) until
+        reset(). An exception raised by a callback, or by a call the near callback made (soften_contact ...), is
+        raised here, after the frame, with the frame's FrameReport (or its error) as its `steadystep_report` (or
+        `__context__`)."""
+        if self._in_frame or self._stepper is None:
+            self._between_frames("step")
+        if type(frame_s) is not float:
+            frame_s = number("frame_s", frame_s, "s")
+        report = _new_frame_report(_FRAME_REPORT)
         self._in_frame = True
         try:
-            status = lib.ssStepper_Step(handle, frame_s, report)
+            status = _step_frame(self._stepper, frame_s, report)
         finally:
             self._in_frame = False
+        if status or self._pending is not None:
+            self._raise_for_frame(status, FrameReport(report))
+        return FrameReport(report)
+
+    def _raise_for_frame(self, status: int, made: FrameReport):
         pending, self._pending = self._pending, None
-        made = from_struct(FrameReport, report[0])
         error = None
-        try:
-            check(status)
-        except SteadystepError as failure:
-            if status in (Status.BLOWUP, Status.SPEED_LIMIT):
-                failure.report = made
-            error = failure
+        if status:
+            error = SteadystepError(status, last_error())
+            if isinstance(error, SimulationFailure) and status != Status.FAILED:
+                error.report = made
         if pending is not None:
             try:
                 pending.steadystep_report = made
@@ -181,23 +198,24 @@ class Stepper:
             if error is not None:
                 raise pending from error
             raise pending
-        if error is not None:
-            raise error
-        return made
+        raise error
 
     def current_step(self) -> StepInfo:
         """The step about to be taken: meaningful inside before_step and collide; between frames, the next step of
         the default length."""
-        return from_struct(StepInfo, lib.ssStepper_CurrentStep(self._handle()))
+        return StepInfo(lib.ssStepper_CurrentStep(self._handle()))
 
     def soften_contact(self, contact, body1, body2) -> None:
         """In the near callback, before dJointCreateContact: turns the contact's tuned softness (its soft_erp /
         soft_cfm where surface.mode has them, else the world's ERP/CFM, as tuned at the registry's tuned step) into
         the softness for the step about to be taken. contact: an odepy dContact (or its address); body1, body2 its
         bodies (None for the static world). Raises SteadystepError with the contact unchanged (adopt first)."""
-        check(lib.ssStepper_SoftenContact(self._handle(), _handles.contact("contact", contact),
-                                          _handles.handle("body1", "body", body1),
-                                          _handles.handle("body2", "body", body2)))
+        try:
+            check(lib.ssStepper_SoftenContact(self._handle(), _handles.contact("contact", contact),
+                                              _handles.handle("body1", "body", body1),
+                                              _handles.handle("body2", "body", body2)))
+        except SteadystepError as error:
+            raise self._refused(error)
 
     def reset(self) -> None:
         """After a failure, once the program repaired or restored its bodies: accepts frames again. Also forgets
@@ -211,11 +229,17 @@ class Stepper:
 
     def watch_body(self, body) -> None:
         """Makes a body known: its forces kept for the whole frame, its state checked after each step."""
-        check(lib.ssStepper_WatchBody(self._handle(), _handles.handle("body", "body", body)))
+        try:
+            check(lib.ssStepper_WatchBody(self._handle(), _handles.handle("body", "body", body)))
+        except SteadystepError as error:
+            raise self._refused(error)
 
     def unwatch_body(self, body) -> None:
         """Stops watching a body; SteadystepError ("not found") when it was not watched."""
-        check(lib.ssStepper_UnwatchBody(self._handle(), _handles.handle("body", "body", body)))
+        try:
+            check(lib.ssStepper_UnwatchBody(self._handle(), _handles.handle("body", "body", body)))
+        except SteadystepError as error:
+            raise self._refused(error)
 
     def destroy_body(self, body) -> None:
         """Destroys a body the stepper may know (unwatched, unbound, its joints unbound, then dBodyDestroy). Use it
