@@ -17,10 +17,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from steadystep._native import SteadystepError, check, ffi, lib, number, shown
-from steadystep.enums import Status
+from steadystep._native import SteadystepError, check, ffi, lib, number, shown, text
+from steadystep.enums import Mapping, Status
 
-MAPPINGS = {"implicit-euler": lib.SS_MAPPING_IMPLICIT_EULER, "matched": lib.SS_MAPPING_MATCHED, "exact": lib.SS_MAPPING_EXACT}
+# The mappings by the library's names for them (ssMappingName: "implicit-euler", "matched", "exact").
+MAPPINGS = {text(lib.ssMappingName(mapping)): int(mapping) for mapping in Mapping}
 
 
 class Spring(NamedTuple):

@@ -16,12 +16,20 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from steadystep import runs
-from steadystep._native import SteadystepError, number
+from steadystep._native import SteadystepError, lib, number
 from steadystep.enums import Status
 from steadystep.limits import MAX_RUN_STEPS, MIN_MEASURED_DURATION_S
 
 DEFAULT_LOW_S = 1.0 / 1000.0
 DEFAULT_HIGH_S = 0.25
+
+
+def default_policies() -> list[str]:
+    """The library's policies that do not cut frames at a fixed step of their own (naive, implicit-euler, matched,
+    exact): with every frame one step of h, a fixed policy steps as its mapping's substep policy does."""
+    return [policy for policy in runs.policy_names() if runs.make_stepping(policy)["cut"] != lib.SS_CUT_FIXED]
+
+
 # Below this the bisection's midpoint would no longer move between its ends in double precision.
 MIN_TOLERANCE = 1e-9
 

@@ -16,15 +16,15 @@ from steadystep._native import SteadystepError, c_string, check, ffi, lib, numbe
 from steadystep.enums import Status
 from steadystep.limits import MAX_RUN_FRAMES, MAX_RUN_STEPS
 from steadystep.profiles import frame_count, seed_value
+from steadystep.stepping import policy_names  # noqa: F401 - the lab's policies are the library's presets
 
 REFERENCE_STEP_S = 1.0 / 1000.0
 REFERENCE_PROFILE = "fixed:1000"
 
 
-def policy_names() -> list[str]:
-    """The lab's policies by name, as the library lists them (stepping.h): naive, implicit-euler, matched, exact,
-    fixed, fixed-matched, fixed-exact."""
-    return [text(lib.ssPolicyNameAt(i)) for i in range(lib.ssPolicyCount())]
+def scene_names() -> list[str]:
+    """The library's scenes by name (scene.h): oscillator, buggy, drop, chain, pile ..."""
+    return [text(lib.ssSceneInfoAt(i).name) for i in range(lib.ssSceneCount())]
 
 
 @dataclass(frozen=True)
