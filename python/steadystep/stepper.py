@@ -52,7 +52,7 @@ _FRAME_REPORT = ffi.typeof("ssFrameReport*")
 _new_frame_report = ffi.new
 _step_frame = lib.ssStepper_Step
 # A stepper call from its own callbacks (until status.h has SS_ERROR_REENTERED: out of range).
-REENTERED = getattr(lib, "SS_ERROR_REENTERED", lib.SS_ERROR_OUT_OF_RANGE)
+_REENTERED = getattr(lib, "SS_ERROR_REENTERED", lib.SS_ERROR_OUT_OF_RANGE)
 
 
 def _checked_callable(name: str, value):
@@ -127,7 +127,7 @@ class Stepper:
 
     def _between_frames(self, what: str):
         if self._in_frame:
-            raise self._refused(SteadystepError(REENTERED, f"stepper.{what}: called from a callback of the same "
+            raise self._refused(SteadystepError(_REENTERED, f"stepper.{what}: called from a callback of the same "
                                                 "stepper, inside its frame"))
         return self._handle()
 
