@@ -57,15 +57,16 @@ def frame_overhead() -> None:
     from steadystep._native import check, ffi, lib
 
     odepy.dInitODE2(0)
-    stepping = ss.Stepping()
+    stepping = ss.Stepping(solver=ss.Solver.QUICK)
     python_world, python_body = _one_body_world()
-    stepper = ss.Stepper(python_world, None, stepping=stepping)
+    stepper = ss.Stepper(python_world, None, tuned_step_s=FRAME_S, stepping=stepping)
     stepper.watch_body(python_body)
 
     direct_world, direct_body = _one_body_world()
     definition = ffi.new("ssStepperDef*", lib.ssDefaultStepperDef())
     definition.world = ffi.cast("dWorldID", ss._handles.address("world", "world", direct_world))
     definition.stepping = stepping.as_c_fields()
+    definition.tuned_step_s = FRAME_S
     made = ffi.new("ssStepper**")
     check(lib.ssStepper_Create(definition, made))
     direct = made[0]

@@ -58,18 +58,13 @@ class SimulationFailure(SteadystepError):
     beyond the position limit, or a frame was refused because an earlier one failed (reset the stepper)."""
 
 
-def _codes(*names: str) -> list[int]:
-    # A status the installed headers do not have yet is skipped: the C values are the truth.
-    return [getattr(lib, name) for name in names if hasattr(lib, name)]
-
-
 _ERROR_CLASSES = {
-    **{code: InvalidValue for code in _codes("SS_ERROR_NOT_FINITE", "SS_ERROR_OUT_OF_RANGE", "SS_ERROR_NO_SPRING",
-                                            "SS_ERROR_NO_FINITE_MAPPING", "SS_ERROR_UNSUPPORTED",
-                                            "SS_ERROR_NOT_FOUND", "SS_ERROR_PARSE")},
-    **{code: SimulationFailure for code in _codes("SS_ERROR_BLOWUP", "SS_ERROR_SPEED_LIMIT",
-                                                 "SS_ERROR_POSITION_LIMIT", "SS_ERROR_FAILED")},
-}
+    **dict.fromkeys((lib.SS_ERROR_NOT_FINITE, lib.SS_ERROR_OUT_OF_RANGE, lib.SS_ERROR_NO_SPRING,
+                     lib.SS_ERROR_NO_FINITE_MAPPING, lib.SS_ERROR_UNSUPPORTED, lib.SS_ERROR_NOT_FOUND,
+                     lib.SS_ERROR_PARSE), InvalidValue),
+    **dict.fromkeys((lib.SS_ERROR_BLOWUP, lib.SS_ERROR_SPEED_LIMIT, lib.SS_ERROR_POSITION_LIMIT, lib.SS_ERROR_FAILED),
+                    SimulationFailure),
+}  # the rest (i/o, out of memory, re-entered): SteadystepError itself
 
 
 def _decode(raw: bytes) -> str:

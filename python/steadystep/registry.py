@@ -22,9 +22,19 @@ from steadystep.convert import Spring
 from steadystep.enums import JointParam, Mapping, Status
 
 
+class ServedCounts(StructView, c_type="ssServedCounts"):
+    """Who served the rows or contacts of a step, or of a frame summed over its steps (ssServedCounts), read-only;
+    each row or contact is counted once, in one of: by_mapping (the stepping's own mapping: every one under implicit
+    Euler), handed_to_matched (exact only: no finite exact softness at this step length), handed_to_implicit_euler
+    (matched/exact only: above the step's Nyquist frequency, undamped, no effective mass, a static load, no finite
+    softness)."""
+
+    __slots__ = ()
+
+
 class ApplyReport(StructView, c_type="ssApplyReport"):
-    """What the registry wrote for one step (ssApplyReport), with the fields and meanings registry.h gives them,
-    read-only (FIELDS lists them; as_dict() copies them)."""
+    """What one Apply did (ssApplyReport), read-only: rows (ServedCounts: every bound row, the world's included,
+    once), row_writes (parameter sets actually written into ODE; unchanged values are skipped)."""
 
     __slots__ = ()
 

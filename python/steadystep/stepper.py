@@ -1,6 +1,7 @@
 """The stepper for a program's own ODE world (stepper.h): one call per rendered frame instead of dWorldQuickStep.
 
-    stepper = Stepper(world, registry, policy="exact", collide=collide, contact_group=contacts)
+    stepper = Stepper(world, space=space, tuned_step_s=1 / 60, solver=Solver.QUICK, policy="exact",
+                      collide=collide, contact_group=contacts)   # adopts all the space reaches, as tuned at 1/60 s
     for frame_s in frames:                    # the frame's real length (s)
         odepy.dBodyAddForce(car, throttle, 0, 0)   # forces added once a frame act for the whole frame
         report = stepper.step(frame_s)        # FrameReport; SteadystepError on a blow-up: repair, then reset()
@@ -18,14 +19,15 @@ the registry must outlive the stepper (it keeps its Registry alive; close() the 
 
 from __future__ import annotations
 
+import dataclasses
 import weakref
 from collections.abc import Callable
 
 from steadystep import _handles
 from steadystep._native import SimulationFailure, SteadystepError, check, ffi, last_error, lib, number, shown
-from steadystep.enums import Mapping, Status
 from steadystep._structs import StructView, address_of
-from steadystep.registry import Registry
+from steadystep.enums import Mapping, Solver, Status
+from steadystep.registry import Registry  # also declares ServedCounts, the view of FrameReport's rows and contacts
 from steadystep.stepping import Stepping, stepping_from
 
 
@@ -51,8 +53,6 @@ class FrameReport(StructView, c_type="ssFrameReport", convert={"failed_body": ad
 _FRAME_REPORT = ffi.typeof("ssFrameReport*")
 _new_frame_report = ffi.new
 _step_frame = lib.ssStepper_Step
-# A stepper call from its own callbacks (until status.h has SS_ERROR_REENTERED: out of range).
-_REENTERED = getattr(lib, "SS_ERROR_REENTERED", lib.SS_ERROR_OUT_OF_RANGE)
 
 
 def _checked_callable(name: str, value):
@@ -65,13 +65,17 @@ class Stepper:
     """Steps one ODE world frame by frame (ssStepper).
 
     world: an odepy dWorldID or an address. registry: a Registry of that world, or None (nothing soft is rewritten,
-    only watched bodies are known). stepping: a Stepping, or policy: a preset's name (policy_names()), whose naive
-    softness is frozen at reference_step_s (s; default the registry's tuned step, else 1/60 s); neither: the
-    defaults. before_step(stepper), collide(stepper): called before each physics step; step_done(step_s): after
-    each step that passed the checks. contact_group: an odepy dJointGroupID emptied after every step, or None.
-    Raises SteadystepError naming a bad value."""
+    only watched bodies are known). space: the program's space, or None: with it, the world and everything the
+    space reaches are adopted as tuned at tuned_step_s (s, required with space), into registry or into one the
+    stepper owns. solver: the ODE step the program calls, Solver.QUICK or Solver.STEP; required unless stepping
+    says it. stepping: a Stepping, or policy: a preset's name (policy_names()), whose naive softness is frozen at
+    reference_step_s (s; default the tuned step, else 1/60 s); neither: the defaults. max_step_s and fixed_step_s
+    of 0 (the defaults) are the tuned step. before_step(stepper), collide(stepper): called before each physics
+    step; step_done(step_s): after each step that passed the checks. contact_group: an odepy dJointGroupID emptied
+    after every step, or None. Raises SteadystepError naming a bad value."""
 
-    def __init__(self, world, registry: Registry | None = None, *, stepping: Stepping | None = None,
+    def __init__(self, world, registry: Registry | None = None, *, space=None, tuned_step_s: float = 0.0,
+                 solver: Solver | None = None, stepping: Stepping | None = None,
                  policy: str | None = None, reference_step_s: float | None = None,
                  before_step: Callable[["Stepper"], object] | None = None,
                  collide: Callable[["Stepper"], object] | None = None,
@@ -79,10 +83,13 @@ class Stepper:
         if registry is not None and not isinstance(registry, Registry):
             raise SteadystepError(Status.OUT_OF_RANGE, f"registry = {shown(registry)}: must be a steadystep.Registry or "
                                   "None")
+        tuned_step_s = number("tuned_step_s", tuned_step_s, "s")
         if reference_step_s is None:
-            tuned = registry.tuned_step_s if registry is not None else 0.0
+            tuned = tuned_step_s or (registry.tuned_step_s if registry is not None else 0.0)
             reference_step_s = tuned if tuned > 0 else 1.0 / 60.0
         self._stepping = stepping_from(stepping, policy, reference_step_s)
+        if solver is not None:
+            self._stepping = dataclasses.replace(self._stepping, solver=solver)
         self._registry = registry  # kept alive: the C stepper borrows it
         self._user = {"before_step": _checked_callable("before_step", before_step),
                       "collide": _checked_callable("collide", collide),
@@ -93,6 +100,8 @@ class Stepper:
 
         definition = ffi.new("ssStepperDef*", lib.ssDefaultStepperDef())
         definition.world = _handles.handle("world", "world", world)
+        definition.space = _handles.handle("space", "space", space)
+        definition.tuned_step_s = tuned_step_s
         definition.registry = registry._handle() if registry is not None else ffi.NULL
         definition.stepping = self._stepping.as_c_fields()
         definition.contact_group = _handles.handle("contact_group", "joint group", contact_group)
@@ -105,8 +114,11 @@ class Stepper:
         if collide is not None:
             definition.collide = self._callback("ssStepCallback*", lambda context, handle: _call(me, "collide"))
         if step_done is not None:
-            definition.step_done = self._callback("ssStepDoneFn*",
+            definition.step_done = self._callback("ssStepDoneCallback*",
                                                   lambda context, step_s: _call(me, "step_done", step_s))
+        if self._stepping.solver == Solver.UNSET and definition.world != ffi.NULL:  # (C names a NULL world first)
+            raise SteadystepError(Status.UNSUPPORTED, "solver = None: say which ODE step the program calls "
+                                  "(Solver.QUICK for dWorldQuickStep, Solver.STEP for dWorldStep)")
         out = ffi.new("ssStepper**")
         check(lib.ssStepper_Create(definition, out))
         # The destructor holds the C registry, so that however the two are collected, the stepper goes first.
@@ -127,7 +139,7 @@ class Stepper:
 
     def _between_frames(self, what: str):
         if self._in_frame:
-            raise self._refused(SteadystepError(_REENTERED, f"stepper.{what}: called from a callback of the same "
+            raise self._refused(SteadystepError(Status.REENTERED, f"stepper.{what}: called from a callback of the same "
                                                 "stepper, inside its frame"))
         return self._handle()
 
