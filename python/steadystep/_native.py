@@ -28,7 +28,7 @@ class SteadystepError(Exception):
     failed (a blow-up, a speed or position limit, a frame refused after a failure), InvalidValue (also a ValueError)
     for a value refused by name, SteadystepError itself for the rest (i/o, memory, re-entry)."""
 
-    def __new__(cls, code: int = 0, message: str = "", *args):
+    def __new__(cls, code: int, message: str = ""):
         if cls is SteadystepError:
             cls = _ERROR_CLASSES.get(int(code), SteadystepError)
         return super().__new__(cls)
@@ -122,7 +122,8 @@ def c_string(name: str, value) -> bytes:
         try:
             raw = value.encode("utf-8", "surrogateescape")
         except UnicodeEncodeError:
-            raise SteadystepError(lib.SS_ERROR_OUT_OF_RANGE, f"{name} = {shown(value)}: has characters that are not text "
+            raise SteadystepError(lib.SS_ERROR_OUT_OF_RANGE,
+                                  f"{name} = {shown(value)}: has characters that are not text "
                                   "(lone surrogates)") from None
     elif isinstance(value, (bytes, bytearray)):
         raw = bytes(value)

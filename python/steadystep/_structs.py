@@ -42,15 +42,28 @@ class StructView:
             setattr(cls, name, _field_property(name, field.type, (convert or {}).get(name)))
         _VIEWS[ffi.typeof(c_type).cname] = cls
 
-    def __init__(self, _cdata=None, _owner=None, **values):
-        """A view of _cdata (the struct the library filled, or a pointer to it; _owner keeps its memory alive when
-        _cdata does not, as for a nested struct), or of a new struct holding values by field name (nested structs
-        as views or dicts; fields not given are 0), e.g. to compare a report with the one expected."""
-        if _cdata is None:
-            _cdata = self.new()
-            _fill(_cdata[0], values, type(self).__name__)
-        self._c = _cdata
-        self._owner = _owner
+    def __init__(self, *values, **named):
+        """A view of a new struct holding values, in the C order or by field name (nested structs as views or
+        dicts; fields not given are 0), e.g. to compare a report with the one expected."""
+        if len(values) > len(self.FIELDS):
+            raise TypeError(f"{type(self).__name__}: {len(values)} values for {len(self.FIELDS)} fields")
+        given = dict(zip(self.FIELDS, values))
+        twice = given.keys() & named.keys()
+        if twice:
+            raise TypeError(f"{type(self).__name__}: {sorted(twice)[0]!r} given twice")
+        cdata = self.new()
+        _fill(cdata[0], {**given, **named}, type(self).__name__)
+        self._c = cdata
+        self._owner = None
+
+    @classmethod
+    def of(cls, cdata, owner=None):
+        """A view of the struct the library filled (cdata: the struct or a pointer to it), read in place; owner keeps
+        its memory alive when cdata does not (a nested struct, read from its parent)."""
+        view = cls.__new__(cls)
+        view._c = cdata
+        view._owner = owner
+        return view
 
     @classmethod
     def new(cls):
@@ -103,7 +116,7 @@ def _field_property(name: str, ctype, convert):
     if ctype.kind == "struct":
         def nested(self, view=_view_class(ctype.cname)):
             # A struct field is read in place: the nested view keeps the outer struct's memory alive.
-            return view(getattr(self._c, name), self._owner if self._owner is not None else self._c)
+            return view.of(getattr(self._c, name), self._owner if self._owner is not None else self._c)
         return property(nested)
     if convert is not None:
         return property(lambda self: convert(getattr(self._c, name)))

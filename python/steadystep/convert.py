@@ -42,7 +42,8 @@ def _spring(spring: Spring | tuple[float, float]) -> dict:
     try:
         k, c = spring
     except (TypeError, ValueError):
-        raise SteadystepError(Status.OUT_OF_RANGE, f"spring = {shown(spring)}: must be a pair (k N/m, c N·s/m)") from None
+        raise SteadystepError(Status.OUT_OF_RANGE,
+                              f"spring = {shown(spring)}: must be a pair (k N/m, c N·s/m)") from None
     return {"stiffness": number("k", k, "N/m"), "damping": number("c", c, "N·s/m")}
 
 
@@ -60,7 +61,8 @@ def _checked(what: str, inputs: dict, status: int, outputs) -> None:
         raise SteadystepError(error.code, f"{_given(what, inputs)}: {error.message}") from None
     for name, value in outputs().items():
         if not math.isfinite(value):
-            raise SteadystepError(Status.NOT_FINITE, f"{_given(what, inputs)}: {name} = {value}: the result is not finite")
+            raise SteadystepError(Status.NOT_FINITE,
+                                  f"{_given(what, inputs)}: {name} = {value}: the result is not finite")
 
 
 def _softness_from_spring(spring: Spring | tuple[float, float], step_s: float) -> Softness:

@@ -69,7 +69,8 @@ def frames_within(spec: str, duration_s: float, seed: int = 1) -> Iterator[float
     while duration_s - elapsed_s > end_tolerance_s:
         frame_s = next_frame(handle)
         if not (math.isfinite(frame_s) and frame_s > 0):
-            raise SteadystepError(Status.OUT_OF_RANGE, f"profile = {shown(spec)}: frame {count + 1} lasts {frame_s!r} s, "
+            raise SteadystepError(Status.OUT_OF_RANGE,
+                                  f"profile = {shown(spec)}: frame {count + 1} lasts {frame_s!r} s, "
                                   "not a finite positive duration")
         frame_s = min(frame_s, duration_s - elapsed_s)
         elapsed_s += frame_s

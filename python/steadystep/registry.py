@@ -52,7 +52,8 @@ def _spring(spring) -> dict:
     try:
         k, c = spring
     except (TypeError, ValueError):
-        raise SteadystepError(Status.OUT_OF_RANGE, f"spring = {shown(spring)}: must be a Spring(k N/m, c N·s/m)") from None
+        raise SteadystepError(Status.OUT_OF_RANGE,
+                              f"spring = {shown(spring)}: must be a Spring(k N/m, c N·s/m)") from None
     return {"stiffness": number("k", k, "N/m"), "damping": number("c", c, "N·s/m")}
 
 
@@ -116,7 +117,7 @@ class Registry:
     def _adopt(self, call, *args) -> AdoptReport:
         out = AdoptReport.new()
         check(call(self._handle(), *args, out))
-        return AdoptReport(out)
+        return AdoptReport.of(out)
 
     def adopt(self, tuned_step_s: float, space) -> AdoptReport:
         """Adopts what the program tuned at tuned_step_s (s, > 0): the world's ERP/CFM, damping and auto-disable
@@ -199,7 +200,7 @@ class Registry:
         out = ApplyReport.new()
         check(lib.ssRegistry_Apply(self._handle(), _mapping(mapping), number("step_s", step_s, "s"),
                                    number("previous_step_s", previous_step_s, "s"), out))
-        return ApplyReport(out)
+        return ApplyReport.of(out)
 
     @property
     def joint_binding_count(self) -> int:

@@ -88,7 +88,8 @@ def _grid_points(grid: dict | None) -> tuple[list[dict], list[dict]]:
     grid = grid or {}
     unknown = set(grid) - set(GRID_AXES)
     if unknown:
-        raise SteadystepError(Status.OUT_OF_RANGE, f"grid: no axis {sorted(unknown)[0]!r} (axes: {', '.join(GRID_AXES)})")
+        raise SteadystepError(Status.OUT_OF_RANGE,
+                              f"grid: no axis {sorted(unknown)[0]!r} (axes: {', '.join(GRID_AXES)})")
     springs = study.grid(**{axis: grid[axis] for axis in ("stiffness", "damping") if axis in grid})
     steps = study.grid(**{axis: grid[axis] for axis in ("max_step_s",) if axis in grid})
     return springs, steps

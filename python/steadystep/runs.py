@@ -228,7 +228,8 @@ def check_run_size(profile: str, duration_s: float, seed: int, stepping: dict) -
     # A bad step length is left to the library, which names it; the frames are counted on the profile itself.
     frames = frame_count(profile, duration_s, seed, MAX_RUN_FRAMES)
     if frames > MAX_RUN_FRAMES:
-        raise SteadystepError(Status.OUT_OF_RANGE, f"profile = {shown(profile)}: more than the bound of {MAX_RUN_FRAMES} "
+        raise SteadystepError(Status.OUT_OF_RANGE,
+                              f"profile = {shown(profile)}: more than the bound of {MAX_RUN_FRAMES} "
                               f"frames per run within duration_s = {duration_s:g} s")
 
 

@@ -53,6 +53,7 @@ class FrameReport(StructView, c_type="ssFrameReport", convert={"failed_body": ad
 _FRAME_REPORT = ffi.typeof("ssFrameReport*")
 _new_frame_report = ffi.new
 _step_frame = lib.ssStepper_Step
+_frame_report = FrameReport.of
 
 
 def _checked_callable(name: str, value):
@@ -81,7 +82,8 @@ class Stepper:
                  collide: Callable[["Stepper"], object] | None = None,
                  step_done: Callable[[float], object] | None = None, contact_group=None):
         if registry is not None and not isinstance(registry, Registry):
-            raise SteadystepError(Status.OUT_OF_RANGE, f"registry = {shown(registry)}: must be a steadystep.Registry or "
+            raise SteadystepError(Status.OUT_OF_RANGE,
+                                  f"registry = {shown(registry)}: must be a steadystep.Registry or "
                                   "None")
         tuned_step_s = number("tuned_step_s", tuned_step_s, "s")
         if reference_step_s is None:
@@ -192,8 +194,8 @@ class Stepper:
         finally:
             self._in_frame = False
         if status or self._pending is not None:
-            self._raise_for_frame(status, FrameReport(report))
-        return FrameReport(report)
+            self._raise_for_frame(status, _frame_report(report))
+        return _frame_report(report)
 
     def _raise_for_frame(self, status: int, made: FrameReport):
         pending, self._pending = self._pending, None
@@ -215,7 +217,7 @@ class Stepper:
     def current_step(self) -> StepInfo:
         """The step about to be taken: meaningful inside before_step and collide; between frames, the next step of
         the default length."""
-        return StepInfo(lib.ssStepper_CurrentStep(self._handle()))
+        return StepInfo.of(lib.ssStepper_CurrentStep(self._handle()))
 
     def soften_contact(self, contact, body1, body2) -> None:
         """In the near callback, before dJointCreateContact: turns the contact's tuned softness (its soft_erp /

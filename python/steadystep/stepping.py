@@ -84,7 +84,8 @@ class Stepping:
 def stepping_from(stepping: Stepping | None, policy: str | None, reference_step_s: float) -> Stepping:
     """One stepping from a Stepper's arguments: stepping, or the named policy, or the defaults (not both)."""
     if stepping is not None and policy is not None:
-        raise SteadystepError(Status.OUT_OF_RANGE, f"policy = {shown(policy)}: give either stepping or policy, not both")
+        raise SteadystepError(Status.OUT_OF_RANGE,
+                              f"policy = {shown(policy)}: give either stepping or policy, not both")
     if policy is not None:
         return Stepping.for_policy(policy, reference_step_s)
     if stepping is None:

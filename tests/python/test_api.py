@@ -44,10 +44,14 @@ def test_each_dataclass_has_exactly_the_c_fields_in_order(cls, ctype):
 def test_each_report_reads_exactly_the_c_fields_in_order(cls, ctype):
     c_fields = [name for name, _ in ffi.typeof(ctype).fields]
     assert list(cls.FIELDS) == c_fields
-    report = cls(ffi.new(f"{ctype}*"))
+    report = cls.of(ffi.new(f"{ctype}*"))
     assert list(report.as_dict()) == c_fields
     with pytest.raises(AttributeError):
         setattr(report, c_fields[0], 1)
+    # Made by hand, as the dataclasses were: positional in the C order, or by name.
+    assert cls(**report.as_dict()) == report == cls(*report.as_dict().values())
+    with pytest.raises(TypeError, match="no field"):
+        cls(no_such_field=1)
 
 
 def test_the_stepping_defaults_and_presets_are_the_librarys():

@@ -35,7 +35,8 @@ def _world_with_a_box(max_speed=0.0):
     mass = odepy.dMass()
     odepy.dMassSetBoxTotal(ctypes.byref(mass), 1.0, 0.1, 0.1, 0.1)
     odepy.dBodySetMass(body, ctypes.byref(mass))
-    stepper = ss.Stepper(world, None, tuned_step_s=1 / 60, solver=ss.Solver.QUICK, stepping=ss.Stepping(max_speed=max_speed))
+    stepper = ss.Stepper(world, None, tuned_step_s=1 / 60, solver=ss.Solver.QUICK,
+                         stepping=ss.Stepping(max_speed=max_speed))
     stepper.watch_body(body)
     return world, body, stepper
 
@@ -94,7 +95,8 @@ def step_a_body_beyond_the_position_limit():
 
 def step_from_a_callback_of_the_same_stepper():
     world, body, stepper = _world_with_a_box()
-    reentering = ss.Stepper(world, None, tuned_step_s=1 / 60, solver=ss.Solver.QUICK, before_step=lambda s: s.step(1 / 60))
+    reentering = ss.Stepper(world, None, tuned_step_s=1 / 60, solver=ss.Solver.QUICK,
+                            before_step=lambda s: s.step(1 / 60))
     try:
         reentering.step(1 / 60)
     finally:
@@ -175,14 +177,16 @@ def test_a_blow_up_carries_its_frame_report():
 
 def test_refusals_made_in_python_carry_the_status_too():
     world = odepy.dWorldCreate()
+    stepper = ss.Stepper(world, None, tuned_step_s=1 / 60, solver=ss.Solver.QUICK)
     try:
         for call in (lambda: ss.Registry(world).bind_world("stiff"), lambda: ss.Registry("a world"),
-                     lambda: ss.Stepper(world, None, tuned_step_s=1 / 60, solver=ss.Solver.QUICK).step("1/60"), lambda: runs.scene_info("nowhere")):
+                     lambda: stepper.step("1/60"), lambda: runs.scene_info("nowhere")):
             with pytest.raises(ss.SteadystepError) as raised:
                 call()
             assert raised.value.code in (S.OUT_OF_RANGE, S.NOT_FOUND)
             assert raised.value.status == ffi.string(lib.ssStatusName(raised.value.code)).decode()
     finally:
+        stepper.close()
         odepy.dWorldDestroy(world)
 
 
