@@ -11,7 +11,10 @@ each physics step (stepper.current_step() tells the step), step_done(step_s) aft
 checks. collide typically calls odepy.dSpaceCollide(space, None, near) and the near callback calls
 stepper.soften_contact(contact, body1, body2) before dJointCreateContact. An exception raised by a callback does
 not cross C: it is kept, the callbacks are not called again for the rest of that frame (whose remaining steps
-ODE still takes), and step() raises it once the frame is over.
+ODE still takes), and step() raises it once the frame is over. The near callback is called by ODE through ctypes,
+which prints an exception and goes on: a refusal of the stepper's own calls made there (soften_contact ...) is
+kept for step() all the same, and wrapping the near callback, odepy.dNearCallback(stepper.near_callback(near)),
+keeps any exception it raises.
 
 Handles (world, bodies, joints, the contact group) are odepy handles or integer addresses, borrowed: the world and
 the registry must outlive the stepper (it keeps its Registry alive; close() the stepper before dWorldDestroy).
@@ -218,6 +221,23 @@ class Stepper:
         """The step about to be taken: meaningful inside before_step and collide; between frames, the next step of
         the default length."""
         return StepInfo.of(lib.ssStepper_CurrentStep(self._handle()))
+
+    def near_callback(self, near: Callable) -> Callable:
+        """near (an odepy near callback, near(data, geom1, geom2)) wrapped so that an exception it raises during a
+        frame is kept and raised by step(), as a callback's is, instead of being printed and lost by ctypes:
+        odepy.dSpaceCollide(space, None, odepy.dNearCallback(stepper.near_callback(near)))."""
+        me = weakref.ref(self)
+
+        def kept_near(*args):
+            stepper = me()
+            try:
+                near(*args)
+            except BaseException as error:  # noqa: BLE001 - raised by step() after the frame
+                if stepper is None or not stepper._in_frame:
+                    raise
+                stepper._refused(error)
+
+        return kept_near
 
     def soften_contact(self, contact, body1, body2) -> None:
         """In the near callback, before dJointCreateContact: turns the contact's tuned softness (its soft_erp /

@@ -133,3 +133,25 @@ def test_re_entering_the_stepper_from_the_near_callback_is_raised_by_step(world,
     capfd.readouterr()
     stepper.close()
     odepy.dSpaceDestroy(space)
+
+
+def test_an_exception_in_a_wrapped_near_callback_is_raised_by_step(world):
+    space = odepy.dSimpleSpaceCreate(0)
+    ball = ball_on_plane(world, space)
+    calls = []
+
+    def near(data, g1, g2):
+        calls.append(1)
+        return 1 / 0  # the program's own bug in its near callback
+
+    stepper = ss.Stepper(world, None, tuned_step_s=1 / 60, solver=ss.Solver.QUICK, policy="implicit-euler",
+                         collide=lambda s: odepy.dSpaceCollide(space, None, callback))
+    callback = odepy.dNearCallback(stepper.near_callback(near))
+    stepper.watch_body(ball)
+    with pytest.raises(ZeroDivisionError) as raised:
+        stepper.step(1 / 30)  # two substeps: the first raises, the second is taken without the callbacks
+    assert calls == [1] and raised.value.steadystep_report.steps == 2
+    with pytest.raises(ZeroDivisionError):  # outside a frame, the wrapper hides nothing
+        stepper.near_callback(near)(None, None, None)
+    stepper.close()
+    odepy.dSpaceDestroy(space)
