@@ -144,11 +144,13 @@ def reference_stepping() -> dict:
     return _as_dict(lib.ssReferenceStepping(REFERENCE_STEP_S))
 
 
-# How a run ends (RunResult.status): "ok" ran to the end within the scene's sanity bounds; "blow-up" and
-# "speed limit" ended early with a state that was not finite or absurdly fast; "broken" ended early, finite but
-# physically wrong: a step left one of the scene's sanity bounds (scene.h: a torn joint, a box through the floor,
-# energy made). Only "ok" is a run to measure: a report counts every other status as failed.
-BLOW_UP_STATUSES = frozenset({"blow-up", "speed limit"})
+# How a run ends (RunResult.status): "ok" ran to the end within the scene's sanity bounds; "blow-up", "speed limit"
+# and "position limit" (the library's names for those statuses) ended early with a state that was not finite,
+# absurdly fast or absurdly far; "broken" ended early, finite but physically wrong: a step left one of the scene's
+# sanity bounds (scene.h: a torn joint, a box through the floor, energy made). Only "ok" is a run to measure: a
+# report counts every other status as failed.
+BLOW_UP_STATUSES = frozenset(text(lib.ssStatusName(status)) for status in (
+    lib.SS_ERROR_BLOWUP, lib.SS_ERROR_SPEED_LIMIT, lib.SS_ERROR_POSITION_LIMIT))
 BROKEN = "broken"
 
 
