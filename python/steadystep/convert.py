@@ -13,9 +13,8 @@ here (a spring is a pair): pass np.asarray(...) to convert many.
 from __future__ import annotations
 
 import math
+import sys
 from typing import NamedTuple
-
-import numpy as np
 
 from steadystep._native import SteadystepError, check, ffi, lib, number, shown, text
 from steadystep.enums import Mapping, Status
@@ -147,7 +146,10 @@ def _mapped(what: str, function, spring, mass, step_s, previous_step_s) -> Softn
 # ---- elementwise over numpy arrays ---------------------------------------------------------------------------------
 
 def _is_array(value) -> bool:
-    return isinstance(value, np.ndarray) and value.ndim > 0
+    # numpy is imported only by a program that has arrays to convert: without it loaded, nothing is an array (and
+    # `import steadystep` stays without numpy's import time).
+    numpy = sys.modules.get("numpy")
+    return numpy is not None and isinstance(value, numpy.ndarray) and value.ndim > 0
 
 
 def _elementwise(scalar, result_type, names: tuple[str, ...], *values):
@@ -155,6 +157,7 @@ def _elementwise(scalar, result_type, names: tuple[str, ...], *values):
     results gathered into arrays of the broadcast shape (as result_type, or a tuple)."""
     if not any(_is_array(value) for value in values):
         return scalar(*values)
+    import numpy as np
     try:
         shape = np.broadcast_shapes(*(np.shape(value) for value in values))
     except ValueError:

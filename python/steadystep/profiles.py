@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from steadystep._native import SteadystepError, c_string, check, ffi, integer, lib, number, shown
 from steadystep.enums import Status
 from steadystep.limits import MAX_RUN_FRAMES
+
+if TYPE_CHECKING:  # numpy is imported where an array is made, not by `import steadystep`
+    import numpy as np
 
 DEFAULT_PROFILES = ("fixed:30", "uniform:15:45", "jitter:30:3", "hitch:60:30:0.1", "vsync:60:30")
 SEED_RANGE = (0, 2**64 - 1)
@@ -43,6 +45,8 @@ class Profile:
     def frames(self, count: int) -> np.ndarray:
         """The next `count` frame durations (s); count in [0, MAX_RUN_FRAMES] (limits.py)."""
         count = integer("count", count, 0, MAX_RUN_FRAMES)
+        import numpy as np
+
         return np.array([lib.ssProfile_Next(self._profile) for _ in range(count)], dtype=float)
 
     def reset(self) -> None:
