@@ -7,6 +7,8 @@ added in C appears here with the next build, nested structs as nested views. Eac
 so a report kept from an earlier frame keeps its values.
 
     class FrameReport(StructView, c_type="ssFrameReport", convert={"failed_body": address_of}): ...
+    FrameReport.of(filled)                  # the struct the library filled, read in place
+    FrameReport(steps=1, step_s=1 / 60)     # one made by hand (fields not given are 0), e.g. to compare
 """
 
 from __future__ import annotations

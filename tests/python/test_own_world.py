@@ -374,8 +374,7 @@ def test_an_exception_in_a_callback_is_raised_by_step_and_the_stepper_goes_on(wo
     with pytest.raises(KeyError, match="from before_step") as raised:
         stepper.step(0.05)  # 3 substeps: the second raises, the third is taken without the callback
     assert raised.value.steadystep_report.steps == 3 and len(calls) == 2
-    assert calls[0] == ss.StepInfo(mapping=ss.Mapping.IMPLICIT_EULER, step_s=0.05 / 3, softness_step_s=0.05 / 3,
-                                   previous_step_s=0.0, index=0, count=3)
+    assert calls[0] == ss.StepInfo(ss.Mapping.IMPLICIT_EULER, 0.05 / 3, 0.05 / 3, 0.0, 0, 3)
     assert stepper.step(0.01).steps == 1 and len(calls) == 3  # not failed: the next frame is stepped as usual
 
     def reenter(stepper):
