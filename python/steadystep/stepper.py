@@ -52,9 +52,10 @@ class FrameReport(StructView, c_type="ssFrameReport", convert={"failed_body": ad
     __slots__ = ()
 
 
-# The per-frame path, looked up once.
+# The per-frame path, looked up once. ssStepper_Step zeroes its report before anything else, on every path
+# (src/stepper.c; tests/python/test_lifetimes.py holds it to that), so the report's memory is not cleared twice.
 _FRAME_REPORT = ffi.typeof("ssFrameReport*")
-_new_frame_report = ffi.new
+_new_frame_report = ffi.new_allocator(should_clear_after_alloc=False)
 _step_frame = lib.ssStepper_Step
 _frame_report = FrameReport.of
 

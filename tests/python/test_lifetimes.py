@@ -4,11 +4,13 @@ callback (where ctypes would print it and go on), is raised by step() after the 
 
 import ctypes
 import gc
+import math
 
 import odepy
 import pytest
 
 import steadystep as ss
+from steadystep._native import ffi, lib
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -153,5 +155,30 @@ def test_an_exception_in_a_wrapped_near_callback_is_raised_by_step(world):
     assert calls == [1] and raised.value.steadystep_report.steps == 2
     with pytest.raises(ZeroDivisionError):  # outside a frame, the wrapper hides nothing
         stepper.near_callback(near)(None, None, None)
+    stepper.close()
+    odepy.dSpaceDestroy(space)
+
+
+def test_every_frame_zeroes_its_report_whatever_its_memory_held(world):
+    # Stepper.step hands C an uncleared report: ssStepper_Step must zero it on every path, refusals included.
+    space = odepy.dSimpleSpaceCreate(0)
+    ball = ball_on_plane(world, space)
+    stepper = ss.Stepper(world, None, tuned_step_s=1 / 60, solver=ss.Solver.QUICK, policy="implicit-euler")
+    stepper.watch_body(ball)
+    size = ffi.sizeof("ssFrameReport")
+    report = ffi.new("ssFrameReport*")
+
+    def step(frame_s):
+        ffi.memmove(report, b"\xff" * size, size)  # what an earlier allocation may have left
+        return lib.ssStepper_Step(stepper._stepper, frame_s, report)
+
+    for refused in (-1.0, math.nan, 1e9):
+        assert step(refused) != lib.SS_OK
+        assert bytes(ffi.buffer(report)) == bytes(size), refused
+    odepy.dBodyAddForce(ball, 1e300, 0.0, 0.0)  # a force beyond the bound: refused once the frame began
+    assert step(1 / 60) != lib.SS_OK and bytes(ffi.buffer(report)) == bytes(size)
+    odepy.dBodySetForce(ball, 0.0, 0.0, 0.0)
+    assert step(1 / 60) == lib.SS_OK and report.steps == 1 and report.dropped_s == 0.0
+    assert step(0.0) == lib.SS_OK and bytes(ffi.buffer(report)) == bytes(size)
     stepper.close()
     odepy.dSpaceDestroy(space)
