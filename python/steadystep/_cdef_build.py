@@ -23,7 +23,8 @@ _LAB_AND_SETTINGS = (("core", "status.h"), ("core", "spring.h"), ("core", "stepp
                      ("lab", "scene.h"))
 # The core for a program's own ODE world (registry, adoption, stepper). limits.h brings the integer bounds
 # (SS_MAX_RUN_STEPS ...); its floating-point #defines are not kept (cffi's ABI mode takes integer constants only).
-_OWN_WORLD = (("core", "limits.h"), ("core", "registry.h"), ("core", "adopt.h"), ("core", "stepper.h"))
+_OWN_WORLD = (("core", "limits.h"), ("core", "registry.h"), ("core", "adopt.h"), ("core", "stepper.h"),
+              ("core", "interpolation.h"))
 
 # These headers take ODE's handles. ODE's own headers are not read: cffi needs only the handles' names, as opaque
 # pointers (the Python side passes addresses, e.g. of an odepy world), dReal (a double build, as Debian's) and
