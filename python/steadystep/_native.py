@@ -28,9 +28,9 @@ class SteadystepError(Exception):
     failed (a blow-up, a speed or position limit, a frame refused after a failure), InvalidValue (also a ValueError)
     for a value refused by name, SteadystepError itself for the rest (i/o, memory, re-entry)."""
 
-    def __new__(cls, code: int, message: str = ""):
+    def __new__(cls, *args, **kwargs):
         if cls is SteadystepError:
-            cls = _ERROR_CLASSES.get(int(code), SteadystepError)
+            cls = _ERROR_CLASSES.get(int(args[0] if args else kwargs["code"]), SteadystepError)
         return super().__new__(cls)
 
     def __init__(self, code: int, message: str = ""):

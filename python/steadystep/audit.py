@@ -224,18 +224,18 @@ def measure(program, variants: list[str], runs_per_variant, duration_s: float, d
     reference, check = done["reference",], done["check",]
     for name, run in (("reference", reference), ("check of the reference", check)):
         if not run.ok:
-            raise BadProgram("bad program", f"{program.name}: the {name} ({REFERENCE_POLICY}, {run.profile}) "
+            raise BadProgram(f"{program.name}: the {name} ({REFERENCE_POLICY}, {run.profile}) "
                              f"failed, so nothing can be measured: {run.status}")
     for run in (reference, check):  # a program that ignores --profile would measure the same run everywhere
         expected = frame_count(run.profile, duration_s, run.seed)
         if run.frames and abs(run.frames - expected) > 1:
-            raise BadProgram("bad program", f"{program.name}: under --profile {run.profile} --duration "
+            raise BadProgram(f"{program.name}: under --profile {run.profile} --duration "
                              f"{duration_s:g} it printed {run.frames} frames, not the profile's {expected}: it does "
                              "not follow --profile (one CSV row per frame of the profile, after a t = 0 row)")
     quantities = reference.quantities()
     for key, run in done.items():
         if run.quantities() != quantities:
-            raise BadProgram("bad program", f"{program.name}: the {run.variant} run under {run.profile} prints the "
+            raise BadProgram(f"{program.name}: the {run.variant} run under {run.profile} prints the "
                              f"columns {', '.join(run.quantities())}, the reference {', '.join(quantities)}: every "
                              "run must follow the same quantities")
     amplitudes = {q: float(np.ptp(reference.columns[q])) for q in quantities}
