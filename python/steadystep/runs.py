@@ -171,7 +171,7 @@ class RunResult:
     units: dict[str, str]
     frame_count: int
     wall_s: float                      # wall-clock seconds of stepping (scene building excluded)
-    status: str                        # "ok", "broken", or the blow-up status ("blow-up", "speed limit")
+    status: str                        # "ok", "broken", or a blow-up status (BLOW_UP_STATUSES)
     message: str = ""                  # why a run that is not "ok" ended: the bound, body or joint, value, time
     initial: dict[str, float] = field(default_factory=dict)  # the quantities before the first step (t = 0)
     bound_use: float = 0.0             # the largest value/bound ratio of the scene's sanity bounds (> 1: broken)

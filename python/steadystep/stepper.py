@@ -27,10 +27,10 @@ import weakref
 from collections.abc import Callable
 
 from steadystep import _handles
-from steadystep._native import SimulationFailure, SteadystepError, check, ffi, last_error, lib, number, shown
+from steadystep._native import SteadystepError, check, ffi, last_error, lib, number, shown
 from steadystep._structs import StructView, address_of
 from steadystep.enums import Mapping, Solver, Status
-from steadystep.registry import Registry  # also declares ServedCounts, the view of FrameReport's rows and contacts
+from steadystep.registry import AdoptReport, Registry  # also declares ServedCounts, the view of rows, contacts
 from steadystep.stepping import Stepping, stepping_from
 
 
@@ -179,14 +179,14 @@ class Stepper:
         self._stepping = stepping
 
     def step(self, frame_s: float) -> FrameReport:
-        """Advances the world by one frame of frame_s seconds (0 <= frame_s <= 3600; 0 does nothing). Forces the
-        program added to known bodies before this call act for the whole frame. Returns the frame's FrameReport.
-        Raises SteadystepError with the library's message (the world left as it was for a refused frame); for a
-        failed simulation (SimulationFailure: Status.BLOWUP, SPEED_LIMIT ...) the error's `report` is the
-        FrameReport, whose failed_body names the body, and every later frame is refused (Status.FAILED) until
-        reset(). An exception raised by a callback, or by a call the near callback made (soften_contact ...), is
-        raised here, after the frame, with the frame's FrameReport (or its error) as its `steadystep_report` (or
-        `__context__`)."""
+        """Advances the world by one frame of frame_s seconds (0 <= frame_s <= 3600; 0 takes no step). Forces the
+        program added to known bodies before this call act for the whole frame (a frame of 0 s reads and clears
+        them: F·0 = 0). Returns the frame's FrameReport. Raises SteadystepError with the library's message (the
+        world left as it was for a refused frame); for a body refused at the boundary before the frame or a step (a state or force ODE cannot step, Status.POSITION_LIMIT, ...) or one that blew
+        up or ran away in a step (Status.BLOWUP, Status.SPEED_LIMIT) the error's `report` is the FrameReport, whose
+        failed_body names the body, and every later frame is refused (Status.FAILED) until reset(). An exception
+        raised by a callback, or by a call the near callback made (soften_contact ...), is raised here, after the
+        frame, with the frame's FrameReport (or its error) as its `steadystep_report` (or `__context__`)."""
         if self._in_frame or self._stepper is None:
             self._between_frames("step")
         if type(frame_s) is not float:
@@ -206,7 +206,7 @@ class Stepper:
         error = None
         if status:
             error = SteadystepError(status, last_error())
-            if isinstance(error, SimulationFailure) and status != Status.FAILED:
+            if made.failed_body:  # a body refused at the boundary, or that blew up or ran away in a step
                 error.report = made
         if pending is not None:
             try:
@@ -217,6 +217,21 @@ class Stepper:
                 raise pending from error
             raise pending
         raise error
+
+    @property
+    def adopted(self) -> AdoptReport:
+        """What the stepper's own adoption (space=...) reached, at creation and since (ssStepper_Adopted)."""
+        return AdoptReport.of(lib.ssStepper_Adopted(self._handle()))
+
+    @property
+    def known_body_count(self) -> int:
+        """How many bodies the stepper knows now (ssStepper_KnownBodyCount): forces kept over a frame, checked at
+        every step. A body nothing reaches (no geom in the space, no joint to a known body) is not among them:
+        watch_body() it."""
+        count = lib.ssStepper_KnownBodyCount(self._handle())
+        if count < 0:
+            check(lib.SS_ERROR_OUT_OF_MEMORY)
+        return count
 
     def current_step(self) -> StepInfo:
         """The step about to be taken: meaningful inside before_step and collide; between frames, the next step of

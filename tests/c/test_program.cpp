@@ -294,8 +294,12 @@ TEST_F(ProgramTest, ForcesAndLoadsODECannotStepAreRefusedByNameBeforeAnythingMov
     EXPECT_NE(ssStepper_Step(stepper, 0.05, &report), SS_OK) << force;
     EXPECT_NE(std::string(ssLastError()).find("torque"), std::string::npos) << ssLastError();
     EXPECT_EQ(report.steps, 0);
+    EXPECT_EQ(report.failed_body, body);
     EXPECT_EQ(dBodyGetPosition(body)[2], z);
+    EXPECT_TRUE(dBodyGetTorque(body)[0] == force || std::isnan(force)) << "left as it was";
+    EXPECT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_ERROR_FAILED);  // latched until the program repairs
     dBodySetTorque(body, 0, 0, 0);
+    ssStepper_Reset(stepper);
   }
   EXPECT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK) << ssLastError();
   ssStepper_Destroy(stepper);

@@ -148,13 +148,7 @@ def test_every_status_has_a_case():
     assert set(CASES) == set(ss.Status) - {S.OK}
 
 
-# The position bound is the stepper's boundary check (issue 14.1), which another change brings to stepper.c.
-PENDING_IN_C = {S.POSITION_LIMIT: "stepper.c does not check positions against SS_MAX_POSITION_M yet"}
-
-
-@pytest.mark.parametrize("status", [
-    pytest.param(status, marks=[pytest.mark.xfail(reason=PENDING_IN_C[status], raises=pytest.fail.Exception)]
-                 if status in PENDING_IN_C else []) for status in CASES], ids=lambda status: status.name)
+@pytest.mark.parametrize("status", list(CASES), ids=lambda status: status.name)
 def test_each_failure_raises_its_own_status(status):
     with pytest.raises(ss.SteadystepError) as raised:
         CASES[status]()

@@ -175,8 +175,14 @@ def test_every_frame_zeroes_its_report_whatever_its_memory_held(world):
     for refused in (-1.0, math.nan, 1e9):
         assert step(refused) != lib.SS_OK
         assert bytes(ffi.buffer(report)) == bytes(size), refused
-    odepy.dBodyAddForce(ball, 1e300, 0.0, 0.0)  # a force beyond the bound: refused once the frame began
-    assert step(1 / 60) != lib.SS_OK and bytes(ffi.buffer(report)) == bytes(size)
+    odepy.dBodyAddForce(ball, 1e300, 0.0, 0.0)  # a force beyond the bound: refused at the boundary, naming the body
+    assert step(1 / 60) != lib.SS_OK
+    refused = ss.FrameReport.of(report).as_dict()
+    assert refused.pop("failed_body") == ctypes.cast(ball, ctypes.c_void_p).value
+    expected = ss.FrameReport().as_dict()
+    del expected["failed_body"]
+    assert refused == expected
+    stepper.reset()
     odepy.dBodySetForce(ball, 0.0, 0.0, 0.0)
     assert step(1 / 60) == lib.SS_OK and report.steps == 1 and report.dropped_s == 0.0
     assert step(0.0) == lib.SS_OK and bytes(ffi.buffer(report)) == bytes(size)
