@@ -45,9 +45,7 @@ struct ssStepper {
   int in_step;           /* inside ssStepper_Step: its callbacks are running */
   int destroy_requested; /* ssStepper_Destroy was called from a callback: done when ssStepper_Step returns */
   ssStepInfo current;
-  /* a program softens many contacts with the same tuned numbers: the last ones' law is kept */
-  ssSoftness contact_tuned;
-  ssRowLaw contact_law;
+  ssContactCache contact_cache; /* a program softens many contacts with the same numbers */
   ssFrameReport* report; /* the frame being stepped, for ssStepper_SoftenContact's counts */
   ssPoseHistory* poses;  /* SS_CUT_FIXED: the known bodies' last two states, to draw (interpolation.c) */
   /* the first failure, latched until ssStepper_Reset */
@@ -141,7 +139,7 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
     stepper->def.registry = registry;
   }
   resolveSpeeds(&stepper->def.stepping);
-  stepper->contact_tuned = (ssSoftness){NAN, NAN};
+  stepper->contact_cache = ssContactCacheEmpty();
   describeNextStep(stepper);
   *out = stepper;
   return SS_OK;
@@ -296,17 +294,10 @@ ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID 
   const dSurfaceParameters* surface = &contact->surface;
   double erp = (surface->mode & dContactSoftERP) ? surface->soft_erp : world.erp;
   double cfm = (surface->mode & dContactSoftCFM) ? surface->soft_cfm : world.cfm;
-  if (erp != stepper->contact_tuned.erp || cfm != stepper->contact_tuned.cfm) {
-    ssRowLaw law;
-    ssStatus status = ssRowLawFromTuned("contact", erp, cfm, tuned_step_s, &law);
-    if (status != SS_OK) return status;
-    stepper->contact_tuned = (ssSoftness){erp, cfm};
-    stepper->contact_law = law;
-  }
   const ssStepInfo* step = &stepper->current;
   ssRowFallback handed_on;
-  ssStatus status = ssContactSoftenLaw(contact, body1, body2, &stepper->contact_law, step->mapping,
-                                       step->softness_step_s, step->previous_step_s, &handed_on);
+  ssStatus status = ssContactSoftenCached(&stepper->contact_cache, contact, body1, body2, erp, cfm, tuned_step_s,
+                                          step->mapping, step->softness_step_s, step->previous_step_s, &handed_on);
   if (status != SS_OK) return status;
   if (stepper->report != NULL) {
     ssServedCounts* contacts = &stepper->report->contacts;
