@@ -96,7 +96,8 @@ typedef struct SharedSoftness {
 
 static int sameLaw(const ssRowLaw* a, const ssRowLaw* b) {
   return a->hard == b->hard && a->spring.stiffness == b->spring.stiffness && a->spring.damping == b->spring.damping &&
-         a->hard_rate_per_s == b->hard_rate_per_s;
+         a->hard_rate_per_s == b->hard_rate_per_s && a->tuned_step_s == b->tuned_step_s &&
+         a->tuned.erp == b->tuned.erp && a->tuned.cfm == b->tuned.cfm;
 }
 
 /* Whether the row's law is the shared one's: by slot where both are in the law table (distinct there). */
@@ -364,7 +365,7 @@ static int writeRows(ssRegistry* registry, ssMapping mapping) {
 static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* softness) {
   for (int j = 0; j < registry->law_count; ++j) {
     const ssRowLaw* law = &registry->laws[j];
-    if (!law->hard) {
+    if (!law->hard && step_s != law->tuned_step_s) { /* at its tuned step, a law gives its tuned numbers back */
       /* ssSoftnessFromSpring's arithmetic without its checks, which every bound law passed for every step length
        * (ssCheckLawForEveryStep at bind time): cfm within ODE's range is all that is left to see */
       double hk_plus_c = step_s * law->spring.stiffness + law->spring.damping;

@@ -68,12 +68,16 @@ static ssStatus computeRow(const ssJointRowBinding* row, ssMapping mapping, doub
 
 static double stepsIn(double seconds, double step_s) { return ceil(seconds / step_s - 1e-9); }
 
-/* A body binding's values for the step, each written where ODE holds another. */
+/* A body binding's values for the step, each written where ODE holds another: at the step adoption read them for,
+ * the program's own numbers; at any other, what the rates and seconds stand for, with at most
+ * SS_MAX_AVERAGE_SAMPLES samples. */
 static void writeBody(const ssBodyBinding* binding, dWorldID world, double step_s) {
   dBodyID body = binding->body;
+  const ssBodyTuned* tuned = &binding->tuned;
   if (binding->has_damping) {
-    double linear = -expm1(-binding->linear_rate_per_s * step_s);
-    double angular = -expm1(-binding->angular_rate_per_s * step_s);
+    int as_tuned = step_s == tuned->damping_step_s;
+    double linear = as_tuned ? tuned->linear_scale : -expm1(-binding->linear_rate_per_s * step_s);
+    double angular = as_tuned ? tuned->angular_scale : -expm1(-binding->angular_rate_per_s * step_s);
     if (body) {
       if (dBodyGetLinearDamping(body) != linear) dBodySetLinearDamping(body, linear);
       if (dBodyGetAngularDamping(body) != angular) dBodySetAngularDamping(body, angular);
@@ -83,20 +87,20 @@ static void writeBody(const ssBodyBinding* binding, dWorldID world, double step_
     }
   }
   if (binding->has_auto_disable) {
+    int as_tuned = step_s == tuned->auto_disable_step_s;
     double steps = stepsIn(binding->idle_time_s, step_s);
-    int idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
-    double samples = fmax(1.0, stepsIn(binding->average_window_s, step_s));
-    unsigned average = samples < 1e6 ? (unsigned)samples : 1000000u;
+    int idle_steps = as_tuned ? tuned->idle_steps : steps < INT32_MAX ? (int)steps : INT32_MAX;
+    double idle_time_s = as_tuned ? tuned->idle_time_s : binding->idle_time_s;
+    double samples = fmin(fmax(1.0, stepsIn(binding->average_window_s, step_s)), SS_MAX_AVERAGE_SAMPLES);
+    unsigned average = as_tuned ? (unsigned)tuned->average_samples : (unsigned)samples;
     if (body) {
       if (dBodyGetAutoDisableSteps(body) != idle_steps) dBodySetAutoDisableSteps(body, idle_steps);
-      if (dBodyGetAutoDisableTime(body) != binding->idle_time_s)
-        dBodySetAutoDisableTime(body, binding->idle_time_s);
+      if (dBodyGetAutoDisableTime(body) != idle_time_s) dBodySetAutoDisableTime(body, idle_time_s);
       if ((unsigned)dBodyGetAutoDisableAverageSamplesCount(body) != average)
         dBodySetAutoDisableAverageSamplesCount(body, average);
     } else {
       if (dWorldGetAutoDisableSteps(world) != idle_steps) dWorldSetAutoDisableSteps(world, idle_steps);
-      if (dWorldGetAutoDisableTime(world) != binding->idle_time_s)
-        dWorldSetAutoDisableTime(world, binding->idle_time_s);
+      if (dWorldGetAutoDisableTime(world) != idle_time_s) dWorldSetAutoDisableTime(world, idle_time_s);
       if ((unsigned)dWorldGetAutoDisableAverageSamplesCount(world) != average)
         dWorldSetAutoDisableAverageSamplesCount(world, average);
     }
