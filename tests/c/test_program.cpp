@@ -430,8 +430,9 @@ void AlternatingNear(void* data, dGeomID a, dGeomID b) {
     ASSERT_EQ(ssStepper_SoftenContact(stepper, &contact[i], dGeomGetBody(a), dGeomGetBody(b)), SS_OK)
         << ssLastError();
     const ssStepInfo step = ssStepper_CurrentStep(stepper);
-    const double h0 = g_alternating->tuned_s;
-    const ssSpring spring = {erp / (h0 * cfm), (1 - erp) / cfm};
+    // the pair as the contact holds it (rounded once to dReal) is what the stepper reads
+    const double h0 = g_alternating->tuned_s, held_erp = AsDReal(erp), held_cfm = AsDReal(cfm);
+    const ssSpring spring = {held_erp / (h0 * held_cfm), (1 - held_erp) / held_cfm};
     ASSERT_EQ(ssContactSoften(&fresh, dGeomGetBody(a), dGeomGetBody(b), spring, step.mapping, step.softness_step_s,
                               step.previous_step_s),
               SS_OK)
