@@ -188,8 +188,8 @@ static ssStatus planBody(Plan* plan, dBodyID body) {
   if (status != SS_OK) return status;
   if (!pushPending(plan, body)) return outOfMemory();
   if (ssRegistryHasBody(plan->registry, body)) return SS_OK;
-  char what[64];
-  snprintf(what, sizeof what, "body %p", (void*)body);
+  /* the message names the body; it is written only on a refusal (one snprintf a body was 4.5 % of adopting) */
+  char what[64] = "body";
   PlannedBody planned;
   memset(&planned, 0, sizeof planned);
   planned.binding.body = body;
@@ -206,9 +206,9 @@ static ssStatus planBody(Plan* plan, dBodyID body) {
     binding->tuned.damping_step_s = world->tuned.damping_step_s;
     binding->tuned.linear_scale = world->tuned.linear_scale;
     binding->tuned.angular_scale = world->tuned.angular_scale;
-  } else {
-    status = dampingRates(what, linear, angular, plan->tuned_step_s, binding);
-    if (status != SS_OK) return status;
+  } else if ((status = dampingRates(what, linear, angular, plan->tuned_step_s, binding)) != SS_OK) {
+    snprintf(what, sizeof what, "body %p", (void*)body);
+    return dampingRates(what, linear, angular, plan->tuned_step_s, binding);
   }
   int steps = dBodyGetAutoDisableSteps(body), samples = dBodyGetAutoDisableAverageSamplesCount(body);
   double seconds = dBodyGetAutoDisableTime(body);
@@ -223,14 +223,20 @@ static ssStatus planBody(Plan* plan, dBodyID body) {
     binding->tuned.idle_steps = world->tuned.idle_steps;
     binding->tuned.idle_time_s = world->tuned.idle_time_s;
     binding->tuned.average_samples = world->tuned.average_samples;
-  } else {
-    status = autoDisableTimes(what, steps, seconds, samples, plan->tuned_step_s, binding);
-    if (status != SS_OK) return status;
+  } else if ((status = autoDisableTimes(what, steps, seconds, samples, plan->tuned_step_s, binding)) != SS_OK) {
+    snprintf(what, sizeof what, "body %p", (void*)body);
+    return autoDisableTimes(what, steps, seconds, samples, plan->tuned_step_s, binding);
   }
   if (!ssReserveOne((void**)&plan->bodies, plan->body_count, &plan->body_capacity, sizeof planned))
     return outOfMemory();
   plan->bodies[plan->body_count++] = planned;
   return SS_OK;
+}
+
+/* A row's law from its tuned ERP/CFM, writable at every step length. */
+static ssStatus planRowLaw(const char* what, double erp, double cfm, double tuned_step_s, ssRowLaw* law) {
+  ssStatus status = ssRowLawFromTuned(what, erp, cfm, tuned_step_s, law);
+  return status == SS_OK ? ssCheckLawForEveryStep(what, law) : status;
 }
 
 static ssStatus planRow(Plan* plan, dJointID joint, ssJointParam param, int axis) {
@@ -244,13 +250,12 @@ static ssStatus planRow(Plan* plan, dJointID joint, ssJointParam param, int axis
    * each step) stands for the world's tuned spring. Motor rows are dampers, whose cfm is adopted as it is. */
   if (param != SS_PARAM_MOTOR && erp == world_now.erp && cfm == world_now.cfm && worldLaw(plan, &world_law)) {
     row.law = world_law;
-  } else {
+  } else if (planRowLaw("row", erp, cfm, plan->tuned_step_s, &row.law) != SS_OK) {
+    /* refused: again, with the message naming the row (written only on a refusal, as for bodies) */
     char what[96];
     snprintf(what, sizeof what, "%s joint %p, %s axis %d", ssJointTypeName(joint), (void*)joint,
              ssJointParamName(param), axis);
-    ssStatus status = ssRowLawFromTuned(what, erp, cfm, plan->tuned_step_s, &row.law);
-    if (status == SS_OK) status = ssCheckLawForEveryStep(what, &row.law);
-    if (status != SS_OK) return status;
+    return planRowLaw(what, erp, cfm, plan->tuned_step_s, &row.law);
   }
   if (!ssReserveOne((void**)&plan->rows, plan->row_count, &plan->row_capacity, sizeof row)) return outOfMemory();
   plan->rows[plan->row_count++] = row;

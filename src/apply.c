@@ -238,9 +238,10 @@ static int sharesRow(const JointBinding* a, const JointBinding* b) {
          !a->law.hard && !b->law.hard;
 }
 
-/* Whether writing b over a would change nothing in ODE: a row without an erp (a motor) holds only its cfm. */
+/* Whether writing b over a would change nothing in ODE (as it stores them: in float, doubles that round alike are
+ * one value): a row without an erp (a motor) holds only its cfm. */
 static int sameWrite(int erp_number, const ssSoftness* a, const ssSoftness* b) {
-  return a->cfm == b->cfm && (erp_number < 0 || a->erp == b->erp);
+  return ssSameInOde(a->cfm, b->cfm) && (erp_number < 0 || ssSameInOde(a->erp, b->erp));
 }
 
 /* Apply's first pass in general: each row's mass and softness into pending, and the load corrections, all checked
@@ -391,8 +392,8 @@ static int writeRowsByLaw(ssRegistry* registry, const ssSoftness* softness) {
   int by_law = registry->written_by_law;
   int erp_changed[kLawTableSize], cfm_changed[kLawTableSize];
   for (int j = 0; j < registry->law_count; ++j) {
-    erp_changed[j] = softness[j].erp != registry->law_written[j].erp;
-    cfm_changed[j] = softness[j].cfm != registry->law_written[j].cfm;
+    erp_changed[j] = !ssSameInOde(softness[j].erp, registry->law_written[j].erp);
+    cfm_changed[j] = !ssSameInOde(softness[j].cfm, registry->law_written[j].cfm);
   }
   HotRow* hot = registry->hot_rows;
   for (int i = 0; i < registry->joint_count; ++i) {
@@ -458,8 +459,8 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   if (status != SS_OK) return status;
 
   /* Nothing below can fail. */
-  if (registry->world_bound && (dWorldGetERP(registry->world) != registry->world_pending.erp ||
-                                dWorldGetCFM(registry->world) != registry->world_pending.cfm)) {
+  if (registry->world_bound && (!ssSameInOde(dWorldGetERP(registry->world), registry->world_pending.erp) ||
+                                !ssSameInOde(dWorldGetCFM(registry->world), registry->world_pending.cfm))) {
     dWorldSetERP(registry->world, registry->world_pending.erp);
     dWorldSetCFM(registry->world, registry->world_pending.cfm);
     counts.row_writes += 1;

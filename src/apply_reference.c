@@ -139,7 +139,8 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
     return status;
   }
   dWorldID world_id = ssRegistryWorld(registry);
-  if (world_bound && (dWorldGetERP(world_id) != world.erp || dWorldGetCFM(world_id) != world.cfm)) {
+  if (world_bound &&
+      (!ssSameInOde(dWorldGetERP(world_id), world.erp) || !ssSameInOde(dWorldGetCFM(world_id), world.cfm))) {
     dWorldSetERP(world_id, world.erp);
     dWorldSetCFM(world_id, world.cfm);
     counts.row_writes += 1;
@@ -151,9 +152,9 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
     ssRowWriter writer;
     ssJointRowWriterOf(row.joint, row.param, row.axis, &writer);
     /* a motor row has no erp: ODE holds only its cfm */
-    int erp_differs = writer.erp_number >= 0 && erp != computed[i].softness.erp;
+    int erp_differs = writer.erp_number >= 0 && !ssSameInOde(erp, computed[i].softness.erp);
     /* a row bound since the last Apply is written whatever ODE holds (registry.h: binding again rewrites it) */
-    if (row.unwritten || erp_differs || cfm != computed[i].softness.cfm) {
+    if (row.unwritten || erp_differs || !ssSameInOde(cfm, computed[i].softness.cfm)) {
       ssRowWrite(&writer, row.joint, computed[i].softness.erp, computed[i].softness.cfm);
       ssRegistrySetRowWritten(registry, i, computed[i].softness);
       counts.row_writes += 1;

@@ -3,6 +3,7 @@
 // callback; refusals that leave the registry as it was.
 #include <cmath>
 #include <cstring>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -261,6 +262,17 @@ TEST_F(AdoptTest, BadInputIsRefusedByNameAndNothingIsBound) {
   EXPECT_NE(std::string(ssLastError()).find("erp = 1.5"), std::string::npos) << ssLastError();
   EXPECT_EQ(ssRegistry_JointBindingCount(registry), 0);
   EXPECT_EQ(ssRegistry_TunedStep(registry), 0.0);
+  // A body's value that stands for no rate (a damping scale of 1 or more) is named with its body.
+  dJointSetHingeParam(hinge, dParamStopERP, 0.2);
+  dBodySetLinearDamping(body, 1.5);
+  char named[64];
+  std::snprintf(named, sizeof named, "body %p", static_cast<void*>(body));
+  EXPECT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find(named), std::string::npos) << ssLastError();
+  EXPECT_NE(std::string(ssLastError()).find("1.5"), std::string::npos) << ssLastError();
+  EXPECT_EQ(ssRegistry_TunedStep(registry), 0.0);
+  dBodySetLinearDamping(body, 0);
+  dJointSetHingeParam(hinge, dParamStopERP, 1.5);
   const double world_erp = dWorldGetERP(world);
   ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 0.1, 0, nullptr), SS_OK);
   EXPECT_EQ(dWorldGetERP(world), world_erp);
