@@ -90,7 +90,7 @@ static const ssSpring DEFAULT_SPRING = {40.0, 0.5};
 
 /* ---- the process's world ---- */
 
-static WorldSettings read_settings(dWorldID world) {
+static inline WorldSettings read_settings(dWorldID world) {
   WorldSettings s;
   memset(&s, 0, sizeof s);
   dWorldGetGravity(world, s.gravity);
@@ -114,7 +114,7 @@ static WorldSettings read_settings(dWorldID world) {
   return s;
 }
 
-static void write_settings(dWorldID world, const WorldSettings* s) {
+static inline void write_settings(dWorldID world, const WorldSettings* s) {
   dWorldSetGravity(world, s->gravity[0], s->gravity[1], s->gravity[2]);
   dWorldSetERP(world, s->erp);
   dWorldSetCFM(world, s->cfm);
@@ -135,7 +135,7 @@ static void write_settings(dWorldID world, const WorldSettings* s) {
 }
 
 /* The process's world as saved: made at the first call, its settings put back at every later one. */
-static const Scene* scene_for_input(void) {
+static inline const Scene* scene_for_input(void) {
   static Scene scene;
   if (scene.world == 0) {
     dInitODE2(0);
@@ -158,7 +158,7 @@ static const Scene* scene_for_input(void) {
 
 /* ---- islands ---- */
 
-static dBodyID make_body(World* w, double x, double z) {
+static inline dBodyID make_body(World* w, double x, double z) {
   dBodyID body = dBodyCreate(w->world);
   dMass mass;
   dMassSetBoxTotal(&mass, 1.0, 0.2, 0.2, 0.2);
@@ -168,7 +168,7 @@ static dBodyID make_body(World* w, double x, double z) {
 }
 
 /* ODE has one parameter setter per joint type. */
-static void set_param(dJointID joint, int parameter, double value) {
+static inline void set_param(dJointID joint, int parameter, double value) {
   switch (dJointGetType(joint)) {
     case dJointTypeHinge: dJointSetHingeParam(joint, parameter, value); break;
     case dJointTypeSlider: dJointSetSliderParam(joint, parameter, value); break;
@@ -189,18 +189,18 @@ static void set_param(dJointID joint, int parameter, double value) {
   }
 }
 
-static void set_stops(dJointID joint, int axis_group, double lo, double hi) {
+static inline void set_stops(dJointID joint, int axis_group, double lo, double hi) {
   set_param(joint, dParamLoStop + axis_group, lo);
   set_param(joint, dParamHiStop + axis_group, hi);
 }
 
-static void set_motor(dJointID joint, int axis_group) {
+static inline void set_motor(dJointID joint, int axis_group) {
   set_param(joint, dParamVel + axis_group, 0.5);
   set_param(joint, dParamFMax + axis_group, 10.0);
 }
 
 /* Binds every (param, axis) the joint supports to the default spring. */
-static void bind_defaults(World* w, dJointID joint) {
+static inline void bind_defaults(World* w, dJointID joint) {
   if (joint == 0) return;
   for (int param = SS_PARAM_JOINT; param <= SS_PARAM_SUSPENSION; ++param)
     for (int axis = 1; axis <= 3; ++axis)
@@ -215,7 +215,7 @@ static void bind_defaults(World* w, dJointID joint) {
 
 /* Makes the island's bodies and joints. When tuned is given (adopt mode), the main joint's first soft row gets those
  * tuned ERP/CFM before adoption: values the program set, which adoption must either take or refuse by name. */
-static void build_island(World* w, int kind, const double* tuned) {
+static inline void build_island(World* w, int kind, const double* tuned) {
   Island* island = &w->islands[kind];
   memset(island, 0, sizeof *island);
   island->present = 1;
@@ -408,14 +408,14 @@ static void build_island(World* w, int kind, const double* tuned) {
 /* The documented way to destroy what the stepper knows: ssStepper_DestroyJoint for the island's joints, or
  * ssStepper_DestroyBody for its bodies (their geoms first). Joints first or bodies first are both valid (ODE then
  * detaches the joints, which stay bound until destroyed). */
-static void destroy_island_joints(World* w, int kind) {
+static inline void destroy_island_joints(World* w, int kind) {
   Island* island = &w->islands[kind];
   for (int i = 0; i < island->joint_count; ++i)
     FUZZ_REQUIRE(ssStepper_DestroyJoint(w->stepper, island->joints[i]) == SS_OK, "DestroyJoint: %s", ssLastError());
   island->joint_count = 0;
 }
 
-static void destroy_island_bodies(World* w, int kind) {
+static inline void destroy_island_bodies(World* w, int kind) {
   Island* island = &w->islands[kind];
   for (int i = 0; i < island->body_count; ++i) {
     if (island->geoms[i] != 0) dGeomDestroy(island->geoms[i]);
@@ -426,7 +426,7 @@ static void destroy_island_bodies(World* w, int kind) {
 
 /* ---- contacts ---- */
 
-static void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
+static inline void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
   ssStepper* stepper = data;
   World* w = current_world;
   dBodyID body1 = dGeomGetBody(geom1), body2 = dGeomGetBody(geom2);
@@ -463,13 +463,13 @@ static void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
   }
 }
 
-static void collide_all(World* w, ssStepper* stepper) { dSpaceCollide(w->space, stepper, near_callback); }
+static inline void collide_all(World* w, ssStepper* stepper) { dSpaceCollide(w->space, stepper, near_callback); }
 
 /* ---- states ---- */
 
 enum { STATE_CAPACITY = MAX_ISLANDS_PER_INPUT * MAX_ISLAND_BODIES };
 
-static int snapshot(const World* w, BodyState* out) {
+static inline int snapshot(const World* w, BodyState* out) {
   int count = 0;
   for (int k = 0; k < ISLAND_COUNT; ++k)
     for (int i = 0; i < w->islands[k].body_count && count < STATE_CAPACITY; ++i, ++count) {
@@ -484,7 +484,7 @@ static int snapshot(const World* w, BodyState* out) {
   return count;
 }
 
-static int all_finite(const BodyState* states, int count, int* which) {
+static inline int all_finite(const BodyState* states, int count, int* which) {
   for (int i = 0; i < count; ++i) {
     const dReal* values = states[i].position;
     for (size_t j = 0; j < sizeof states[i] / sizeof(dReal); ++j)
@@ -499,7 +499,7 @@ static int all_finite(const BodyState* states, int count, int* which) {
 /* ---- choosing ---- */
 
 /* Physics steps the frame would take (an upper bound, to within the FIXED accumulator's one step). */
-static double steps_for(const World* w, double frame_s) {
+static inline double steps_for(const World* w, double frame_s) {
   if (!(frame_s > 0) || !isfinite(frame_s)) return 0;
   switch (w->stepping.cut) {
     case SS_CUT_WHOLE_FRAME: return 1;
@@ -510,9 +510,9 @@ static double steps_for(const World* w, double frame_s) {
 }
 
 /* Whether the frame fits in what is left of the input's step budget. */
-static int within_budget(const World* w, double frame_s) { return steps_for(w, frame_s) <= w->steps_left; }
+static inline int within_budget(const World* w, double frame_s) { return steps_for(w, frame_s) <= w->steps_left; }
 
-static const char* joint_type_name(dJointID joint) {
+static inline const char* joint_type_name(dJointID joint) {
   static const char* names[] = {"none", "ball", "hinge", "slider", "contact", "universal", "hinge2", "fixed", "null",
                                 "amotor", "lmotor", "plane2d", "pr", "pu", "piston", "dball", "dhinge",
                                 "transmission"};
@@ -522,7 +522,7 @@ static const char* joint_type_name(dJointID joint) {
 }
 
 /* One of the input's joints, or 0 when it has none (which the library must refuse by name). */
-static dJointID pick_joint(World* w, uint8_t byte) {
+static inline dJointID pick_joint(World* w, uint8_t byte) {
   int count = 0;
   for (int k = 0; k < ISLAND_COUNT; ++k) count += w->islands[k].joint_count;
   if (count == 0) return 0;
@@ -535,7 +535,7 @@ static dJointID pick_joint(World* w, uint8_t byte) {
 }
 
 /* One of the input's bodies; 0xFF (or no body left) stands for the world's defaults. */
-static dBodyID pick_body(World* w, uint8_t byte) {
+static inline dBodyID pick_body(World* w, uint8_t byte) {
   if (byte == 0xFF) return 0;
   int count = 0;
   for (int k = 0; k < ISLAND_COUNT; ++k) count += w->islands[k].body_count;
@@ -549,7 +549,7 @@ static dBodyID pick_body(World* w, uint8_t byte) {
 }
 
 /* The island kind the byte names among those the input has, or -1. */
-static int pick_island(const World* w, uint8_t byte) {
+static inline int pick_island(const World* w, uint8_t byte) {
   int count = 0;
   for (int k = 0; k < ISLAND_COUNT; ++k) count += w->islands[k].present;
   if (count == 0) return -1;
@@ -562,18 +562,18 @@ static int pick_island(const World* w, uint8_t byte) {
 /* ---- checks ---- */
 
 /* A refused registry call names something and keeps the bindings as they were. */
-static void check_registry_call(World* w, ssStatus status, int bindings_before, const char* what) {
+static inline void check_registry_call(World* w, ssStatus status, int bindings_before, const char* what) {
   if (status == SS_OK) return;
   FUZZ_REQUIRE(ssLastError()[0] != '\0', "%s refused (%s) without a message", what, ssStatusName(status));
   FUZZ_REQUIRE(ssRegistry_JointBindingCount(w->registry) == bindings_before, "%s refused (%s) but the binding count "
                "went from %d to %d", what, ssLastError(), bindings_before, ssRegistry_JointBindingCount(w->registry));
 }
 
-static int same_double(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+static inline int same_double(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
 
 /* Whether the stepper holds the stepping it was given: every field as given, except that a speed limit of 0 stands
  * for the guard ODE itself needs (stepping.h), which the stepper fills in. Field by field: padding is no state. */
-static int holds_stepping(const ssStepping* held, const ssStepping* given) {
+static inline int holds_stepping(const ssStepping* held, const ssStepping* given) {
   double max_speed = given->max_speed == 0 ? held->max_speed : given->max_speed;
   double max_angular_speed = given->max_angular_speed == 0 ? held->max_angular_speed : given->max_angular_speed;
   return held->cut == given->cut && held->mapping == given->mapping &&
@@ -590,7 +590,7 @@ static int holds_stepping(const ssStepping* held, const ssStepping* given) {
 /* Reads the input's header (islands, the stepper's fields, adoption) and makes its registry, stepper and islands in
  * the process's world. def_template gives the callbacks; the world, registry, collide and contact group are set
  * here. The header: [islands] [cut, mapping, solver] [fields] [the fields' values...]. */
-static void make_world(World* w, FuzzInput* in, const ssStepperDef* def_template) {
+static inline void make_world(World* w, FuzzInput* in, const ssStepperDef* def_template) {
   const Scene* scene = scene_for_input();
   memset(w, 0, sizeof *w);
   current_world = w;
@@ -669,7 +669,7 @@ static void make_world(World* w, FuzzInput* in, const ssStepperDef* def_template
 }
 
 /* Destroys what the input made, leaving the process's world empty for the next one. */
-static void destroy_world(World* w) {
+static inline void destroy_world(World* w) {
   for (int k = 0; k < ISLAND_COUNT; ++k) {
     destroy_island_joints(w, k);
     destroy_island_bodies(w, k);
