@@ -10,8 +10,8 @@
  *
  * Promises checked: the process never aborts and no sanitizer reports (ODE's asserts included: nothing the program
  * does the ordinary way may make ODE abort); every refusal is a named ssStatus with a non-empty ssLastError(); a
- * frame reported OK leaves every body finite (unless the program itself set a state after the frame's last check,
- * in the last step_done). Actions fire only in the outermost frame's callbacks: a frame stepped from a callback
+ * frame reported OK that took a step leaves every body finite (unless the program itself set a state after the
+ * frame's last check, in the last step_done). Actions fire only in the outermost frame's callbacks: a frame stepped from a callback
  * (before the stepper refused re-entry) runs the contacts only. */
 #include "fuzz_world.h"
 
@@ -281,7 +281,8 @@ static void frame(Program* p, double frame_s, int op) {
     return;
   }
   w->steps_left -= report.steps > 0 ? report.steps : 0;
-  if (status == SS_OK && !p->set_after_check) {
+  /* A frame that takes no step (0 s, or carried over) hands ODE nothing: a state the program set stays as set. */
+  if (status == SS_OK && report.steps > 0 && !p->set_after_check) {
     BodyState after[STATE_CAPACITY];
     int count = snapshot(w, after), which = -1;
     FUZZ_REQUIRE(all_finite(after, count, &which), "op %d: frame %.17g s reported OK but body %d is not finite", op,
