@@ -88,6 +88,7 @@ static Scene build(int with_stepper) {
   ssStepperDef def = ssDefaultStepperDef();
   def.world = scene.world;
   def.registry = scene.registry;
+  def.stepping.solver = SS_SOLVER_QUICK;
   def.stepping.max_step_s = kFrame_s;
   def.stepping.max_speed = 1000;
   check(ssStepper_Create(&def, &scene.stepper), "stepper");

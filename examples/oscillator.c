@@ -175,6 +175,7 @@ int main(int argc, char** argv) {
   def.stepping = stepping;
   def.stepping.solver = o.use_step ? SS_SOLVER_STEP : SS_SOLVER_QUICK;
   def.stepping.max_step_s = o.max_step_s;
+  def.stepping.fixed_step_s = 1.0 / 60; /* as the lab's (steadystep run) */
   def.stepping.max_speed = 100; /* m/s, as the lab's scenes: nothing here moves near that fast unless it exploded */
   def.step_done = printStep;
   def.step_done_context = &recorder;

@@ -117,6 +117,7 @@ int main(int argc, char** argv) {
   /* naive freezes the softness at the step the numbers were tuned for: the program's own stepping */
   ssStepping stepping = ssDefaultStepping();
   stepping.max_step_s = flags.max_step_s;
+  stepping.solver = SS_SOLVER_QUICK; /* steadystep: the ODE step this program calls */
   if (ssSteppingForPolicy(flags.policy, 1.0 / 60, &stepping) != SS_OK)
     return exampleRefuse(&flags, PROGRAM, "--policy", flags.policy, ssLastError());
   box_count = flags.boxes;

@@ -15,7 +15,7 @@ static double contactMass(const dContact* contact, dBodyID body1, dBodyID body2)
 }
 
 ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
-                            double step_s, double previous_step_s, int* implicit_euler_fallback) {
+                            double step_s, double previous_step_s, ssRowFallback* handed_on) {
   double mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard ? NAN : contactMass(contact, body1, body2);
   ssSoftness softness;
   ssRowFallback fallback;
@@ -25,7 +25,7 @@ ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, con
   contact->surface.mode |= dContactSoftERP | dContactSoftCFM;
   contact->surface.soft_erp = softness.erp;
   contact->surface.soft_cfm = softness.cfm;
-  if (implicit_euler_fallback != NULL) *implicit_euler_fallback = fallback.to_implicit_euler;
+  if (handed_on != NULL) *handed_on = fallback;
   return SS_OK;
 }
 

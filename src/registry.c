@@ -24,8 +24,8 @@ typedef struct JointBinding {
   ssJointParam param;
   int axis;
   int law_slot; /* the law in the registry's table; -1: not there, read law */
-  /* the mass the last Apply gave the row (NAN: none): the input of its softness under the accurate mappings, and
-   * under implicit Euler, which needs it only for the Nyquist report, the one measured every few Applies */
+  /* the mass the last Apply of an accurate mapping gave the row (NAN: none), the input of its softness (implicit
+   * Euler reads no mass) */
   double mass;
 
   ssSoftness pending; /* computed in the general first pass */
@@ -49,7 +49,6 @@ typedef struct JointBinding {
 typedef struct HotRow {
   dJointID joint;
   ssParamSetter set; /* the row's writer: NULL for a row without softness */
-  double mass;
   int16_t erp_number, cfm_number; /* ODE's parameter numbers (below 0x400); erp_number -1: none */
   int16_t law_slot;
 } HotRow;
@@ -91,7 +90,6 @@ struct ssRegistry {
   int body_cache_stale;
   unsigned apply_stamp;
   int loaded_rows; /* bindings with a load, counted with the body cache: Apply skips the load passes without */
-  int report_mass_age; /* implicit-Euler Applies until the report's masses are computed again; 0 after a rebinding */
   /* the distinct laws of the bindings (programs bind many rows to a few springs), rebuilt with the body cache */
   ssRowLaw laws[kLawTableSize];
   int law_count;
@@ -372,15 +370,11 @@ static ssStatus failBinding(ssStatus status, const JointBinding* binding) {
                 ssJointParamName(binding->param), binding->axis, cause);
 }
 
-/* How many Applies of the implicit-Euler mapping reuse a computed effective mass for the Nyquist report. */
-enum { kReportMassRefresh = 16 };
-
-/* Counts one row of this Apply in the report: how its softness was obtained, and whether it is above Nyquist. */
-static void countRow(const ssRowLaw* law, double mass, double step_s, const ssRowFallback* fallback,
-                     ssApplyReport* report) {
-  report->rows_exact_fallback += fallback->exact_to_matched;
-  report->rows_implicit_euler_fallback += fallback->to_implicit_euler;
-  if (!law->hard) report->rows_over_nyquist += ssOverNyquist(law->spring, mass, step_s);
+/* Counts one row of this Apply in the report, once, by who served it. */
+static void countRow(const ssRowFallback* fallback, ssApplyReport* report) {
+  if (fallback->to_implicit_euler) report->rows.handed_to_implicit_euler += 1;
+  else if (fallback->exact_to_matched) report->rows.handed_to_matched += 1;
+  else report->rows.by_mapping += 1;
 }
 
 /* The softness of one row for this step, counting in the report how it was obtained. */
@@ -388,7 +382,7 @@ static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass,
                             double previous_step_s, ssApplyReport* report, ssRowFallback* fallback,
                             ssSoftness* out) {
   ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, fallback, out);
-  countRow(law, mass, step_s, fallback, report);
+  countRow(fallback, report);
   return status;
 }
 
@@ -462,7 +456,6 @@ static void rebuildApplyCache(ssRegistry* registry) {
     }
   registry->body_cache = cache;
   registry->body_cache_count = count;
-  registry->report_mass_age = 0;
   registry->law_count = 0;
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
@@ -482,7 +475,6 @@ static void rebuildApplyCache(ssRegistry* registry) {
     const JointBinding* binding = &registry->joints[i];
     registry->hot_rows[i] = (HotRow){.joint = binding->joint,
                                      .set = binding->writer.set,
-                                     .mass = binding->mass,
                                      .erp_number = (int16_t)binding->writer.erp_number,
                                      .cfm_number = (int16_t)binding->writer.cfm_number,
                                      .law_slot = (int16_t)binding->law_slot};
@@ -524,7 +516,7 @@ static double rowMass(ssRegistry* registry, const JointBinding* binding) {
 }
 
 /* The binding's mass for this Apply: given, or measured from the bodies when `measure` (every Apply of the accurate
- * mappings; every few of the implicit-Euler mapping, which needs it only for the Nyquist report), or the last one.
+ * mappings), or the last one (implicit Euler, which reads none).
  * NAN when the row has none (no dynamic body, or a transmission): the accurate mappings then hand the row to the
  * implicit-Euler mapping. */
 static double bindingMass(ssRegistry* registry, const JointBinding* binding, const ssRowLaw* law, int measure) {
@@ -607,12 +599,11 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     if (mapping != SS_MAPPING_IMPLICIT_EULER && binding->computed_epoch == registry->reuse_epoch &&
         binding->computed_mapping == mapping && binding->mass == mass && binding->computed_step_s == step_s &&
         binding->computed_previous_s == previous_s) {
-      countRow(law, mass, step_s, &binding->computed_fallback, counts);
+      countRow(&binding->computed_fallback, counts);
       *unwritten += !sameSoftness(&binding->pending, &binding->written);
       continue;
     }
     binding->mass = mass;
-    registry->hot_rows[i].mass = mass;
     int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
     const SharedSoftness* hit = NULL;
     for (int j = 0; j < shared_count && hit == NULL; ++j)
@@ -620,7 +611,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     if (hit != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
-      countRow(law, mass, step_s, &hit->fallback, counts);
+      countRow(&hit->fallback, counts);
     } else {
       status = softnessFor(law, mapping, mass, step_s, previous_s, counts, &binding->computed_fallback,
                            &binding->pending);
@@ -658,8 +649,11 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
          * whose static stiffness is k itself, serves the row (as for every row an accurate mapping cannot) */
         status = ssSoftnessFromSpring(*spring, step_s, &binding->pending);
         if (status != SS_OK) return failBinding(status, binding);
+        /* counted once: moved from who was to serve it */
+        if (binding->computed_fallback.exact_to_matched) counts->rows.handed_to_matched -= 1;
+        else counts->rows.by_mapping -= 1;
+        counts->rows.handed_to_implicit_euler += 1;
         binding->computed_fallback = (ssRowFallback){0, 1};
-        counts->rows_implicit_euler_fallback += 1;
         correction = 0;
       }
       binding->load_correction = correction;
@@ -669,14 +663,17 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
   return SS_OK;
 }
 
-/* Apply's second pass in general: the rows whose softness changed, then the load forces. */
-static void writeRows(ssRegistry* registry, ssMapping mapping) {
+/* Apply's second pass in general: the rows whose softness changed, then the load forces. Returns the rows
+ * written. */
+static int writeRows(ssRegistry* registry, ssMapping mapping) {
+  int writes = 0;
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
     PREFETCH_ROWS(registry, i, 2);
     if (sameSoftness(&binding->pending, &binding->written)) continue;
     ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
     binding->written = binding->pending;
+    writes += 1;
   }
   if (mapping != SS_MAPPING_IMPLICIT_EULER && registry->loaded_rows > 0) {
     for (int i = 0; i < registry->joint_count; ++i) {
@@ -685,6 +682,7 @@ static void writeRows(ssRegistry* registry, ssMapping mapping) {
         ssJointAddRowForce(binding->joint, binding->param, binding->axis, binding->load_correction);
     }
   }
+  return writes;
 }
 
 /* Implicit Euler when every row's law is in the table: the softness of each law, checked (the only part that can
@@ -701,13 +699,11 @@ static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* s
   return SS_OK;
 }
 
-/* The one pass of lawSoftnesses' case: each row's mass for the Nyquist report, and its law's softness written
- * where it changed. Nothing here can fail. Between the Applies that measure the masses, it reads the rows' hot
- * records and nothing else: where every row of a law was written by the last such pass, law_written says what ODE
- * holds. */
-static void writeRowsByLaw(ssRegistry* registry, double step_s, int measure, const ssSoftness* softness,
-                           ssApplyReport* counts) {
-  double last_mass = NAN;
+/* The one pass of lawSoftnesses' case: each row's law's softness written where it changed. Nothing here can
+ * fail. It reads the rows' hot records and nothing else: where every row of a law was written by the last such
+ * pass, law_written says what ODE holds. Returns the rows written. */
+static int writeRowsByLaw(ssRegistry* registry, const ssSoftness* softness) {
+  int writes = 0;
   int by_law = registry->written_by_law;
   int changed[kLawTableSize];
   for (int j = 0; j < registry->law_count; ++j)
@@ -718,18 +714,6 @@ static void writeRowsByLaw(ssRegistry* registry, double step_s, int measure, con
 #if defined(__GNUC__)
     if (i + kPrefetchAhead / 2 < registry->joint_count) __builtin_prefetch(hot[i + kPrefetchAhead / 2].joint);
 #endif
-    const ssRowLaw* law = &registry->laws[row->law_slot];
-    if (measure) {
-      JointBinding* binding = &registry->joints[i];
-      PREFETCH_ROWS(registry, i, 2);
-      const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
-      int same_row =
-          before != NULL && sharesRow(before, binding) && binding->effective_mass == before->effective_mass;
-      binding->mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
-      row->mass = binding->mass;
-      last_mass = binding->mass;
-    }
-    if (!law->hard) counts->rows_over_nyquist += ssOverNyquist(law->spring, row->mass, step_s);
     const ssSoftness* law_softness = &softness[row->law_slot];
     if (by_law) {
       if (!changed[row->law_slot]) continue;
@@ -740,9 +724,11 @@ static void writeRowsByLaw(ssRegistry* registry, double step_s, int measure, con
     if (row->set == NULL) continue;
     if (row->erp_number >= 0) row->set(row->joint, row->erp_number, law_softness->erp);
     row->set(row->joint, row->cfm_number, law_softness->cfm);
+    writes += 1;
   }
   for (int j = 0; j < registry->law_count; ++j) registry->law_written[j] = softness[j];
   registry->written_by_law = 1;
+  return writes;
 }
 
 ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
@@ -757,10 +743,10 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
    * written already (a program with constant frames pays nothing here) */
   if (mapping == SS_MAPPING_IMPLICIT_EULER && registry->applied_mapping == mapping &&
       registry->applied_step_s == step_s && registry->applied_revision == registry->revision) {
-    if (report != NULL) *report = registry->applied_counts;
+    if (report != NULL) *report = (ssApplyReport){registry->applied_counts.rows, 0};
     return SS_OK;
   }
-  ssApplyReport counts = {0, 0, 0, 0};
+  ssApplyReport counts = {{0, 0, 0}, 0};
   if (registry->body_cache_stale || registry->body_cache_revision != registry->revision) rebuildApplyCache(registry);
   if (++registry->apply_stamp == 0) { /* after 2^32 Applies: no cached body may look computed for this one */
     for (int i = 0; i < registry->body_cache_count; ++i) registry->body_cache[i].stamp = 0;
@@ -774,7 +760,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
       status = ssCheckSoftnessForOde("softness", registry->world_pending.erp, registry->world_pending.cfm);
     if (status != SS_OK) return failBinding(status, NULL);
   }
-  int measure = mapping != SS_MAPPING_IMPLICIT_EULER || registry->report_mass_age == 0;
+  int measure = mapping != SS_MAPPING_IMPLICIT_EULER; /* implicit Euler reads no mass */
   int by_law = mapping == SS_MAPPING_IMPLICIT_EULER && registry->rows_outside_laws == 0;
   ssSoftness law_softness[kLawTableSize];
   if (!by_law) materializeWritten(registry); /* computeRows and writeRows compare each row's own */
@@ -785,19 +771,19 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   if (status != SS_OK) return status;
 
   /* Nothing below can fail. */
-  if (mapping == SS_MAPPING_IMPLICIT_EULER) {
-    registry->report_mass_age = measure ? kReportMassRefresh - 1 : registry->report_mass_age - 1;
-    registry->reuse_epoch += 1;
-  }
-  if (registry->world_bound) {
+  if (mapping == SS_MAPPING_IMPLICIT_EULER) registry->reuse_epoch += 1;
+  if (registry->world_bound && (dWorldGetERP(registry->world) != registry->world_pending.erp ||
+                                dWorldGetCFM(registry->world) != registry->world_pending.cfm)) {
     dWorldSetERP(registry->world, registry->world_pending.erp);
     dWorldSetCFM(registry->world, registry->world_pending.cfm);
-    counts.rows_written += 1;
+    counts.row_writes += 1;
   }
-  if (by_law) writeRowsByLaw(registry, step_s, measure, law_softness, &counts);
-  else if (unwritten > 0 || (mapping != SS_MAPPING_IMPLICIT_EULER && registry->loaded_rows > 0))
-    writeRows(registry, mapping);
-  counts.rows_written += registry->joint_count;
+  if (by_law) {
+    counts.rows.by_mapping += registry->joint_count; /* implicit Euler serves every row */
+    counts.row_writes += writeRowsByLaw(registry, law_softness);
+  } else if (unwritten > 0 || (mapping != SS_MAPPING_IMPLICIT_EULER && registry->loaded_rows > 0)) {
+    counts.row_writes += writeRows(registry, mapping);
+  }
   for (int i = 0; i < registry->body_count; ++i) {
     ssBodyBinding* binding = &registry->bodies[i];
     if (binding->written_step_s != step_s) writeBody(binding, registry->world, step_s);

@@ -48,9 +48,9 @@ ssSoftness ssRegistryTunedWorld(const ssRegistry* registry);
 /* Undoes ssRegistry_AdoptWorld, when the rest of an adoption failed. */
 void ssRegistryForgetWorldAdoption(ssRegistry* registry);
 
-/* ssContactSoften for a law, without checking its arguments; *implicit_euler_fallback (may be NULL) says whether the
- * accurate mapping handed the contact to the implicit-Euler mapping. */
+/* ssContactSoften for a law, without checking its arguments; *fallback (may be NULL) says whether the accurate
+ * mapping handed the contact on (to matched, or to implicit Euler). */
 ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
-                            double step_s, double previous_step_s, int* implicit_euler_fallback);
+                            double step_s, double previous_step_s, ssRowFallback* fallback);
 
 #endif

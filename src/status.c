@@ -21,6 +21,8 @@ const char* ssStatusName(ssStatus status) {
     case SS_ERROR_SPEED_LIMIT: return "speed limit";
     case SS_ERROR_OUT_OF_MEMORY: return "out of memory";
     case SS_ERROR_FAILED: return "failed earlier";
+    case SS_ERROR_POSITION_LIMIT: return "position limit";
+    case SS_ERROR_REENTERED: return "reentered";
   }
   return "unknown status";
 }

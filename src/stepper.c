@@ -25,7 +25,10 @@ typedef struct KnownBody {
 } KnownBody;
 
 struct ssStepper {
-  ssStepperDef def;
+  ssStepperDef def;            /* def.registry: the registry in use, the given one or owned_registry */
+  ssRegistry* owned_registry;  /* made for def.space when no registry was given */
+  double tuned_step_s;         /* 0: none */
+  ssAdoptReport adopted;       /* what adoption reached, summed */
   double previous_step_s; /* 0: no usable history */
   double accumulator_s;   /* FIXED: time not yet stepped */
   double short_frame_s;   /* other policies: frames too short to step, carried */
@@ -61,7 +64,28 @@ ssStepperDef ssDefaultStepperDef(void) {
 static ssStatus validateDef(const ssStepperDef* def) {
   if (def == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "def = NULL: a definition is required");
   if (def->world == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "world = NULL: a world is required");
+  if (def->registry != NULL && ssRegistryWorld(def->registry) != def->world)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "registry of world %p: not def.world = %p", (void*)ssRegistryWorld(def->registry),
+                  (void*)def->world);
+  if (def->space != 0 && def->tuned_step_s == 0)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "tuned_step_s = 0 s: with a space, say which step the program was tuned for");
+  if (def->tuned_step_s != 0) {
+    ssStatus status = ssCheckStepLength("tuned_step_s", def->tuned_step_s);
+    if (status != SS_OK) return status;
+  }
   return ssValidateStepping(&def->stepping);
+}
+
+/* stepping's max_step_s and fixed_step_s of 0 stand for the tuned step; the one the cut uses must have one. */
+static ssStatus resolveSteps(ssStepping* stepping, double tuned_step_s) {
+  if (stepping->max_step_s == 0) stepping->max_step_s = tuned_step_s;
+  if (stepping->fixed_step_s == 0) stepping->fixed_step_s = tuned_step_s;
+  const char* missing = stepping->cut == SS_CUT_SUBSTEPS && stepping->max_step_s == 0  ? "max_step_s"
+                        : stepping->cut == SS_CUT_FIXED && stepping->fixed_step_s == 0 ? "fixed_step_s"
+                                                                                        : NULL;
+  if (missing == NULL) return SS_OK;
+  return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.%s = 0 s (the tuned step), but there is no tuned step: set "
+                                       "def.tuned_step_s, adopt into the registry, or give stepping.%s", missing, missing);
 }
 
 /* The step length a step's softness is computed for: its own, or the frozen one. */
@@ -72,6 +96,7 @@ static double softnessStep(const ssStepping* stepping, double step_s) {
 static void describeNextStep(ssStepper* stepper) {
   const ssStepping* stepping = &stepper->def.stepping;
   double step_s = stepping->cut == SS_CUT_FIXED ? stepping->fixed_step_s : stepping->max_step_s;
+  if (step_s == 0) step_s = stepping->cut == SS_CUT_FIXED ? stepping->max_step_s : stepping->fixed_step_s;
   stepper->current =
       (ssStepInfo){stepping->mapping, step_s, softnessStep(stepping, step_s), stepper->previous_step_s, 0, 1};
 }
@@ -86,9 +111,27 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   ssStatus status = validateDef(def);
   if (status != SS_OK) return status;
   if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the stepper");
+  double tuned_step_s = def->tuned_step_s != 0 ? def->tuned_step_s : ssRegistry_TunedStep(def->registry);
+  ssStepping stepping = def->stepping;
+  if ((status = resolveSteps(&stepping, tuned_step_s)) != SS_OK) return status;
   ssStepper* stepper = calloc(1, sizeof *stepper);
   if (stepper == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating a stepper");
   stepper->def = *def;
+  stepper->def.stepping = stepping;
+  stepper->tuned_step_s = tuned_step_s;
+  if (def->space != 0) {
+    ssRegistry* registry = def->registry;
+    if (registry == NULL && (registry = stepper->owned_registry = ssRegistry_Create(def->world)) == NULL) {
+      free(stepper);
+      return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating the stepper's registry");
+    }
+    if ((status = ssRegistry_Adopt(registry, tuned_step_s, def->space, &stepper->adopted)) != SS_OK) {
+      ssRegistry_Destroy(stepper->owned_registry);
+      free(stepper);
+      return status;
+    }
+    stepper->def.registry = registry;
+  }
   resolveSpeeds(&stepper->def.stepping);
   stepper->contact_tuned = (ssSoftness){NAN, NAN};
   describeNextStep(stepper);
@@ -98,6 +141,7 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
 
 void ssStepper_Destroy(ssStepper* stepper) {
   if (stepper == NULL) return;
+  ssRegistry_Destroy(stepper->owned_registry);
   free(stepper->watched);
   free(stepper->known);
   free(stepper->known_ids);
@@ -185,7 +229,9 @@ ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping) {
   REQUIRE_STEPPER(stepper);
   ssStatus status = ssValidateStepping(stepping);
   if (status != SS_OK) return status;
-  stepper->def.stepping = *stepping;
+  ssStepping resolved = *stepping;
+  if ((status = resolveSteps(&resolved, stepper->tuned_step_s)) != SS_OK) return status;
+  stepper->def.stepping = resolved;
   resolveSpeeds(&stepper->def.stepping);
   stepper->previous_step_s = 0;
   stepper->accumulator_s = 0;
@@ -225,13 +271,15 @@ ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID 
     stepper->contact_law = law;
   }
   const ssStepInfo* step = &stepper->current;
-  int fell_back = 0;
+  ssRowFallback handed_on;
   ssStatus status = ssContactSoftenLaw(contact, body1, body2, &stepper->contact_law, step->mapping,
-                                       step->softness_step_s, step->previous_step_s, &fell_back);
+                                       step->softness_step_s, step->previous_step_s, &handed_on);
   if (status != SS_OK) return status;
   if (stepper->report != NULL) {
-    stepper->report->contacts_softened += 1;
-    stepper->report->contacts_implicit_euler_fallback += fell_back;
+    ssServedCounts* contacts = &stepper->report->contacts;
+    if (handed_on.to_implicit_euler) contacts->handed_to_implicit_euler += 1;
+    else if (handed_on.exact_to_matched) contacts->handed_to_matched += 1;
+    else contacts->by_mapping += 1;
   }
   return SS_OK;
 }
@@ -383,17 +431,21 @@ static ssStatus latch(ssStepper* stepper, ssStatus status) {
   return status;
 }
 
+/* The registry's Apply for a step; *applied says who served the rows (counted for every step they serve). */
 static ssStatus apply(ssStepper* stepper, ssMapping mapping, double step_s, double previous_step_s,
-                      ssFrameReport* report) {
+                      ssApplyReport* applied, ssFrameReport* report) {
+  *applied = (ssApplyReport){{0, 0, 0}, 0};
   if (stepper->def.registry == NULL) return SS_OK;
-  ssApplyReport applied;
-  ssStatus status = ssRegistry_Apply(stepper->def.registry, mapping, step_s, previous_step_s, &applied);
+  ssStatus status = ssRegistry_Apply(stepper->def.registry, mapping, step_s, previous_step_s, applied);
   if (status != SS_OK) return status;
-  report->apply.rows_written += applied.rows_written;
-  report->apply.rows_over_nyquist += applied.rows_over_nyquist;
-  report->apply.rows_exact_fallback += applied.rows_exact_fallback;
-  report->apply.rows_implicit_euler_fallback += applied.rows_implicit_euler_fallback;
+  report->row_writes += applied->row_writes;
   return SS_OK;
+}
+
+static void addServed(ssServedCounts* sum, const ssServedCounts* counts) {
+  sum->by_mapping += counts->by_mapping;
+  sum->handed_to_matched += counts->handed_to_matched;
+  sum->handed_to_implicit_euler += counts->handed_to_implicit_euler;
 }
 
 /* Takes a frame's `steps` steps of step_s: everything else about them (mapping, the softness' step, history)
@@ -408,11 +460,12 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
   int apply_every_step = mapping != SS_MAPPING_IMPLICIT_EULER;
   int use_history = mapping == SS_MAPPING_EXACT && stepping->frozen_step_s == 0;
   if (stepping->quick_iterations > 0) dWorldSetQuickStepNumIterations(def->world, stepping->quick_iterations);
+  ssApplyReport applied;
   for (int i = 0; i < steps; ++i) {
     double previous_step_s = use_history ? stepper->previous_step_s : 0;
     putForces(stepper, frame_s, steps, step_s);
     if (i == 0 || apply_every_step) {
-      ssStatus status = apply(stepper, mapping, softness_step_s, previous_step_s, report);
+      ssStatus status = apply(stepper, mapping, softness_step_s, previous_step_s, &applied, report);
       if (status != SS_OK) return status;
     }
     stepper->current = (ssStepInfo){mapping, step_s, softness_step_s, previous_step_s, i, steps};
@@ -423,6 +476,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     if (def->contact_group) dJointGroupEmpty(def->contact_group);
     if (!stepped) return latch(stepper, ssFail(SS_ERROR_OUT_OF_MEMORY, "ODE ran out of memory in its step"));
     report->steps += 1;
+    addServed(&report->rows, &applied.rows);
     report->step_s = step_s;
     report->simulated_s += step_s;
     for (int k = 0; k < stepper->known_count; ++k) {
@@ -458,7 +512,14 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
     steps = count < 1 ? 1 : (int)count;
   }
   stepper->short_frame_s = 0;
-  ssStatus status = takeSteps(stepper, steps, total_s / steps, frame_s, report);
+  double step_s = total_s / steps;
+  if (stepping->cut == SS_CUT_SUBSTEPS && steps > stepping->max_steps_per_frame) {
+    /* a long frame (a breakpoint, a hitch) is cut off like the fixed cut's: the rest is dropped, and reported */
+    steps = stepping->max_steps_per_frame;
+    step_s = stepping->max_step_s;
+    report->dropped_s = total_s - steps * step_s;
+  }
+  ssStatus status = takeSteps(stepper, steps, step_s, fmax(frame_s - report->dropped_s, 0), report);
   clearCarried(stepper);
   return status;
 }
@@ -479,7 +540,7 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
   if (due == 0) {
     carryForces(stepper, frame_s);
   } else {
-    status = takeSteps(stepper, (int)due, step_s, frame_s, report);
+    status = takeSteps(stepper, (int)due, step_s, fmax(frame_s - report->dropped_s, 0), report);
     clearCarried(stepper);
   }
   stepper->accumulator_s = fmax(accumulator_s - report->steps * step_s, 0);

@@ -12,11 +12,11 @@ ssStepping ssDefaultStepping(void) {
       .cut = SS_CUT_SUBSTEPS,
       .mapping = SS_MAPPING_IMPLICIT_EULER,
       .frozen_step_s = 0,
-      .solver = SS_SOLVER_QUICK,
+      .solver = SS_SOLVER_UNSET,
       .quick_iterations = 0,
-      .max_step_s = 1.0 / 60.0,
-      .fixed_step_s = 1.0 / 60.0,
-      .max_steps_per_frame = 8,
+      .max_step_s = 0,
+      .fixed_step_s = 0,
+      .max_steps_per_frame = 32,
       .max_speed = 1e4,
       .max_angular_speed = 1e4,
   };
@@ -47,16 +47,22 @@ ssStatus ssValidateStepping(const ssStepping* stepping) {
   if (ssMappingName(stepping->mapping) == NULL)
     return ssFail(SS_ERROR_UNSUPPORTED, "stepping.mapping = %d: unknown (0 implicit-euler, 1 matched, 2 exact)",
                   (int)stepping->mapping);
+  if (stepping->solver == SS_SOLVER_UNSET)
+    return ssFail(SS_ERROR_UNSUPPORTED, "stepping.solver = unset: say which ODE step the program calls "
+                                        "(SS_SOLVER_QUICK for dWorldQuickStep, SS_SOLVER_STEP for dWorldStep)");
   if (stepping->solver != SS_SOLVER_QUICK && stepping->solver != SS_SOLVER_STEP)
-    return ssFail(SS_ERROR_UNSUPPORTED, "stepping.solver = %d: unknown (0 quick, 1 step)", (int)stepping->solver);
+    return ssFail(SS_ERROR_UNSUPPORTED, "stepping.solver = %d: unknown (1 quick, 2 step)", (int)stepping->solver);
   if (stepping->quick_iterations < 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.quick_iterations = %d: must not be negative (0 = the world's own)",
                   stepping->quick_iterations);
   if (stepping->max_steps_per_frame <= 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.max_steps_per_frame = %d: must be positive",
                   stepping->max_steps_per_frame);
-  ssStatus status = ssCheckStepLength("stepping.max_step_s", stepping->max_step_s);
-  if (status == SS_OK) status = ssCheckStepLength("stepping.fixed_step_s", stepping->fixed_step_s);
+  ssStatus status = SS_OK;
+  /* 0: the tuned step, resolved (or refused) by the stepper */
+  if (stepping->max_step_s != 0) status = ssCheckStepLength("stepping.max_step_s", stepping->max_step_s);
+  if (status == SS_OK && stepping->fixed_step_s != 0)
+    status = ssCheckStepLength("stepping.fixed_step_s", stepping->fixed_step_s);
   if (status == SS_OK && stepping->frozen_step_s != 0)
     status = ssCheckStepLength("stepping.frozen_step_s", stepping->frozen_step_s);
   if (status == SS_OK) status = checkSpeed("stepping.max_speed", "m/s", stepping->max_speed);

@@ -41,15 +41,19 @@ typedef enum ssJointParam {
   SS_PARAM_SUSPENSION = 3,
 } ssJointParam;
 
-/** What the registry wrote in one Apply. */
+/** Who served the rows or contacts of a step (or of a frame, summed over its steps). Each row or contact is counted
+ *  once, in one of the three. */
+typedef struct ssServedCounts {
+  int by_mapping;               /* served by the stepping's own mapping (every one under implicit Euler) */
+  int handed_to_matched;        /* exact only: served by matched (this step length gave exact no finite softness) */
+  int handed_to_implicit_euler; /* matched/exact only: served by implicit Euler (above the step's Nyquist
+                                 * frequency, undamped, no effective mass, a static load, no finite softness) */
+} ssServedCounts;
+
+/** What one Apply did. */
 typedef struct ssApplyReport {
-  int rows_written;           /* joint parameter sets brought up to date, plus 1 for a bound world */
-  int rows_over_nyquist;      /* rows whose natural frequency exceeds half the step rate (1/(2h)) */
-  int rows_exact_fallback;    /* SS_MAPPING_EXACT rows that this step length could not serve: matched was used */
-  /* SS_MAPPING_MATCHED or SS_MAPPING_EXACT rows served by the implicit-Euler mapping for this step: rows above the
-   * step's Nyquist frequency (near-rigid), undamped rows, rows with no effective mass, rows whose accurate softness
-   * would underflow or overflow. */
-  int rows_implicit_euler_fallback;
+  ssServedCounts rows; /* every bound row, the world's included, once */
+  int row_writes;      /* parameter sets actually written into ODE (unchanged values are skipped) */
 } ssApplyReport;
 
 /** Creates an empty registry for world. Returns NULL when out of memory. */

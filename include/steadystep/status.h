@@ -27,6 +27,8 @@ typedef enum ssStatus {
   SS_ERROR_SPEED_LIMIT = 10,      /* a body moved faster than the configured limit */
   SS_ERROR_OUT_OF_MEMORY = 11,
   SS_ERROR_FAILED = 12,           /* an earlier frame failed: the stepper refuses frames until ssStepper_Reset */
+  SS_ERROR_POSITION_LIMIT = 13,   /* a known body beyond SS_MAX_POSITION_M (limits.h), where ODE's spaces overflow */
+  SS_ERROR_REENTERED = 14,        /* a stepper function that must not be called from the stepper's own callbacks was */
 } ssStatus;
 
 /** The enum's name without prefix, e.g. "out of range". Never NULL. */

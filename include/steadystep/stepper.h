@@ -6,7 +6,8 @@
  * steps with the program's own solver settings, the contact group is emptied and the known bodies are checked.
  *
  *     ssStepperDef def = ssDefaultStepperDef();
- *     def.world = world; def.registry = registry; def.stepping.max_step_s = 1.0 / 60.0;
+ *     def.world = world; def.space = space; def.tuned_step_s = 1.0 / 60.0;   // the step the program was tuned for
+ *     def.stepping.solver = SS_SOLVER_QUICK;                   // the ODE step the program calls
  *     def.collide = collide; def.contact_group = contacts;   // collide calls dSpaceCollide(space, stepper, near)
  *     ssStepper* stepper; ssStepper_Create(&def, &stepper);
  *     for (;;) {
@@ -60,13 +61,24 @@ typedef struct ssStepInfo {
 typedef void ssStepCallback(void* context, ssStepper* stepper);
 
 /** Called after each physics step that passed the checks, with its length (s); for recording. */
-typedef void ssStepDoneFn(void* context, double step_s);
+typedef void ssStepDoneCallback(void* context, double step_s);
 
 /** How a stepper is made. Start from ssDefaultStepperDef(): new fields keep working defaults. */
 typedef struct ssStepperDef {
   dWorldID world;               /* required */
-  ssRegistry* registry;         /* may be NULL: nothing soft is rewritten, only watched bodies are known */
-  ssStepping stepping;          /* how frames become steps (stepping.h); default ssDefaultStepping() */
+  /* Optional: the program's space. ssStepper_Create adopts the world and everything the space reaches as tuned at
+   * tuned_step_s (ssRegistry_Adopt, adopt.h), into a registry it makes and owns (or into `registry` when given),
+   * and before every step finds the bodies and joints added since. */
+  dSpaceID space;
+  /* The step (s) the program's ERP/CFM, damping and auto-disable were tuned for, in [SS_MIN_STEP_S, SS_MAX_STEP_S]:
+   * required with space; 0 otherwise means ssRegistry_TunedStep(registry) (0 without a registry or adoption).
+   * stepping.max_step_s and fixed_step_s default to it. */
+  double tuned_step_s;
+  /* Optional, borrowed (it must outlive the stepper): a registry of `world` for springs bound by hand. NULL
+   * without space: nothing soft is rewritten, only watched bodies are known. */
+  ssRegistry* registry;
+  /* How frames become steps (stepping.h); default ssDefaultStepping(), whose solver must be set. */
+  ssStepping stepping;
   /* Before each step, after the frame's forces were put back and the registry applied: add forces that depend on
    * the state (PD controllers, drag, buoyancy). Forces that are constant over a frame can simply be added before
    * ssStepper_Step. May be NULL. */
@@ -76,7 +88,7 @@ typedef struct ssStepperDef {
    * contacts in contact_group and soften each with ssStepper_SoftenContact. May be NULL. */
   ssStepCallback* collide;
   void* collide_context;
-  ssStepDoneFn* step_done;      /* may be NULL */
+  ssStepDoneCallback* step_done; /* may be NULL */
   void* step_done_context;
   dJointGroupID contact_group;  /* emptied after every step when not 0 */
 } ssStepperDef;
@@ -88,12 +100,13 @@ typedef struct ssFrameReport {
   double simulated_s;         /* time simulated this frame (s) */
   double carried_s;           /* time not simulated yet, carried to the next frame (s): FIXED's accumulator, or a
                                * frame shorter than SS_MIN_STEP_S */
-  double dropped_s;           /* FIXED: time dropped by max_steps_per_frame (s) */
+  double dropped_s;           /* time dropped by stepping.max_steps_per_frame (s), never simulated */
   double interpolation;       /* FIXED: accumulator / fixed_step_s in [0, 1), to blend the last two states */
-  ssApplyReport apply;        /* summed over the frame's steps */
-  int contacts_softened;      /* contacts softened with ssStepper_SoftenContact */
-  int contacts_implicit_euler_fallback; /* of those, contacts the accurate mapping could not serve: implicit Euler
-                                         * served them */
+  ssServedCounts rows;        /* row-steps: every bound row (the world's included) counted once per physics step,
+                               * by who served it (registry.h) */
+  ssServedCounts contacts;    /* contacts softened with ssStepper_SoftenContact, by who served them */
+  int row_writes;             /* parameter sets written into ODE, summed over the frame's Applies (implicit Euler
+                               * applies once a frame of equal substeps, and writes only what changed) */
   dBodyID failed_body;        /* the body that blew up or ran too fast, else 0 */
 } ssFrameReport;
 
@@ -104,9 +117,13 @@ typedef struct ssFrameReport {
 /** The defaults listed at each field. */
 SS_API ssStepperDef ssDefaultStepperDef(void);
 
-/** Makes a stepper. The registry and the world are borrowed: they must outlive it.
- *  Errors: SS_ERROR_OUT_OF_RANGE (def or out NULL, no world, or a field outside its range, named),
- *  SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED (those of ssValidateStepping), SS_ERROR_OUT_OF_MEMORY. */
+/** Makes a stepper. The world and a given registry are borrowed: they must outlive it. With def->space, the
+ *  world and everything the space reaches are adopted as tuned at def->tuned_step_s (into def->registry when
+ *  given, else into a registry the stepper makes and destroys with itself); nothing is made or adopted on an error.
+ *  Errors: SS_ERROR_OUT_OF_RANGE (def or out NULL, no world, a registry of another world, space without
+ *  tuned_step_s, a field outside its range, stepping.max_step_s or fixed_step_s 0 with no tuned step, named),
+ *  SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED (those of ssValidateStepping, e.g. stepping.solver unset); those of
+ *  ssRegistry_Adopt; SS_ERROR_OUT_OF_MEMORY. */
 SS_API ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out);
 
 /** Destroys the stepper. NULL is a no-op. */

@@ -27,10 +27,12 @@ typedef enum ssFrameCut {
                            * interpolation factor for rendering */
 } ssFrameCut;
 
-/** Which ODE solver a step calls. */
+/** Which ODE step the stepper calls: the one the program calls. There is no default: a program says which, so that
+ *  a dWorldStep program never silently becomes a dWorldQuickStep one (ssValidateStepping refuses UNSET). */
 typedef enum ssSolver {
-  SS_SOLVER_QUICK = 0, /* dWorldQuickStep, iterative: the world's own iteration count and SOR w */
-  SS_SOLVER_STEP = 1,  /* dWorldStep, the direct (big matrix) solver */
+  SS_SOLVER_UNSET = 0, /* not said yet: refused */
+  SS_SOLVER_QUICK = 1, /* dWorldQuickStep, iterative: the world's own iteration count and SOR w */
+  SS_SOLVER_STEP = 2,  /* dWorldStep, the direct (big matrix) solver */
 } ssSolver;
 
 /** Everything about stepping that needs no ODE handle. Start from ssDefaultStepping(). */
@@ -40,13 +42,19 @@ typedef struct ssStepping {
   /* > 0: every step's softness is computed for this step length (s), whatever the step's own: fixed ERP/CFM, the
    * way ODE programs are usually tuned (the naive policy). 0 (default): each step's own length. */
   double frozen_step_s;
-  ssSolver solver;         /* default SS_SOLVER_QUICK */
+  ssSolver solver;         /* required: default SS_SOLVER_UNSET, which is refused */
   /* dWorldQuickStep iterations written into the world before each frame, >= 0; default 0: the world's own setting
    * is left as the program set it. The stepper writes no other solver setting. */
   int quick_iterations;
-  double max_step_s;       /* SUBSTEPS: the longest substep (s), in [SS_MIN_STEP_S, SS_MAX_STEP_S]; default 1/60 */
-  double fixed_step_s;     /* FIXED: the constant step (s), in the same range; default 1/60 */
-  int max_steps_per_frame; /* FIXED: cap against the spiral of death (later time is dropped), > 0; default 8 */
+  /* SUBSTEPS: the longest substep (s), in [SS_MIN_STEP_S, SS_MAX_STEP_S]; default 0: the stepper's tuned step
+   * (ssStepperDef.tuned_step_s, or the registry's), refused when it has none */
+  double max_step_s;
+  double fixed_step_s;     /* FIXED: the constant step (s), in the same range; default 0: the tuned step, as above */
+  /* SUBSTEPS and FIXED: the most physics steps a frame takes, > 0, against the spiral of death and a long frame
+   * (a breakpoint, a hitch): the frame's time beyond them is dropped and reported (ssFrameReport.dropped_s).
+   * Default 32: 0.53 s of simulated time a frame at 1/60 s steps (no frame of the lab's profiles comes near: its
+   * longest, hitch:60:30:0.1's 0.1 s, is 6 steps), 0.13 s at 1/240 s. Whole-frame steps take one step anyway. */
+  int max_steps_per_frame;
   /* A known body faster than this after a step is a runaway (m/s, rad/s), in [0, SS_MAX_SAFE_SPEED]. Default
    * 1e4 m/s and 1e4 rad/s: far above anything a game moves, and a blow-up is stopped long before ODE 0.16 would
    * abort the process (a non-finite rotation fails an assertion inside the next step). Raise them for faster
@@ -59,8 +67,9 @@ typedef struct ssStepping {
 SS_API ssStepping ssDefaultStepping(void);
 
 /** Checks every field, naming the first one out of range.
+ *  max_step_s and fixed_step_s may be 0 (the tuned step, which only the stepper knows).
  *  Errors: SS_ERROR_OUT_OF_RANGE (NULL, or a field outside its range), SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED
- *  (an unknown cut, mapping or solver). */
+ *  (an unknown cut, mapping or solver, and SS_SOLVER_UNSET: "say which ODE step the program calls"). */
 SS_API ssStatus ssValidateStepping(const ssStepping* stepping);
 
 /** The cut's name: "whole-frame", "substeps", "fixed"; NULL for an unknown value. */

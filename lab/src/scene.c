@@ -94,6 +94,9 @@ ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out) {
 ssStatus ssLabStepping(const char* policy, ssStepping* out) {
   if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the stepping");
   ssStepping stepping = ssDefaultStepping();
+  stepping.solver = SS_SOLVER_QUICK;
+  stepping.max_step_s = SS_LAB_STEP_S;
+  stepping.fixed_step_s = SS_LAB_STEP_S;
   ssStatus status = ssSteppingForPolicy(policy, SS_LAB_NAIVE_REFERENCE_STEP_S, &stepping);
   if (status == SS_OK) *out = stepping;
   return status;
@@ -101,6 +104,7 @@ ssStatus ssLabStepping(const char* policy, ssStepping* out) {
 
 ssStepping ssReferenceStepping(double step_s) {
   ssStepping stepping = ssDefaultStepping();
+  stepping.solver = SS_SOLVER_QUICK;
   stepping.max_step_s = step_s;
   stepping.fixed_step_s = step_s;
   return stepping;
@@ -228,6 +232,12 @@ void ssScene_Destroy(ssScene* scene) {
   free(scene);
 }
 
+static void addServed(ssSceneServedCounts* sum, const ssServedCounts* counts) {
+  sum->by_mapping += counts->by_mapping;
+  sum->handed_to_matched += counts->handed_to_matched;
+  sum->handed_to_implicit_euler += counts->handed_to_implicit_euler;
+}
+
 ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps) {
   if (scene == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to step");
   ssEnsureOde();
@@ -241,11 +251,9 @@ ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps) {
   ssSceneCounters* counters = &scene->counters;
   ++counters->frames;
   counters->steps += report.steps;
-  counters->rows_written += report.apply.rows_written;
-  counters->rows_implicit_euler_fallback += report.apply.rows_implicit_euler_fallback;
-  counters->rows_exact_fallback += report.apply.rows_exact_fallback;
-  counters->contacts_softened += report.contacts_softened;
-  counters->contacts_implicit_euler_fallback += report.contacts_implicit_euler_fallback;
+  addServed(&counters->rows, &report.rows);
+  addServed(&counters->contacts, &report.contacts);
+  counters->row_writes += report.row_writes;
   return status;
 }
 

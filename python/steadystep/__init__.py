@@ -15,15 +15,15 @@ from steadystep.convert import (Softness, Spring, exact_softness, frequency_from
                                 softness_for, softness_from_spring, spring_from_frequency, spring_from_softness)
 from steadystep.enums import FrameCut, JointParam, Mapping, Solver, Status
 from steadystep.profiles import Profile, frame_times
-from steadystep.registry import (AdoptReport, ApplyReport, Registry, contact_soften, joint_effective_mass,
-                                 joint_supports)
+from steadystep.registry import (AdoptReport, ApplyReport, Registry, ServedCounts, contact_soften,
+                                 joint_effective_mass, joint_supports)
 from steadystep.stepper import FrameReport, Stepper, StepInfo
 from steadystep.stepping import Stepping, policy_names
 from steadystep.study import grid, make_executor, sweep
 
 __all__ = [
     "AdoptReport", "ApplyReport", "FrameCut", "FrameReport", "JointParam", "Mapping", "Profile", "Registry",
-    "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper", "SteadystepError", "Stepping", "contact_soften",
+    "ServedCounts", "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper", "SteadystepError", "Stepping", "contact_soften",
     "exact_softness", "frame_times", "frequency_from_spring", "grid", "joint_effective_mass", "joint_supports",
     "make_executor", "matched_softness", "policy_names", "softness_for", "softness_from_spring",
     "spring_from_frequency", "spring_from_softness", "sweep",

@@ -30,6 +30,7 @@ class Mapping(IntEnum):
 class Solver(IntEnum):
     """Which ODE solver a step calls (stepping.h, ssSolver)."""
 
+    UNSET = lib.SS_SOLVER_UNSET  # not said: refused (a program says which ODE step it calls)
     QUICK = lib.SS_SOLVER_QUICK  # dWorldQuickStep, with the world's own iterations and SOR w
     STEP = lib.SS_SOLVER_STEP    # dWorldStep, the direct solver
 
@@ -59,3 +60,5 @@ class Status(IntEnum):
     SPEED_LIMIT = lib.SS_ERROR_SPEED_LIMIT
     OUT_OF_MEMORY = lib.SS_ERROR_OUT_OF_MEMORY
     FAILED = lib.SS_ERROR_FAILED
+    POSITION_LIMIT = lib.SS_ERROR_POSITION_LIMIT
+    REENTERED = lib.SS_ERROR_REENTERED

@@ -14,7 +14,7 @@ body must be unbound (or destroyed through Stepper.destroy_joint/destroy_body) b
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from steadystep import _handles
 from steadystep._native import SteadystepError, check, ffi, integer, last_error, lib, number, shown, status_name
@@ -33,13 +33,22 @@ def from_struct(cls, cdata):
 
 
 @dataclass(frozen=True)
-class ApplyReport:
-    """What the registry wrote for one step (ssApplyReport); counts of rows."""
+class ServedCounts:
+    """Who served the rows or contacts of a step, or of a frame summed over its steps (ssServedCounts); each row or
+    contact is counted once, in one of the three."""
 
-    rows_written: int         # joint parameter sets brought up to date, plus 1 for a bound world
-    rows_over_nyquist: int    # rows whose natural frequency exceeds half the step rate, 1/(2h)
-    rows_exact_fallback: int  # EXACT rows this step length could not serve: matched was used
-    rows_implicit_euler_fallback: int  # MATCHED or EXACT rows served by the implicit-Euler mapping
+    by_mapping: int                # served by the stepping's own mapping (every one under implicit Euler)
+    handed_to_matched: int         # exact only: served by matched (no finite exact softness at this step length)
+    handed_to_implicit_euler: int  # matched/exact only: served by implicit Euler (above the step's Nyquist
+    #                                frequency, undamped, no effective mass, a static load, no finite softness)
+
+
+@dataclass(frozen=True)
+class ApplyReport:
+    """What one Apply did (ssApplyReport)."""
+
+    rows: ServedCounts = field(metadata={"struct": ServedCounts})  # every bound row, the world's included, once
+    row_writes: int  # parameter sets actually written into ODE (unchanged values are skipped)
 
 
 @dataclass(frozen=True)

@@ -46,8 +46,8 @@ class Row:
     wall_us_per_step: float
     status: str
     rms_vs_exact: float | None = None
-    rows_fallback: int = 0           # matched/exact rows the implicit-Euler mapping served (ssRun_Counters)
-    contacts_fallback: int = 0       # matched/exact contacts the implicit-Euler mapping served
+    rows_handed_to_implicit_euler: int = 0      # matched/exact row-steps implicit Euler served (ssRun_Counters)
+    contacts_handed_to_implicit_euler: int = 0  # matched/exact contacts implicit Euler served
     grid: dict[str, float] = field(default_factory=dict)  # the swept values of this row (GRID_AXES), {} if none
 
 
@@ -261,8 +261,8 @@ def _compare_scene(report: Report, scene: str, done: dict, springs: list[dict], 
                         metrics.steps_per_second(result.step_count, result.simulated_s),
                         1e6 * result.wall_s / result.step_count if result.step_count else math.nan,
                         result.status, _rms_vs_exact(result) if scene == "oscillator" else None,
-                        result.counters.get("rows_implicit_euler_fallback", 0),
-                        result.counters.get("contacts_implicit_euler_fallback", 0),
+                        result.counters["rows"]["handed_to_implicit_euler"],
+                        result.counters["contacts"]["handed_to_implicit_euler"],
                         grid={**point, **step}))
             for policy in report.policies[scene]:
                 by_profile = {profile: done["run", scene, i, j, profile, policy] for profile in report.profiles}
@@ -395,8 +395,8 @@ def _as_json(report: Report, command: str) -> dict:
         "rows": [{"scene": r.scene, "profile": r.profile, "policy": r.policy, "status": r.status,
                   "deviation": dict(r.deviations),
                   "steps_per_frame": r.steps_per_frame, "steps_per_second": r.steps_per_second,
-                  "rms_vs_exact": r.rms_vs_exact, "rows_implicit_euler_fallback": r.rows_fallback,
-                  "contacts_implicit_euler_fallback": r.contacts_fallback, **({"grid": r.grid} if r.grid else {})}
+                  "rms_vs_exact": r.rms_vs_exact, "rows_handed_to_implicit_euler": r.rows_handed_to_implicit_euler,
+                  "contacts_handed_to_implicit_euler": r.contacts_handed_to_implicit_euler, **({"grid": r.grid} if r.grid else {})}
                  for r in report.rows],
         "spread": report.spreads,
         "consistency": report.consistency,
@@ -411,8 +411,8 @@ def _as_json(report: Report, command: str) -> dict:
 
 
 CSV_COLUMNS = ("scene", "profile", "policy", "quantity", "deviation_per_amplitude", "quantity_unit",
-               "rms_vs_exact_per_x0", "steps_per_frame", "steps_per_s", "rows_implicit_euler_fallback",
-               "contacts_implicit_euler_fallback", "status")
+               "rms_vs_exact_per_x0", "steps_per_frame", "steps_per_s", "rows_handed_to_implicit_euler",
+               "contacts_handed_to_implicit_euler", "status")
 
 
 def _as_csv(report: Report) -> str:
@@ -427,8 +427,8 @@ def _as_csv(report: Report) -> str:
             exact = "" if r.rms_vs_exact is None else f"{r.rms_vs_exact:.6g}"
             writer.writerow([r.scene, r.profile, r.policy, *(f"{r.grid[a]!r}" for a in swept), q, f"{v:.6g}",
                              units.get(q, ""), exact,
-                             f"{r.steps_per_frame:.6g}", f"{r.steps_per_second:.6g}", r.rows_fallback,
-                             r.contacts_fallback, r.status])
+                             f"{r.steps_per_frame:.6g}", f"{r.steps_per_second:.6g}", r.rows_handed_to_implicit_euler,
+                             r.contacts_handed_to_implicit_euler, r.status])
     return buffer.getvalue()
 
 
@@ -617,8 +617,8 @@ def _scene_section(report: Report, scene: str) -> list[str]:
         rows.append([html.escape(r.profile), _policy_cell(r.policy)] + [_number(r.grid[a], 6) for a in swept]
                     + [_cell(r.deviations[q], r.status) for q in quantities]
                     + ([_cell(r.rms_vs_exact, r.status)] if scene == "oscillator" else [])
-                    + [_number(r.steps_per_frame), str(r.rows_fallback) if fallback else "-",
-                       str(r.contacts_fallback) if fallback else "-",
+                    + [_number(r.steps_per_frame), str(r.rows_handed_to_implicit_euler) if fallback else "-",
+                       str(r.contacts_handed_to_implicit_euler) if fallback else "-",
                        _status(r.status)])
     parts += [_table(header, rows, f"runs-{scene}"),
               "<p class=small>Rows (contacts) served by implicit Euler: of a matched or exact policy, the joint rows "

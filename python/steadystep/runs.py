@@ -173,8 +173,8 @@ class RunResult:
     initial: dict[str, float] = field(default_factory=dict)  # the quantities before the first step (t = 0)
     bound_use: float = 0.0             # the largest value/bound ratio of the scene's sanity bounds (> 1: broken)
     extra: dict = field(default_factory=dict)
-    # ssRun_Counters: frames, steps, rows_written, rows_implicit_euler_fallback, rows_exact_fallback,
-    # contacts_softened, contacts_implicit_euler_fallback (summed over the run)
+    # ssRun_Counters (ssSceneCounters), summed over the run: frames, steps, rows and contacts (each a dict of
+    # by_mapping, handed_to_matched, handed_to_implicit_euler), row_writes
     counters: dict = field(default_factory=dict)
 
     @property
@@ -342,8 +342,9 @@ class Scene:
         return lib.ssScene_BoundUse(self._handle())
 
     def counters(self) -> dict[str, int]:
-        """What the scene's stepper did so far (ssScene_Counters): frames, steps, rows written, and the rows and
-        contacts an accurate mapping could not serve (served by implicit Euler)."""
+        """What the scene's stepper did so far (ssScene_Counters): frames, steps, the row-steps and contacts by who
+        served them (rows, contacts: dicts of by_mapping, handed_to_matched, handed_to_implicit_euler), and the
+        parameter sets written (row_writes)."""
         return _as_dict(lib.ssScene_Counters(self._handle()))
 
     def points(self) -> np.ndarray:

@@ -1,6 +1,7 @@
 """The stepper for a program's own ODE world (stepper.h): one call per rendered frame instead of dWorldQuickStep.
 
-    stepper = Stepper(world, registry, policy="exact", collide=collide, contact_group=contacts)
+    stepper = Stepper(world, space=space, tuned_step_s=1 / 60, solver=Solver.QUICK, policy="exact",
+                      collide=collide, contact_group=contacts)   # adopts all the space reaches, as tuned at 1/60 s
     for frame_s in frames:                    # the frame's real length (s)
         odepy.dBodyAddForce(car, throttle, 0, 0)   # forces added once a frame act for the whole frame
         report = stepper.step(frame_s)        # FrameReport; SteadystepError on a blow-up: repair, then reset()
@@ -18,14 +19,15 @@ the registry must outlive the stepper (it keeps its Registry alive; close() the 
 
 from __future__ import annotations
 
+import dataclasses
 import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from steadystep import _handles
 from steadystep._native import SteadystepError, check, ffi, lib, number, shown
-from steadystep.enums import Mapping, Status
-from steadystep.registry import ApplyReport, Registry, from_struct
+from steadystep.enums import Mapping, Solver, Status
+from steadystep.registry import Registry, ServedCounts, from_struct
 from steadystep.stepping import Stepping, stepping_from
 
 
@@ -49,11 +51,11 @@ class FrameReport:
     step_s: float                # length of the last step taken (s); 0 when none
     simulated_s: float           # time simulated this frame (s)
     carried_s: float             # time carried to the next frame (s): FIXED's accumulator, or a too-short frame
-    dropped_s: float             # FIXED: time dropped by max_steps_per_frame (s)
+    dropped_s: float             # time dropped by max_steps_per_frame (s), never simulated
     interpolation: float         # FIXED: accumulator / fixed_step_s in [0, 1), to blend the last two states
-    apply: ApplyReport = field(metadata={"struct": ApplyReport})  # summed over the frame's steps
-    contacts_softened: int       # contacts softened with soften_contact
-    contacts_implicit_euler_fallback: int  # of those, served by the implicit-Euler mapping
+    rows: ServedCounts = field(metadata={"struct": ServedCounts})  # row-steps: every bound row once per step
+    contacts: ServedCounts = field(metadata={"struct": ServedCounts})  # contacts softened with soften_contact
+    row_writes: int              # parameter sets written into ODE, summed over the frame's Applies
     failed_body: int = field(metadata={"convert": lambda body: int(ffi.cast("uintptr_t", body))})
     # the address of the body that blew up or ran too fast, else 0 (compare with ctypes.cast(body, c_void_p).value)
 
@@ -68,13 +70,17 @@ class Stepper:
     """Steps one ODE world frame by frame (ssStepper).
 
     world: an odepy dWorldID or an address. registry: a Registry of that world, or None (nothing soft is rewritten,
-    only watched bodies are known). stepping: a Stepping, or policy: a preset's name (policy_names()), whose naive
-    softness is frozen at reference_step_s (s; default the registry's tuned step, else 1/60 s); neither: the
-    defaults. before_step(stepper), collide(stepper): called before each physics step; step_done(step_s): after
-    each step that passed the checks. contact_group: an odepy dJointGroupID emptied after every step, or None.
-    Raises SteadystepError naming a bad value."""
+    only watched bodies are known). space: the program's space, or None: with it, the world and everything the
+    space reaches are adopted as tuned at tuned_step_s (s, required with space), into registry or into one the
+    stepper owns. solver: the ODE step the program calls, Solver.QUICK or Solver.STEP; required unless stepping
+    says it. stepping: a Stepping, or policy: a preset's name (policy_names()), whose naive softness is frozen at
+    reference_step_s (s; default the tuned step, else 1/60 s); neither: the defaults. max_step_s and fixed_step_s
+    of 0 (the defaults) are the tuned step. before_step(stepper), collide(stepper): called before each physics
+    step; step_done(step_s): after each step that passed the checks. contact_group: an odepy dJointGroupID emptied
+    after every step, or None. Raises SteadystepError naming a bad value."""
 
-    def __init__(self, world, registry: Registry | None = None, *, stepping: Stepping | None = None,
+    def __init__(self, world, registry: Registry | None = None, *, space=None, tuned_step_s: float = 0.0,
+                 solver: Solver | None = None, stepping: Stepping | None = None,
                  policy: str | None = None, reference_step_s: float | None = None,
                  before_step: Callable[["Stepper"], object] | None = None,
                  collide: Callable[["Stepper"], object] | None = None,
@@ -82,10 +88,13 @@ class Stepper:
         if registry is not None and not isinstance(registry, Registry):
             raise SteadystepError("out of range", f"registry = {shown(registry)}: must be a steadystep.Registry or "
                                   "None")
+        tuned_step_s = number("tuned_step_s", tuned_step_s, "s")
         if reference_step_s is None:
-            tuned = registry.tuned_step_s if registry is not None else 0.0
+            tuned = tuned_step_s or (registry.tuned_step_s if registry is not None else 0.0)
             reference_step_s = tuned if tuned > 0 else 1.0 / 60.0
         self._stepping = stepping_from(stepping, policy, reference_step_s)
+        if solver is not None:
+            self._stepping = dataclasses.replace(self._stepping, solver=solver)
         self._registry = registry  # kept alive: the C stepper borrows it
         self._user = {"before_step": _checked_callable("before_step", before_step),
                       "collide": _checked_callable("collide", collide),
@@ -96,6 +105,8 @@ class Stepper:
 
         definition = ffi.new("ssStepperDef*", lib.ssDefaultStepperDef())
         definition.world = _handles.handle("world", "world", world)
+        definition.space = _handles.handle("space", "space", space)
+        definition.tuned_step_s = tuned_step_s
         definition.registry = registry._handle() if registry is not None else ffi.NULL
         definition.stepping = self._stepping.as_c_fields()
         definition.contact_group = _handles.handle("contact_group", "joint group", contact_group)
@@ -108,8 +119,12 @@ class Stepper:
         if collide is not None:
             definition.collide = self._callback("ssStepCallback*", lambda context, handle: _call(me, "collide"))
         if step_done is not None:
-            definition.step_done = self._callback("ssStepDoneFn*",
+            definition.step_done = self._callback("ssStepDoneCallback*",
                                                   lambda context, step_s: _call(me, "step_done", step_s))
+        if self._stepping.solver == Solver.UNSET and definition.world != ffi.NULL:  # (C names a NULL world first)
+            raise SteadystepError("unsupported", "solver = None: say which ODE step the program calls "
+                                  "(Solver.QUICK for dWorldQuickStep, Solver.STEP for dWorldStep)",
+                                  int(Status.UNSUPPORTED))
         out = ffi.new("ssStepper**")
         check(lib.ssStepper_Create(definition, out))
         self._stepper = ffi.gc(out[0], lib.ssStepper_Destroy)

@@ -1,7 +1,8 @@
 """How frames become physics steps (stepping.h): the cut of a frame and the mapping of each step, as one dataclass.
 
-    Stepping()                                        # the library's defaults: substeps of at most 1/60 s,
-                                                      # implicit Euler (the article's method)
+    Stepping(solver=Solver.QUICK)                     # the library's defaults: substeps of at most the tuned
+                                                      # step, implicit Euler (the article's method), and the
+                                                      # ODE step the program calls (no default)
     Stepping.for_policy("exact")                      # a named preset: substeps, exact mapping
     Stepping(cut=FrameCut.FIXED, mapping=Mapping.MATCHED, fixed_step_s=1 / 120)   # any combination
 
@@ -33,11 +34,11 @@ class Stepping:
     cut: FrameCut = FrameCut(_DEFAULT.cut)             # how a frame becomes steps
     mapping: Mapping = Mapping(_DEFAULT.mapping)       # how each spring becomes ERP/CFM for a step
     frozen_step_s: float = _DEFAULT.frozen_step_s      # s; > 0 freezes the softness at that step (naive); 0: none
-    solver: Solver = Solver(_DEFAULT.solver)           # dWorldQuickStep or dWorldStep
+    solver: Solver = Solver(_DEFAULT.solver)           # dWorldQuickStep or dWorldStep; UNSET (default) is refused
     quick_iterations: int = _DEFAULT.quick_iterations  # QuickStep iterations set before each frame; 0: the world's
-    max_step_s: float = _DEFAULT.max_step_s            # SUBSTEPS: the longest substep (s), default 1/60
-    fixed_step_s: float = _DEFAULT.fixed_step_s        # FIXED: the constant step (s), default 1/60
-    max_steps_per_frame: int = _DEFAULT.max_steps_per_frame  # FIXED: steps a frame at most (later time dropped)
+    max_step_s: float = _DEFAULT.max_step_s            # SUBSTEPS: the longest substep (s); 0 (default): the tuned
+    fixed_step_s: float = _DEFAULT.fixed_step_s        # FIXED: the constant step (s); 0 (default): the tuned step
+    max_steps_per_frame: int = _DEFAULT.max_steps_per_frame  # steps a frame at most (the rest dropped, reported)
     max_speed: float = _DEFAULT.max_speed              # m/s above which a known body is a runaway; 0: ODE's guard
     max_angular_speed: float = _DEFAULT.max_angular_speed  # rad/s, likewise
 

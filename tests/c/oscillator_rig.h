@@ -8,6 +8,7 @@
 
 #include <ode/ode.h>
 
+#include "test_stepping.h"
 #include "steadystep/lab/profile.h"
 #include "steadystep/steadystep.h"
 
@@ -15,7 +16,7 @@ struct OscillatorRig {
   double mass = 1.0, x0 = 0.5, gravity = 0.0;
   bool declare_load = false;  // tell the registry the weight the stop carries (ssRegistry_SetJointLoad)
   ssSpring spring = {40.0, 1.0};
-  ssStepperDef def = ssDefaultStepperDef();
+  ssStepperDef def = TestStepperDef();
 
   dWorldID world = nullptr;
   dBodyID body = nullptr;

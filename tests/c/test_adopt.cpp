@@ -144,7 +144,7 @@ TEST_F(AdoptTest, OdeDefaultsAreAdoptedLikeTunedValues) {
     EXPECT_NEAR(dJointGetBallParam(ball, dParamERP), erp, 1e-12);
     // near-rigid: far above the step's Nyquist frequency, so the accurate mappings hand the rows to spring
     if (mapping != SS_MAPPING_IMPLICIT_EULER) {
-      EXPECT_GE(applied.rows_implicit_euler_fallback, 2) << ssMappingName(mapping);
+      EXPECT_GE(applied.rows.handed_to_implicit_euler, 2) << ssMappingName(mapping);
     }
   }
 }

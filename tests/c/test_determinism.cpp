@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "test_stepping.h"
 #include "steadystep/lab/scene.h"
 #include "steadystep/steadystep.h"
 
@@ -29,7 +30,7 @@ uint64_t RunHash(const char* scene, ssSolver solver, int* steps_out) {
   ssRunDef def{};
   def.scene = scene;
   EXPECT_EQ(ssDefaultSceneParams(scene, &def.params), SS_OK) << ssLastError();
-  def.stepping = ssDefaultStepping();  // substeps of at most 1/60 s, implicit Euler at each step's length
+  def.stepping = TestStepping();  // substeps of at most 1/60 s, implicit Euler at each step's length
   def.stepping.solver = solver;
   def.profile = "fixed:60";
   def.seed = 1;

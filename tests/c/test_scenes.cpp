@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "test_stepping.h"
 #include "steadystep/lab/scene.h"
 #include "steadystep/steadystep.h"
 
@@ -28,7 +29,7 @@ ssRunDef Def(const char* scene, const char* profile, double duration_s) {
   ssRunDef def{};
   def.scene = scene;
   EXPECT_EQ(ssDefaultSceneParams(scene, &def.params), SS_OK) << ssLastError();
-  def.stepping = ssDefaultStepping();
+  def.stepping = TestStepping();
   def.profile = profile;
   def.seed = 7;
   def.duration_s = duration_s;
@@ -219,7 +220,8 @@ TEST(Scenes, BadInputsAreRefusedByName) {
       {[](ssStepping& s) { s.max_step_s = std::numeric_limits<double>::quiet_NaN(); }, SS_ERROR_NOT_FINITE,
        "max_step_s"},
       {[](ssStepping& s) { s.frozen_step_s = -1; }, SS_ERROR_OUT_OF_RANGE, "frozen_step_s"},
-      {[](ssStepping& s) { s.fixed_step_s = 0; }, SS_ERROR_OUT_OF_RANGE, "fixed_step_s"},
+      {[](ssStepping& s) { s.cut = SS_CUT_FIXED; s.fixed_step_s = 0; }, SS_ERROR_OUT_OF_RANGE, "fixed_step_s"},
+      {[](ssStepping& s) { s.solver = SS_SOLVER_UNSET; }, SS_ERROR_UNSUPPORTED, "solver = unset"},
       {[](ssStepping& s) { s.max_steps_per_frame = 0; }, SS_ERROR_OUT_OF_RANGE, "max_steps_per_frame"},
   };
   for (const SteppingCase& c : stepping_cases) {
@@ -434,7 +436,7 @@ TEST(Scenes, NullHandlesAndOutputsAreRefusedByName) {
   EXPECT_TRUE(names("out = NULL")) << ssLastError();
   EXPECT_EQ(ssSceneFind(nullptr), nullptr);
   ASSERT_EQ(ssDefaultSceneParams("oscillator", &params), SS_OK);
-  ssStepping stepping = ssDefaultStepping();
+  ssStepping stepping = TestStepping();
   ssScene* scene = nullptr;
   EXPECT_EQ(ssScene_Create(nullptr, &params, &stepping, &scene), SS_ERROR_OUT_OF_RANGE);
   EXPECT_TRUE(names("name = NULL")) << ssLastError();

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "test_stepping.h"
 #include "ode_fixture.h"
 #include "oscillator_rig.h"
 
@@ -19,13 +20,18 @@ TEST_F(StepperTest, FramesAreSplitIntoEqualSubstepsNoLongerThanTheMaximum) {
     double frame_s;
     int steps;
   } cases[] = {{1.0 / 60.0, 1}, {2.0 / 60.0, 2}, {0.05, 3}, {1.0 / 144.0, 1}, {0.1 + 0.2, 18}};
+  double previous_step_s = 0;
   for (const Case& c : cases) {
     ssFrameReport report;
     ASSERT_EQ(ssStepper_Step(rig.stepper, c.frame_s, &report), SS_OK);
     EXPECT_EQ(report.steps, c.steps) << c.frame_s;
     EXPECT_NEAR(report.step_s, c.frame_s / c.steps, 1e-15);
     EXPECT_NEAR(report.simulated_s, c.frame_s, 1e-15);
-    EXPECT_EQ(report.apply.rows_written, 1);  // the implicit-Euler mapping is written once a frame
+    EXPECT_EQ(report.rows.by_mapping, c.steps);  // the one bound row, counted once per step it served
+    EXPECT_EQ(report.rows.handed_to_matched + report.rows.handed_to_implicit_euler, 0);
+    // the implicit-Euler mapping is written once a frame, and only where the step length changed
+    EXPECT_EQ(report.row_writes, report.step_s != previous_step_s ? 1 : 0) << c.frame_s;
+    previous_step_s = report.step_s;
   }
 }
 
@@ -108,9 +114,14 @@ TEST_F(StepperTest, CreateRefusesBadDefinitionsNamingTheField) {
       {[](ssStepperDef* d) { d->stepping.max_speed = -1; }, SS_ERROR_OUT_OF_RANGE, "max_speed = -1"},
       {[](ssStepperDef* d) { d->stepping.cut = (ssFrameCut)42; }, SS_ERROR_UNSUPPORTED, "cut = 42"},
       {[](ssStepperDef* d) { d->stepping.solver = (ssSolver)7; }, SS_ERROR_UNSUPPORTED, "solver = 7"},
+      {[](ssStepperDef* d) { d->stepping.solver = SS_SOLVER_UNSET; }, SS_ERROR_UNSUPPORTED, "solver = unset"},
+      {[](ssStepperDef* d) { d->stepping.fixed_step_s = 0; d->stepping.cut = SS_CUT_FIXED; }, SS_ERROR_OUT_OF_RANGE,
+       "fixed_step_s = 0 s (the tuned step)"},
+      {[](ssStepperDef* d) { d->space = (dSpaceID)1; }, SS_ERROR_OUT_OF_RANGE, "tuned_step_s = 0 s: with a space"},
+      {[](ssStepperDef* d) { d->tuned_step_s = -1; }, SS_ERROR_OUT_OF_RANGE, "tuned_step_s = -1"},
   };
   for (const Case& c : cases) {
-    ssStepperDef def = ssDefaultStepperDef();
+    ssStepperDef def = TestStepperDef();
     def.world = other;
     c.change(&def);
     ssStepper* stepper = nullptr;
@@ -124,13 +135,13 @@ TEST_F(StepperTest, CreateRefusesBadDefinitionsNamingTheField) {
 TEST_F(StepperTest, PoliciesArePresetsOfCutAndMappingNamedByTheLibrary) {
   ASSERT_EQ(ssPolicyCount(), 7);
   for (int i = 0; i < ssPolicyCount(); ++i) {
-    ssStepping stepping = ssDefaultStepping();
+    ssStepping stepping = TestStepping();
     ASSERT_EQ(ssSteppingForPolicy(ssPolicyNameAt(i), 1.0 / 60, &stepping), SS_OK);
     EXPECT_STREQ(ssSteppingPolicyName(&stepping), ssPolicyNameAt(i));
     EXPECT_EQ(ssValidateStepping(&stepping), SS_OK);
   }
   EXPECT_EQ(ssPolicyNameAt(ssPolicyCount()), nullptr);
-  ssStepping stepping = ssDefaultStepping();
+  ssStepping stepping = TestStepping();
   const ssStepping before = stepping;
   EXPECT_EQ(ssSteppingForPolicy("smooth", 1.0 / 60, &stepping), SS_ERROR_PARSE);
   EXPECT_NE(std::string(ssLastError()).find("smooth"), std::string::npos);
@@ -264,7 +275,7 @@ TEST_F(StepperTest, BlowUpsAndRunawaysAreReportedAndStepsAreRefusedUntilReset) {
 }
 
 TEST_F(StepperTest, TheSpeedGuardIsOnByDefaultForLinearAndAngularSpeed) {
-  ssStepperDef def = ssDefaultStepperDef();
+  ssStepperDef def = TestStepperDef();
   EXPECT_GT(def.stepping.max_speed, 0);
   EXPECT_GT(def.stepping.max_angular_speed, 0);
   OscillatorRig rig;
@@ -277,16 +288,19 @@ TEST_F(StepperTest, TheSpeedGuardIsOnByDefaultForLinearAndAngularSpeed) {
   EXPECT_NE(std::string(ssLastError()).find("max_angular_speed"), std::string::npos) << ssLastError();
 }
 
-TEST_F(StepperTest, FrequenciesAboveHalfTheStepRateAreReported) {
+TEST_F(StepperTest, RowsAboveHalfTheStepRateAreHandedToImplicitEulerAndCounted) {
   OscillatorRig rig;
   rig.spring = {40000.0, 1.0};  // 1 kg: w = 200 rad/s, so w h > π above h = 15.7 ms
+  ssSteppingForPolicy("matched", 1.0 / 30, &rig.def.stepping);
   rig.def.stepping.max_step_s = 1.0 / 30.0;
   ASSERT_EQ(rig.Build(), SS_OK);
   ssFrameReport report;
   ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 30.0, &report), SS_OK);
-  EXPECT_EQ(report.apply.rows_over_nyquist, 1);
+  EXPECT_EQ(report.rows.handed_to_implicit_euler, 1);
+  EXPECT_EQ(report.rows.by_mapping, 0);
   ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 100.0, &report), SS_OK);
-  EXPECT_EQ(report.apply.rows_over_nyquist, 0);
+  EXPECT_EQ(report.rows.handed_to_implicit_euler, 0);
+  EXPECT_EQ(report.rows.by_mapping, 1);
 }
 
 TEST_F(StepperTest, ExactFallsBackToMatchedWhereAStepPairHasNoFiniteMapping) {
@@ -299,9 +313,73 @@ TEST_F(StepperTest, ExactFallsBackToMatchedWhereAStepPairHasNoFiniteMapping) {
   for (double frame_s : {0.4, 0.004, 0.4, 0.004}) {
     ssFrameReport report;
     ASSERT_EQ(ssStepper_Step(rig.stepper, frame_s, &report), SS_OK) << ssLastError();
-    fallbacks += report.apply.rows_exact_fallback;
+    fallbacks += report.rows.handed_to_matched;
+    EXPECT_EQ(report.rows.by_mapping + report.rows.handed_to_matched + report.rows.handed_to_implicit_euler,
+              report.steps);  // each row-step counted once
   }
   EXPECT_GT(fallbacks, 0);
+}
+
+TEST_F(StepperTest, ALongSubstepFrameIsCappedAndTheDroppedTimeReported) {
+  OscillatorRig rig;
+  rig.def.stepping.max_steps_per_frame = 5;
+  ASSERT_EQ(rig.Build(), SS_OK);  // max_step_s = 1/60
+  ssFrameReport report;
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 5.0 / 60, &report), SS_OK);  // exactly the cap: nothing dropped
+  EXPECT_EQ(report.steps, 5);
+  EXPECT_EQ(report.dropped_s, 0);
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 10.0, &report), SS_OK);  // a breakpoint: 5 steps, not 600
+  EXPECT_EQ(report.steps, 5);
+  EXPECT_DOUBLE_EQ(report.step_s, 1.0 / 60);
+  EXPECT_NEAR(report.simulated_s, 5.0 / 60, 1e-15);
+  EXPECT_NEAR(report.dropped_s, 10.0 - 5.0 / 60, 1e-12);
+  EXPECT_EQ(ssDefaultStepping().max_steps_per_frame, 32);
+}
+
+TEST_F(StepperTest, WithASpaceTheStepperAdoptsIntoARegistryOfItsOwnAtTheTunedStep) {
+  dSpaceID space = dSimpleSpaceCreate(0);
+  dBodyID body = MakeBody(1.0);
+  dGeomSetBody(dCreateSphere(space, 0.1), body);
+  dJointID slider = dJointCreateSlider(world, 0);
+  dJointAttach(slider, body, 0);
+  dJointSetSliderAxis(slider, 1, 0, 0);
+  dJointSetSliderParam(slider, dParamLoStop, 0);
+  dJointSetSliderParam(slider, dParamHiStop, 0);
+  dJointSetSliderParam(slider, dParamStopERP, 0.4);  // tuned at 1/50 s
+  dJointSetSliderParam(slider, dParamStopCFM, 1e-3);
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = world;
+  def.space = space;
+  def.stepping.solver = SS_SOLVER_STEP;
+  ssStepper* stepper = nullptr;
+  EXPECT_EQ(ssStepper_Create(&def, &stepper), SS_ERROR_OUT_OF_RANGE);  // which step was it tuned for?
+  EXPECT_NE(std::string(ssLastError()).find("tuned_step_s = 0 s"), std::string::npos) << ssLastError();
+  def.tuned_step_s = 1.0 / 50;
+  ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK) << ssLastError();
+  const ssStepping stepping = ssStepper_Stepping(stepper);
+  EXPECT_EQ(stepping.max_step_s, 1.0 / 50);  // 0: the tuned step
+  EXPECT_EQ(stepping.fixed_step_s, 1.0 / 50);
+  EXPECT_EQ(stepping.solver, SS_SOLVER_STEP);
+  ssFrameReport report;
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 100, &report), SS_OK) << ssLastError();
+  EXPECT_EQ(report.rows.by_mapping, 3);  // adopted: the world's ERP/CFM, the slider's stop and its motor row
+  // The stop's spring, k = erp / (h0 cfm), c = (1 - erp) / cfm, written for the step of 1/100 s.
+  const double h0 = 1.0 / 50, h = 1.0 / 100, k = 0.4 / (h0 * 1e-3), c = 0.6 / 1e-3;
+  EXPECT_NEAR(dJointGetSliderParam(slider, dParamStopERP), h * k / (h * k + c), 1e-12);
+  EXPECT_NEAR(dJointGetSliderParam(slider, dParamStopCFM), 1 / (h * k + c), 1e-12);
+  ssStepper_Destroy(stepper);  // and its registry
+
+  // A registry of another world is refused by name.
+  dWorldID other = dWorldCreate();
+  ssRegistry* foreign = ssRegistry_Create(other);
+  def.registry = foreign;
+  stepper = nullptr;
+  EXPECT_EQ(ssStepper_Create(&def, &stepper), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(stepper, nullptr);
+  EXPECT_NE(std::string(ssLastError()).find("not def.world"), std::string::npos) << ssLastError();
+  ssRegistry_Destroy(foreign);
+  dWorldDestroy(other);
+  dSpaceDestroy(space);
 }
 
 }  // namespace

@@ -505,7 +505,7 @@ static inline double steps_for(const World* w, double frame_s) {
     case SS_CUT_WHOLE_FRAME: return 1;
     case SS_CUT_FIXED:
       return fmin(ceil(frame_s / w->stepping.fixed_step_s) + 1, w->stepping.max_steps_per_frame);
-    default: return ceil(frame_s / w->stepping.max_step_s);
+    default: return fmin(ceil(frame_s / w->stepping.max_step_s), w->stepping.max_steps_per_frame);
   }
 }
 
@@ -572,14 +572,17 @@ static inline void check_registry_call(World* w, ssStatus status, int bindings_b
 static inline int same_double(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
 
 /* Whether the stepper holds the stepping it was given: every field as given, except that a speed limit of 0 stands
- * for the guard ODE itself needs (stepping.h), which the stepper fills in. Field by field: padding is no state. */
+ * for the guard ODE itself needs (stepping.h), and a step length of 0 for the tuned step, which the stepper fills
+ * in. Field by field: padding is no state. */
 static inline int holds_stepping(const ssStepping* held, const ssStepping* given) {
+  double max_step_s = given->max_step_s == 0 ? held->max_step_s : given->max_step_s;
+  double fixed_step_s = given->fixed_step_s == 0 ? held->fixed_step_s : given->fixed_step_s;
   double max_speed = given->max_speed == 0 ? held->max_speed : given->max_speed;
   double max_angular_speed = given->max_angular_speed == 0 ? held->max_angular_speed : given->max_angular_speed;
   return held->cut == given->cut && held->mapping == given->mapping &&
          same_double(held->frozen_step_s, given->frozen_step_s) && held->solver == given->solver &&
-         held->quick_iterations == given->quick_iterations && same_double(held->max_step_s, given->max_step_s) &&
-         same_double(held->fixed_step_s, given->fixed_step_s) &&
+         held->quick_iterations == given->quick_iterations && same_double(held->max_step_s, max_step_s) &&
+         same_double(held->fixed_step_s, fixed_step_s) &&
          held->max_steps_per_frame == given->max_steps_per_frame && held->max_speed > 0 &&
          held->max_angular_speed > 0 && same_double(held->max_speed, max_speed) &&
          same_double(held->max_angular_speed, max_angular_speed);
@@ -614,7 +617,9 @@ static inline void make_world(World* w, FuzzInput* in, const ssStepperDef* def_t
   uint8_t how = fuzz_byte(in);
   def.stepping.cut = (ssFrameCut)(how % 4);           /* 3 is unknown */
   def.stepping.mapping = (ssMapping)((how >> 2) % 4); /* 3 is unknown */
-  def.stepping.solver = (ssSolver)((how >> 4) % 3);   /* 2 is unknown */
+  def.stepping.solver = (ssSolver)((how >> 4) % 4);   /* 0 is unset, 3 unknown */
+  /* The steps the program's tuned for, unless fuzzed: 0 (the tuned step) is refused, the registry has none yet. */
+  def.stepping.max_step_s = def.stepping.fixed_step_s = 1.0 / 60;
   uint8_t fields = fuzz_byte(in);
   if (fields & 1) def.stepping.max_step_s = fuzz_double(in);
   if (fields & 2) def.stepping.fixed_step_s = fuzz_double(in);
@@ -642,6 +647,8 @@ static inline void make_world(World* w, FuzzInput* in, const ssStepperDef* def_t
     fallback.step_done = def.step_done;
     fallback.step_done_context = def.step_done_context;
     fallback.contact_group = def.contact_group;
+    fallback.stepping.solver = SS_SOLVER_QUICK;
+    fallback.stepping.max_step_s = fallback.stepping.fixed_step_s = 1.0 / 60;
     def = fallback;
     FUZZ_REQUIRE(ssStepper_Create(&def, &w->stepper) == SS_OK, "default stepper: %s", ssLastError());
   }

@@ -34,7 +34,7 @@ def test_each_enum_has_exactly_the_c_enumerators(enum, ctype, prefix):
 
 
 @pytest.mark.parametrize("cls, ctype", [
-    (ss.ApplyReport, "ssApplyReport"), (ss.AdoptReport, "ssAdoptReport"), (ss.FrameReport, "ssFrameReport"),
+    (ss.ServedCounts, "ssServedCounts"), (ss.ApplyReport, "ssApplyReport"), (ss.AdoptReport, "ssAdoptReport"), (ss.FrameReport, "ssFrameReport"),
     (ss.StepInfo, "ssStepInfo"), (ss.Stepping, "ssStepping")])
 def test_each_dataclass_has_exactly_the_c_fields_in_order(cls, ctype):
     assert [field.name for field in dataclasses.fields(cls)] == [name for name, _ in ffi.typeof(ctype).fields]
@@ -44,14 +44,17 @@ def test_the_stepping_defaults_and_presets_are_the_librarys():
     default = lib.ssDefaultStepping()
     assert ss.Stepping() == ss.Stepping.from_c(default) and ss.Stepping().policy == "implicit-euler"
     for name in ss.policy_names():
-        stepping = ss.Stepping.for_policy(name, 1 / 30)
+        stepping = ss.Stepping.for_policy(name, 1 / 30, solver=ss.Solver.QUICK)
         assert stepping.policy == name
         stepping.validate()
     assert ss.Stepping.for_policy("naive", 1 / 30).frozen_step_s == 1 / 30
     with pytest.raises(ss.SteadystepError, match="fastest"):
         ss.Stepping.for_policy("fastest")
     with pytest.raises(ss.SteadystepError, match="max_step_s"):
-        ss.Stepping(max_step_s=0.0).validate()
+        ss.Stepping(solver=ss.Solver.QUICK, max_step_s=-1.0).validate()
+    with pytest.raises(ss.SteadystepError, match="stepping.solver = unset"):
+        ss.Stepping(max_step_s=1 / 60).validate()
+    assert ss.Stepping().max_step_s == 0.0 and ss.Stepping().solver == ss.Solver.UNSET  # the tuned step; say which
     with pytest.raises(ss.SteadystepError, match="stepping.cut = 'x'"):
         ss.Stepping(cut="x").validate()
 

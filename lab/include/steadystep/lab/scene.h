@@ -99,12 +99,17 @@ SS_LAB_API ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
 /** The naive policy's reference step in the lab (s): the scenes' softness frozen as if tuned at 30 fps. */
 #define SS_LAB_NAIVE_REFERENCE_STEP_S (1.0 / 30.0)
 
+/** The lab's longest substep and fixed step (s): 1/60. The lab's scenes bind their springs by hand and have no
+ *  tuned step for stepping.max_step_s = 0 to stand for. */
+#define SS_LAB_STEP_S (1.0 / 60.0)
+
 /** The stepping of a policy in the lab: ssDefaultStepping() with the policy's cut and mapping (stepping.h), naive
- *  frozen at SS_LAB_NAIVE_REFERENCE_STEP_S. Errors: those of ssSteppingForPolicy. */
+ *  frozen at SS_LAB_NAIVE_REFERENCE_STEP_S, solver SS_SOLVER_QUICK, max_step_s = fixed_step_s = SS_LAB_STEP_S.
+ *  Errors: those of ssSteppingForPolicy. */
 SS_LAB_API ssStatus ssLabStepping(const char* policy, ssStepping* out);
 
 /** The stepping of a reference run: implicit Euler with substeps of at most step_s (s, in the step range; e.g.
- *  1/1000), fixed_step_s also step_s, the other fields as ssDefaultStepping. Run it under the profile "fixed:N"
+ *  1/1000), fixed_step_s also step_s, solver SS_SOLVER_QUICK, the other fields as ssDefaultStepping. Run it under the profile "fixed:N"
  *  with N = 1/step_s (e.g. "fixed:1000") so that every frame is one step. step_s is not checked here:
  *  ssScene_Create refuses a bad one. */
 SS_LAB_API ssStepping ssReferenceStepping(double step_s);
@@ -148,17 +153,21 @@ SS_LAB_API const char* ssScene_Broken(const ssScene* scene);
  *  physics step so far (0 before the first step; above 1 once broken). A correct run stays well below 1; the tests
  *  measure how far. scene = NULL: NaN, and records "scene = NULL: ..." for ssLastError(). */
 SS_LAB_API double ssScene_BoundUse(const ssScene* scene);
-/** What the scene's stepper did since the scene was built, summed over every frame (ssFrameReport): the rows it
- *  wrote and the rows and contacts an accurate mapping (matched, exact) could not serve, which the implicit-Euler
- *  mapping served instead (stepper.h, registry.h). */
+/** Who served rows or contacts (ssServedCounts, registry.h), summed over a run's steps. */
+typedef struct ssSceneServedCounts {
+  int64_t by_mapping;               /* served by the stepping's own mapping */
+  int64_t handed_to_matched;        /* exact only: served by matched */
+  int64_t handed_to_implicit_euler; /* matched/exact only: served by implicit Euler */
+} ssSceneServedCounts;
+
+/** What the scene's stepper did since the scene was built, summed over every frame (ssFrameReport, stepper.h). */
 typedef struct ssSceneCounters {
-  int64_t frames;                            /* frames stepped with ssScene_Frame */
-  int64_t steps;                             /* physics steps they took */
-  int64_t rows_written;                      /* joint parameter sets written (plus 1 a step for a bound world) */
-  int64_t rows_implicit_euler_fallback;      /* matched/exact rows served by implicit Euler */
-  int64_t rows_exact_fallback;               /* exact rows served by matched */
-  int64_t contacts_softened;                 /* contacts softened for their step */
-  int64_t contacts_implicit_euler_fallback;  /* of those, contacts served by implicit Euler */
+  int64_t frames;                /* frames stepped with ssScene_Frame */
+  int64_t steps;                 /* physics steps they took */
+  ssSceneServedCounts rows;      /* row-steps: every bound row once per physics step, by who served it */
+  ssSceneServedCounts contacts;  /* contacts softened through the stepper (ssStepper_SoftenContact), by who served
+                                  * them; the lab's scenes soften theirs with ssContactSoften, so 0 for them */
+  int64_t row_writes;            /* parameter sets written into ODE */
 } ssSceneCounters;
 
 /** The scene's counters. scene = NULL: all zero, and records "scene = NULL: ..." for ssLastError(). */
@@ -187,7 +196,7 @@ SS_LAB_API ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, i
 typedef struct ssRunDef {
   const char* scene;        /* scene name */
   ssSceneParams params;     /* from ssDefaultSceneParams */
-  ssStepping stepping;      /* from ssDefaultStepping */
+  ssStepping stepping;      /* from ssLabStepping (or ssDefaultStepping with the solver and steps set) */
   const char* profile;      /* profile spec (profile.h) */
   uint64_t seed;            /* profile seed */
   double duration_s;        /* simulated seconds, in (0, SS_MAX_RUN_DURATION_S] (limits.h) */
