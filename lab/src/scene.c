@@ -22,6 +22,7 @@
 
 static const ssSceneDesc* const scenes[] = {
     &ssOscillatorScene, &ssBuggyScene, &ssDropScene, &ssChainScene, &ssPileScene,
+    &ssStackScene,      &ssWallScene,  &ssPistonScene,
 };
 enum { SCENE_COUNT = sizeof scenes / sizeof scenes[0] };
 
@@ -174,6 +175,8 @@ static ssStatus make_stepper(ssScene* scene, const ssStepping* stepping) {
   def.stepping = *stepping;
   def.stepping.max_speed = fmin(stepping->max_speed > 0 ? stepping->max_speed : SS_MAX_SAFE_SPEED,
                                 SS_SCENE_MAX_SPEED_M_PER_S);
+  def.before_step = scene->desc->before_step;
+  def.before_step_context = scene->state;
   def.collide = scene->desc->collide;
   def.collide_context = scene->state;
   def.step_done = scene_step_done;

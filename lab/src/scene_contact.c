@@ -40,3 +40,35 @@ void ssContactCollide(ssContactRecipe* recipe, const ssStepper* stepper) {
   CollideCall call = {recipe, ssStepper_CurrentStep(stepper)};
   dSpaceCollide(recipe->space, &call, near_callback);
 }
+
+/* The near callback of the scenes written as ODE programs: the surface as the program tuned it at 60 fps, then
+ * ssStepper_SoftenContact turns it into the softness for the step about to be taken, as an adopted program does. */
+typedef struct TunedCall {
+  ssTunedContacts* recipe;
+  ssStepper* stepper;
+} TunedCall;
+
+static void tuned_near_callback(void* data, dGeomID geom1, dGeomID geom2) {
+  TunedCall* call = data;
+  ssTunedContacts* recipe = call->recipe;
+  dBodyID body1 = dGeomGetBody(geom1), body2 = dGeomGetBody(geom2);
+  if ((body1 == 0 || !dBodyIsEnabled(body1)) && (body2 == 0 || !dBodyIsEnabled(body2))) return; /* both asleep */
+  if (body1 != 0 && body2 != 0 && dAreConnectedExcluding(body1, body2, dJointTypeContact)) return;
+  dContact contacts[SS_MAX_PAIR_CONTACTS];
+  int count = dCollide(geom1, geom2, recipe->max_contacts, &contacts[0].geom, sizeof contacts[0]);
+  for (int i = 0; i < count; ++i) {
+    dContact* contact = &contacts[i];
+    contact->surface.mode = recipe->surface_mode;
+    contact->surface.mu = recipe->mu;
+    contact->surface.soft_erp = recipe->soft_erp;
+    contact->surface.soft_cfm = recipe->soft_cfm;
+    /* The tuned values come from a validated spring and the registry was adopted: softening cannot fail. */
+    ssStepper_SoftenContact(call->stepper, contact, body1, body2);
+    dJointAttach(dJointCreateContact(recipe->world, recipe->contacts, contact), body1, body2);
+  }
+}
+
+void ssTunedContactsCollide(ssTunedContacts* recipe, ssStepper* stepper) {
+  TunedCall call = {recipe, stepper};
+  dSpaceCollide(recipe->space, &call, tuned_near_callback);
+}

@@ -10,6 +10,7 @@
 
 #include <ode/ode.h>
 
+#include "steadystep/adopt.h"
 #include "steadystep/registry.h"
 #include "steadystep/lab/scene.h"
 #include "steadystep/stepper.h"
@@ -34,6 +35,9 @@ typedef struct ssSceneDesc {
   ssStatus (*build)(const ssSceneWorld* world, const ssSceneParams* params, void** state);
   /* Registers with the stepper the bodies the registry does not watch already (free bodies). May be NULL. */
   ssStatus (*watch)(void* state, ssStepper* stepper);
+  /* The stepper's before_step callback: forces that follow the state or the time (a push, a motor's drive). May be
+   * NULL. */
+  ssStepCallback* before_step;
   /* The stepper's collide callback: create contacts for the stepper's current step. May be NULL. */
   ssStepCallback* collide;
   /* The followed quantities after a step, info.quantity_count of them. */
@@ -57,6 +61,13 @@ extern const ssSceneDesc ssBuggyScene;
 extern const ssSceneDesc ssDropScene;
 extern const ssSceneDesc ssChainScene;
 extern const ssSceneDesc ssPileScene;
+extern const ssSceneDesc ssStackScene;
+extern const ssSceneDesc ssWallScene;
+extern const ssSceneDesc ssPistonScene;
+
+/* The step that the scenes written as ODE programs (stack, wall, piston) tuned their ERP/CFM, damping and
+ * auto-disable for, as programs do at 60 fps; they are adopted at it (ssRegistry_Adopt). */
+#define SS_PROGRAM_TUNED_STEP_S (1.0 / 60.0)
 
 /* Called after every physics step of the scene, after its time has advanced; run.c records with it. */
 typedef void ssSceneStepFn(void* context, const ssScene* scene, double step_s);
@@ -80,6 +91,21 @@ typedef struct ssContactRecipe {
 
 /* Runs dSpaceCollide on recipe->space and softens every contact for the stepper's current step. */
 void ssContactCollide(ssContactRecipe* recipe, const ssStepper* stepper);
+
+/* Contacts as an ODE program tunes them at 60 fps (the scenes written as programs): every contact gets this surface,
+ * and ssStepper_SoftenContact turns its soft ERP/CFM (or the world's, where a mode bit is not set) into the softness
+ * for the step about to be taken. Pairs that are both asleep or static, and pairs joined by a joint, do not collide. */
+typedef struct ssTunedContacts {
+  dWorldID world;
+  dSpaceID space;
+  dJointGroupID contacts;
+  int max_contacts;     /* per pair of geoms, <= SS_MAX_PAIR_CONTACTS */
+  int surface_mode;     /* dContact* mode bits: dContactSoftCFM alone takes the world's ERP */
+  double mu;            /* Coulomb friction coefficient (dContactApprox1: force ratio) */
+  double soft_erp, soft_cfm; /* tuned at SS_PROGRAM_TUNED_STEP_S */
+} ssTunedContacts;
+
+void ssTunedContactsCollide(ssTunedContacts* recipe, ssStepper* stepper);
 
 /* Boxes of one size on a ground plane whose contacts are soft with the scene's spring (drop, pile). */
 typedef struct ssBoxes {

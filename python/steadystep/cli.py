@@ -179,7 +179,9 @@ def build_parser() -> argparse.ArgumentParser:
                               "1, when it blows up or breaks: leaves one of the scene's sanity bounds (a torn joint, a "
                               "box through the floor, energy made; the status and message say which). "
                               + RUN_BOUND_HELP)
-    run.add_argument("scene", metavar="SCENE", help="oscillator, buggy, drop, chain or pile")
+    from steadystep.runs import scenes  # the library's table: no second list here
+    scene_names = ", ".join(info.name for info in scenes())
+    run.add_argument("scene", metavar="SCENE", help=scene_names)
     run.add_argument("--profile", required=True, metavar="SPEC",
                      help="fixed:FPS, uniform:MIN:MAX, jitter:FPS:MS, hitch:FPS:EVERY:S, vsync:A:B or trace:FILE")
     from steadystep.runs import policy_names  # the library's names: no second list here
@@ -197,7 +199,7 @@ def build_parser() -> argparse.ArgumentParser:
                                 "which SCENE stays stable: no blow-up, and its motion within the reference run's "
                                 "range widened by that range on both sides. A trial at --low may take at most "
                                 f"{MAX_RUN_STEPS:.0e} steps.")
-    probe.add_argument("scene", metavar="SCENE", help="oscillator, buggy, drop, chain or pile")
+    probe.add_argument("scene", metavar="SCENE", help=scene_names)
     probe.add_argument("--policies", nargs="+", metavar="POLICY", default=["naive", "implicit-euler", "matched", "exact"],
                        help="default: naive spring matched exact")
     probe.add_argument("--duration", type=_measured_duration, default=3.0, metavar="S",

@@ -82,12 +82,12 @@ double RelativeDeviation(const Recorded& reference, const Recorded& run) {
   return std::sqrt(sum / count) / (*high - *low);
 }
 
-const char* const kAllScenes[] = {"oscillator", "buggy", "drop", "chain", "pile"};
+const char* const kAllScenes[] = {"oscillator", "buggy", "drop", "chain", "pile", "stack", "wall", "piston"};
 
 }  // namespace
 
 TEST(Scenes, TableListsEveryScene) {
-  ASSERT_EQ(ssSceneCount(), 5);
+  ASSERT_EQ(ssSceneCount(), 8);
   for (int i = 0; i < ssSceneCount(); ++i) {
     const ssSceneInfo* info = ssSceneInfoAt(i);
     ASSERT_NE(info, nullptr);
@@ -95,7 +95,7 @@ TEST(Scenes, TableListsEveryScene) {
     EXPECT_GT(info->quantity_count, 0);
     EXPECT_LE(info->quantity_count, SS_MAX_QUANTITIES);
   }
-  EXPECT_EQ(ssSceneInfoAt(5), nullptr);
+  EXPECT_EQ(ssSceneInfoAt(8), nullptr);
   EXPECT_EQ(ssSceneInfoAt(-1), nullptr);
   EXPECT_EQ(ssSceneFind("nope"), nullptr);
 }
@@ -145,6 +145,21 @@ TEST(Scenes, DefaultParamsAreTheDocumentedOnes) {
   EXPECT_EQ(reference.mapping, SS_MAPPING_IMPLICIT_EULER);
   EXPECT_STREQ(ssSteppingPolicyName(&reference), "implicit-euler");
   EXPECT_EQ(reference.max_step_s, 1e-3);
+  // The scenes written as programs: their spring is what the program's tuned ERP/CFM stand for at 1/60 s.
+  struct Tuned {
+    const char* scene;
+    double erp, cfm, mass;
+    int body_count;
+  } const tuned[] = {{"stack", 0.2, 1e-3, 0.1, 6}, {"wall", 0.5, 1e-2, 1, 69}, {"piston", 0.3, 1e-3, 2, 0}};
+  for (const Tuned& t : tuned) {
+    ASSERT_EQ(ssDefaultSceneParams(t.scene, &params), SS_OK);
+    const double h = 1.0 / 60;
+    EXPECT_NEAR(params.spring.stiffness, t.erp / (h * t.cfm), 1e-9 * params.spring.stiffness) << t.scene;
+    EXPECT_NEAR(params.spring.damping, (1 - t.erp) / t.cfm, 1e-9 * params.spring.damping) << t.scene;
+    EXPECT_EQ(params.mass, t.mass) << t.scene;
+    EXPECT_EQ(params.gravity, 9.81) << t.scene;
+    EXPECT_EQ(params.body_count, t.body_count) << t.scene;
+  }
 }
 
 namespace {
@@ -364,7 +379,7 @@ TEST(Scenes, ValuesOutsideOdesRangeAreRefusedByName) {
       {[](ssSceneParams& p) { p.x0 = 1e300; }, "x0 = 1e+300"},
       {[](ssSceneParams& p) { p.gravity = -1e300; }, "gravity = -1e+300"},
   };
-  for (const char* scene : {"oscillator", "buggy", "drop", "chain", "pile"}) {
+  for (const char* scene : kAllScenes) {
     for (const ParamCase& c : param_cases) {
       ssRunDef def = Def(scene, "fixed:60", 1.0);
       c.spoil(def.params);
@@ -391,7 +406,7 @@ TEST(Scenes, ValuesOutsideOdesRangeAreRefusedByName) {
   // The edges themselves are served: the lightest and heaviest masses and the bounds of x0 and gravity build and
   // step without ODE aborting (a speed-limit stop is a served answer).
   for (double mass : {SS_MIN_MASS_KG, SS_MAX_MASS_KG}) {
-    for (const char* scene : {"oscillator", "buggy", "drop", "chain", "pile"}) {
+    for (const char* scene : kAllScenes) {
       ssRunDef def = Def(scene, "fixed:60", 0.2);
       def.params.mass = mass;
       def.params.body_count = std::min(def.params.body_count, 4);

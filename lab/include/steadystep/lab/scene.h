@@ -13,12 +13,30 @@
  *   chain       a chain of links on hinge joints with soft limits (+-0.4 rad), pinned at one end and released
  *               horizontal under gravity (end x m, end z m)
  *   pile        many boxes in a heap for timing (mean height m)
+ * and three written as ODE programs are (after ODE's demos), their ERP/CFM, damping and auto-disable tuned at
+ * 1/60 s and adopted with ssRegistry_Adopt, contacts softened with ssStepper_SoftenContact; params.spring is what
+ * their main tuned softness stands for at 1/60 s:
+ *   stack       a tower of six boxes 200 times apart in mass (20 kg at the bottom, 0.1 kg near the top), heavier
+ *               ones on lighter ones; world ERP 0.2 and contacts' soft CFM 1e-3 (spring: per contact point);
+ *               damping and auto-disable (20 steps) counted in steps, 40 QuickStep iterations; its top box pushed
+ *               sideways for 3 s, then it comes to rest and sleeps (top x m, top z m, kinetic energy J);
+ *               params.mass is the lightest box's mass, body_count the boxes from the bottom (at most 6)
+ *   wall        a wall of 69 bricks (0.4 m, params.mass each) in six courses, hit at 12 m/s by a ball ten times a
+ *               brick's mass and knocked over: hundreds of contacts a step; contacts' soft ERP 0.5 and soft CFM
+ *               0.01, auto-disable after 10 steps (wall mean displacement m, ball x m, ball z m). Not demo_crash's
+ *               own soft ERP 0.8: with it the matched and exact mappings throw the standing wall apart before the
+ *               ball arrives (exact doubles its energy by 0.17 s), while implicit Euler holds it (issue 15)
+ *   piston      a ram (params.mass) on a slider, driven by its motor (0.8 m/s, 40 N) into its stops at +-0.25 m and
+ *               reversed every second, with an arm on a hinge swinging into its stops at +-0.35 rad; stops soft
+ *               by their StopERP/StopCFM (slider: 0.3, 1e-3, the spring; arm: 0.3, 0.1) (ram x m, ram v m/s,
+ *               arm angle rad)
  *
  * Sanity bounds. Every scene declares bounds that a physically correct run never reaches, checked after every
  * physics step (in the lab, not the core library: they are facts about these scenes, not about ODE). Leaving one
  * means the run is finite but wrong: a torn joint, a box through the floor, a spring that made energy. Each scene's
  * file gives the reasons for its numbers; tests/c/test_bounds.cpp measures how close correct runs come (at most
- * 0.66 of a bound: pile's boxes landing at 30 fps) and shows wrong ones broken:
+ * 0.66 of a bound: pile's boxes landing at 30 fps; the wall starts at 0.5 of its energy bound) and shows wrong ones
+ * broken:
  *   oscillator  energy above its rest state, (1/2) m v^2 + (1/2) k (x - x_rest)^2 with x_rest = -m g / k, at most
  *               2 E0 + rounding (E0 its value at release): gravity is conservative and nothing drives the body, so
  *               energy can only fall
@@ -30,6 +48,14 @@
  *               and a 1/60 s step finds their first contact deeper
  *   chain       each hinge's two anchors (one on each link, or the world's) at most 0.05 m (a fifth of a link)
  *               apart
+ *   stack       neighbours overlapping by at most 0.07 m (a quarter of the smallest side); each box's centre at
+ *               most a third of its side across from the one below (slid off or fallen)
+ *   wall        energy above the resting state at most twice its value at the start (nothing drives the wall;
+ *               checked with gravity > 0, which gives a resting state);
+ *               no brick's centre below the floor
+ *   piston      the ram at most 0.06 m beyond a stop (a 1/15 s step at the motor's speed passes it by 5.3 cm), the
+ *               arm at most 0.25 rad beyond its stops; the ram at most 0.01 m off its axis and the hinge's
+ *               anchors at most 0.01 m apart
  * A run that leaves a bound ends there as broken (ssRun_Outcome), its message naming the time, the bound, the body
  * or joint and the value.
  */
@@ -60,12 +86,12 @@ extern "C" {
 typedef struct ssSceneParams {
   ssSpring spring;     /* the scene's soft constraint: slider stop, suspension, contact or joint limit */
   double mass;         /* kg, in [SS_MIN_MASS_KG, SS_MAX_MASS_KG]: the oscillator's body, a buggy's chassis, each
-                        * dropped box, each chain link */
+                        * dropped box, each chain link, the stack's lightest box, each brick, the ram */
   double x0;           /* m, |x0| <= SS_SCENE_MAX_X0_M: the oscillator's initial extension (released at rest);
                         * unused elsewhere */
   double gravity;      /* m/s² along the scene's "down", |gravity| <= SS_SCENE_MAX_GRAVITY_M_PER_S2: oscillator 0
                         * by default (along the slider), others 9.81 */
-  int body_count;      /* pile: boxes; chain: links; drop: boxes; 0 = the scene's default */
+  int body_count;      /* pile, drop, stack: boxes; chain: links; wall: bricks; 0 = the scene's default */
 } ssSceneParams;
 
 /** What a scene follows. */
@@ -166,7 +192,8 @@ typedef struct ssSceneCounters {
   int64_t steps;                 /* physics steps they took */
   ssSceneServedCounts rows;      /* row-steps: every bound row once per physics step, by who served it */
   ssSceneServedCounts contacts;  /* contacts softened through the stepper (ssStepper_SoftenContact), by who served
-                                  * them; the lab's scenes soften theirs with ssContactSoften, so 0 for them */
+                                  * them: stack's and wall's; drop, pile and buggy soften theirs with
+                                  * ssContactSoften, so 0 for them */
   int64_t row_writes;            /* parameter sets written into ODE */
 } ssSceneCounters;
 
@@ -183,7 +210,9 @@ SS_LAB_API int ssScene_Points(const ssScene* scene, double* xyz, int capacity);
  *  scene's stepper (plain = 0, as ssScene_Frame), or (plain = 1) as a program without the library steps, for the
  *  cost benchmark: collide, one dWorldQuickStep (or dWorldStep, per the stepping's solver) of the whole frame and
  *  empty the contacts, with every softness left as the stepper last wrote it (contacts softened as for the
- *  stepper's last step). A plain frame needs one ssScene_Frame first, so that every softness has been written.
+ *  stepper's last step; the stack's push and the piston's motor reversals, added before each step through the
+ *  stepper, are not: the ram stays against the stop it last reached). A plain frame needs one ssScene_Frame first,
+ *  so that every softness has been written.
  *  Frames through the stepper are timed without the lab's sanity bounds (ssScene_Broken, ssScene_BoundUse skip
  *  them), which a program does not pay; a plain frame checks only that the followed quantities stay finite, since
  *  ODE aborts on a step from a non-finite state.
