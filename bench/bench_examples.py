@@ -2,25 +2,28 @@
 quantities depend on the frame rate, how far they are from a fine-step reference, and what adopted stepping costs.
 
 Usage: .venv/bin/python bench/bench_examples.py [BUILD_DIR] [--repeats N] [--boxes N] [--cost-seconds S]
+       [--skip-cost] [--executor WHERE]
 
-1. Frame-rate spread. Every variant (the program's own stepping, and the adopted program under the policies implicit-euler,
-   matched, exact and fixed, max step 1/60 s) runs 10 s under the profiles fixed:60, fixed:30 and uniform:15:45
-   (seeds 1, 2, 3). For each followed quantity q, every run is interpolated linearly onto the time grid of the
+1-2. Frame-rate spread and accuracy: `steadystep audit` (python/steadystep/audit.py, docs/audit.md) of each adopted
+   program with its *_ode twin as its own stepping, under the profiles fixed:60, fixed:30 and uniform:15:45 (seeds 1,
+   2, 3), 10 s, the policies implicit-euler, matched, exact and fixed (max step 1/60 s), so that the bench's numbers
+   are the audit's. For each followed quantity q, every run is interpolated linearly onto the time grid of the
    variant's own fixed:60 run, and
 
        spread = sqrt(mean over the fixed:30 and the three uniform:15:45 runs, and over the grid, of
                      (q_run(t) - q_fixed60(t))^2) / A
 
-   where A = max(q) - min(q) over the fine-step reference run (below), one scale per quantity shared by all variants.
-2. Accuracy. The fine-step reference is the adopted program under implicit-euler, fixed:1000, --max-step 0.001. For each
-   variant, over all five runs (fixed:60 included), error = RMS of (q_run(t) - q_reference(t)) on the reference's
-   grid, divided by the same A.
+   where A = max(q) - min(q) over the fine-step reference run, one scale per quantity shared by all variants. The
+   fine-step reference is the adopted program under implicit-euler with 1 ms frames (fixed:1000, one step each).
+   For each variant, over all five runs (fixed:60 included), error = RMS of (q_run(t) - q_reference(t)) on the
+   reference's grid, divided by the same A. Both over the whole run; the audit's own claims use the times where
+   its reference holds (checked at 0.25 ms), printed below each table.
 3. Cost. The stack with --boxes N (default 200) under fixed:60: its own stepping (one dWorldQuickStep a frame)
    against the adopted program under implicit-euler with --max-step 1 (also one step a frame: the same step sequence). Each
    program times its stepping loop alone (--quiet): wall clock and process CPU time. Runs alternate (own, adopted,
    adopted, own, ...) and the ratio adopted / own is taken per pair; printed: the median ratio over the pairs and its
    range, for both clocks (CPU time is the one a shared, busy machine disturbs least).
-Prints Markdown tables. Exit 1 when a run fails.
+Prints Markdown tables. Exit 1 when a run fails (a program the audit refuses: its one line, exit 1).
 """
 
 from __future__ import annotations
@@ -31,62 +34,39 @@ import statistics
 import subprocess
 import sys
 
-import numpy as np
-
-PROGRAMS = {  # program: followed quantities as the CSV names them
-    "vehicle": ["height_m", "pitch_rad"],
-    "chain": ["end_x_m", "end_z_m"],
-    "stack": ["top_z_m", "ground_force_N"],
-}
+PROGRAMS = ["vehicle", "chain", "stack"]
 POLICIES = ["implicit-euler", "matched", "exact", "fixed"]
-REFERENCE_PROFILE = "fixed:60"
-OTHER_RUNS = [("fixed:30", 1), ("uniform:15:45", 1), ("uniform:15:45", 2), ("uniform:15:45", 3)]
+PROFILES = ["fixed:60", "fixed:30", "uniform:15:45"]
+SEEDS = [1, 2, 3]
 SECONDS = 10.0
 
 
-def run_csv(build: pathlib.Path, program: str, variant: str, profile: str, seed: int,
-            extra: list[str] | None = None) -> dict[str, np.ndarray]:
-    """Runs one example and returns its CSV columns. variant: "own" or a policy name."""
-    if variant == "own":
-        command = [str(build / f"steadystep_example_{program}_ode")]
-    else:
-        command = [str(build / f"steadystep_example_{program}_steadystep"), "--policy", variant]
-    command += ["--profile", profile, "--seed", str(seed), "--duration", str(SECONDS)] + (extra or [])
-    done = subprocess.run(command, capture_output=True, text=True)
-    if done.returncode != 0:
-        sys.exit(f"bench_examples: {' '.join(command)} exited {done.returncode}: {done.stderr.strip()}")
-    lines = done.stdout.strip().splitlines()
-    names = lines[0].split(",")
-    table = np.array([[float(x) for x in line.split(",")] for line in lines[1:]])
-    return {name: table[:, i] for i, name in enumerate(names)}
+def frame_rate_tables(build: pathlib.Path, executor: str) -> None:
+    from steadystep import audit
 
-
-def on_grid(run: dict[str, np.ndarray], grid_s: np.ndarray, quantity: str) -> np.ndarray:
-    return np.interp(grid_s, run["t_s"], run[quantity])
-
-
-def mean_square(runs: list[dict[str, np.ndarray]], against: dict[str, np.ndarray], quantity: str) -> float:
-    grid_s = against["t_s"]
-    truth = against[quantity]
-    return float(np.mean([np.mean((on_grid(run, grid_s, quantity) - truth) ** 2) for run in runs]))
-
-
-def frame_rate_tables(build: pathlib.Path) -> None:
-    for program, quantities in PROGRAMS.items():
-        reference = run_csv(build, program, "implicit-euler", "fixed:1000", 1, ["--max-step", "0.001"])
-        scales = {quantity: float(np.ptp(reference[quantity])) for quantity in quantities}
-        print(f"\n{program}: A = " + ", ".join(f"{q} {scales[q]:.4g}" for q in quantities))
+    for program in PROGRAMS:
+        result = audit.audit(audit.Executable((str(build / f"steadystep_example_{program}_steadystep"),),
+                                              own=(str(build / f"steadystep_example_{program}_ode"),)),
+                             PROFILES, SEEDS, POLICIES, SECONDS, executor)
+        quantities = result.quantities
+        print(f"\n{program}: A = " + ", ".join(f"{q} {result.amplitudes[q]:.4g}" for q in quantities))
         print()
         print("| variant | " + " | ".join(f"spread {q}" for q in quantities) + " | "
               + " | ".join(f"error {q}" for q in quantities) + " |")
         print("|---" * (1 + 2 * len(quantities)) + "|")
-        for variant in ["own"] + POLICIES:
-            at_60 = run_csv(build, program, variant, REFERENCE_PROFILE, 1)
-            others = [run_csv(build, program, variant, profile, seed) for profile, seed in OTHER_RUNS]
-            spreads = [np.sqrt(mean_square(others, at_60, q)) / scales[q] for q in quantities]
-            errors = [np.sqrt(mean_square([at_60] + others, reference, q)) / scales[q] for q in quantities]
+        for variant in result.variants:
+            spreads = [result.spread["whole"][variant][q] for q in quantities]
+            errors = [result.deviation["whole"][variant][q] for q in quantities]
             name = f"{program}_ode (own stepping)" if variant == "own" else f"adopted, {variant}"
             print(f"| {name} | " + " | ".join(f"{x:.4f}" for x in spreads + errors) + " |")
+        check = result.reference
+        held = "the whole run" if check["holds_whole_run"] else \
+            f"{check['held_s']:.3g} s (not at " + ", ".join(f"{a:.3g}-{b:.3g} s" for a, b in check["not_held"]) + ")"
+        print(f"\nThe reference holds for {held}; the audit's recommendation: "
+              + next(c["variant"] for c in result.claims if c["kind"] == "recommend") + ".")
+        failed = [r for r in result.runs if r["status"] != "ok"]
+        if failed:
+            sys.exit(f"bench_examples: {program}: {len(failed)} runs failed: {failed[0]['status']}")
 
 
 def loop_seconds(build: pathlib.Path, variant: str, boxes: int, seconds: float) -> tuple[float, float]:
@@ -140,9 +120,15 @@ def main() -> None:
     parser.add_argument("--boxes", type=int, default=200, help="boxes of the cost run (default 200)")
     parser.add_argument("--cost-seconds", type=float, default=10.0, help="simulated time of a cost run (s)")
     parser.add_argument("--skip-cost", action="store_true", help="the frame-rate tables only")
+    parser.add_argument("--executor", default="local", help="where the audit's runs go (study.py; default local)")
     args = parser.parse_args()
     build = pathlib.Path(args.build).resolve()
-    frame_rate_tables(build)
+    from steadystep._native import SteadystepError
+
+    try:
+        frame_rate_tables(build, args.executor)
+    except SteadystepError as error:  # a program the audit refuses (BadProgram): its one line
+        sys.exit(f"bench_examples: {error}")
     if not args.skip_cost:
         cost_table(build, args.repeats, args.boxes, args.cost_seconds)
     diff_sizes(pathlib.Path(__file__).resolve().parent.parent)

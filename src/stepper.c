@@ -9,6 +9,7 @@
 
 #include "array.h"
 #include "error.h"
+#include "interpolation_internal.h"
 #include "ode_bounds.h"
 #include "registry_internal.h"
 #include "steadystep/adopt.h"
@@ -49,6 +50,7 @@ struct ssStepper {
   ssSoftness contact_tuned;
   ssRowLaw contact_law;
   ssFrameReport* report; /* the frame being stepped, for ssStepper_SoftenContact's counts */
+  ssPoseHistory* poses;  /* SS_CUT_FIXED: the known bodies' last two states, to draw (interpolation.c) */
   /* the first failure, latched until ssStepper_Reset */
   ssStatus failed_status;
   char failed_message[256];
@@ -146,6 +148,7 @@ void ssStepper_Destroy(ssStepper* stepper) {
   free(stepper->known);
   free(stepper->known_ids);
   free(stepper->pushed);
+  ssPoseHistory_Destroy(stepper->poses);
   free(stepper);
 }
 
@@ -222,6 +225,7 @@ void ssStepper_Reset(ssStepper* stepper) {
   stepper->accumulator_s = 0;
   stepper->short_frame_s = 0;
   forgetCarried(stepper);
+  ssPoseHistory_Forget(stepper->poses);
   describeNextStep(stepper);
 }
 
@@ -236,9 +240,12 @@ ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping) {
   stepper->previous_step_s = 0;
   stepper->accumulator_s = 0;
   stepper->short_frame_s = 0;
+  ssPoseHistory_Forget(stepper->poses);
   describeNextStep(stepper);
   return SS_OK;
 }
+
+ssPoseHistory** ssStepperPoseSlot(ssStepper* stepper) { return &stepper->poses; }
 
 ssStepping ssStepper_Stepping(const ssStepper* stepper) {
   if (stepper != NULL) return stepper->def.stepping;
@@ -471,6 +478,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     stepper->current = (ssStepInfo){mapping, step_s, softness_step_s, previous_step_s, i, steps};
     if (def->before_step) def->before_step(def->before_step_context, stepper);
     if (def->collide) def->collide(def->collide_context, stepper);
+    if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistory_BeforeLastStep(stepper->poses);
     int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, step_s)
                                                       : dWorldQuickStep(def->world, step_s);
     if (def->contact_group) dJointGroupEmpty(def->contact_group);
@@ -528,6 +536,8 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
 static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
   double step_s = stepping->fixed_step_s;
+  ssStatus status = ssPoseHistory_BeginFrame(&stepper->poses, stepper->known_ids, stepper->known_count);
+  if (status != SS_OK) return status;
   double accumulator_s = stepper->accumulator_s + frame_s;
   double due = floor(accumulator_s / step_s + kStepCountSlack);
   int cap = stepping->max_steps_per_frame;
@@ -536,7 +546,6 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
     accumulator_s -= report->dropped_s;
     due = cap;
   }
-  ssStatus status = SS_OK;
   if (due == 0) {
     carryForces(stepper, frame_s);
   } else {
@@ -546,6 +555,7 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
   stepper->accumulator_s = fmax(accumulator_s - report->steps * step_s, 0);
   report->carried_s = stepper->accumulator_s;
   report->interpolation = fmin(stepper->accumulator_s / step_s, nextafter(1.0, 0.0));
+  ssPoseHistory_EndFrame(stepper->poses, report->steps, report->interpolation);
   return status;
 }
 

@@ -10,5 +10,6 @@
 #include "steadystep/registry.h"
 #include "steadystep/adopt.h"
 #include "steadystep/stepper.h"
+#include "steadystep/interpolation.h"
 
 #endif

@@ -70,7 +70,7 @@ typedef struct dxJointGroup* dJointGroupID;
 typedef double dReal;
 typedef struct dContact dContact;
 """
-_CORE_HEADERS = ("limits.h", "registry.h", "adopt.h", "stepper.h")
+_CORE_HEADERS = ("limits.h", "registry.h", "adopt.h", "stepper.h", "interpolation.h")
 
 
 def _core_cdef_source() -> str:

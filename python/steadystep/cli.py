@@ -1,4 +1,4 @@
-"""The `steadystep` command: figure, compare, run, probe, convert. A thin layer over the package.
+"""The `steadystep` command: figure, compare, run, probe, convert, audit. A thin layer over the package.
 
 Whatever the arguments' bytes, the command never shows a traceback. Exit codes: 0 done; 1 a run blew up or broke
 (its records are still written); 2 a refusal: bad arguments, every SteadystepError, a file that cannot be read or
@@ -210,6 +210,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="longest step tried (default 0.25 s)")
     probe.add_argument("--json", action="store_true", help="strict JSON on stdout")
     _executor_argument(probe)
+
+    from steadystep import audit_cli  # the audit's arguments live with it
+    audit_cli.add_parser(commands, _seed, _executor_argument)
 
     convert = commands.add_parser("convert", help="springs <-> ERP/CFM <-> frequency and damping ratio",
                                   description="One of: --k K --c C --dt H (spring to ERP/CFM), --erp E --cfm F "
@@ -439,8 +442,10 @@ def _dispatch(argv: list[str]) -> int:
         args = build_parser().parse_args(argv)
     except SystemExit as done:  # --help: argparse has printed it
         return done.code if isinstance(done.code, int) else 0
+    from steadystep import audit_cli
+
     handler = {"figure": _figure, "compare": _compare, "run": _run, "probe": _probe,
-               "convert": _convert}[args.command]
+               "convert": _convert, "audit": audit_cli.command}[args.command]
     return handler(args, argv)
 
 

@@ -214,6 +214,24 @@ class Stepper:
                                           _handles.handle("body1", "body", body1),
                                           _handles.handle("body2", "body", body2)))
 
+    def interpolated_pose(self, body) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+        """The pose to draw body at after the last frame (steadystep/interpolation.h): (position in m, rotation as
+        ODE's quaternion w, x, y, z). Under the fixed cut, blended between its last two physics states at the
+        frame's interpolation factor (drawn up to one fixed step behind; a body the program moved between frames is
+        drawn where it put it); under the other cuts ODE's own pose. SteadystepError ("not found") for a body the
+        stepper did not know at its last fixed frame."""
+        position, quaternion = ffi.new("double[3]"), ffi.new("double[4]")
+        check(lib.ssStepper_InterpolatedPose(self._between_frames("interpolated_pose"),
+                                             _handles.handle("body", "body", body), position, quaternion))
+        return tuple(position), tuple(quaternion)
+
+    def set_interpolation(self, on: bool) -> None:
+        """Keeps the poses to draw under the fixed cut (True, the default) or nothing (False: a program that draws
+        nothing; interpolated_pose then gives ODE's pose)."""
+        if not isinstance(on, bool):
+            raise SteadystepError("out of range", f"on = {shown(on)}: must be True or False")
+        check(lib.ssStepper_SetInterpolation(self._between_frames("set_interpolation"), int(on)))
+
     def reset(self) -> None:
         """After a failure, once the program repaired or restored its bodies: accepts frames again. Also forgets
         the step history, the FIXED accumulator and the momentum carried over."""

@@ -1,0 +1,96 @@
+"""The `steadystep audit` subcommand: its arguments and its run (cli.py hooks it in)."""
+
+from __future__ import annotations
+
+import math
+import shlex
+from pathlib import Path
+
+from steadystep._native import SteadystepError
+
+HELP = ("audit your own program: its frame-rate dependence under every policy, against a checked reference")
+DESCRIPTION = (
+    "Runs PROGRAM (an executable taking --profile SPEC --seed N --duration S --policy NAME and printing CSV "
+    "t_s,<quantity>_<unit>,... on stdout, one row per frame; exit 0 done, 1 a frame failed) or a Python file "
+    "(--python FILE defining build_world() and read_quantities(world)) under every frame-time profile and policy, "
+    "and the program's own stepping (--own: the same flags but --policy), against a fine-step reference "
+    "(implicit-euler at 1000 frames a second) that it checks at 4000. Writes audit.html, metrics.json and "
+    "metrics.csv to --out (docs/audit.md). A program that does not exist, is not executable, prints no or "
+    "malformed CSV, hangs past --time-limit or crashes is refused with exit 2, naming it.")
+
+
+def _positive(text: str) -> float:
+    import argparse
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text!r} must be a finite number above 0")
+    return value
+
+
+def add_parser(commands, seed_type, executor_argument) -> None:
+    """The audit subparser, on cli.py's subcommands (seed_type and executor_argument: cli.py's own)."""
+    from steadystep import audit
+
+    parser = commands.add_parser("audit", help=HELP, description=DESCRIPTION)
+    program = parser.add_mutually_exclusive_group(required=True)
+    program.add_argument("program", nargs="?", metavar="PROGRAM", help="the program run with --policy NAME; "
+                         "quote it with its own fixed arguments: 'build/game --level 2'")
+    program.add_argument("--python", metavar="FILE", help="a Python file defining build_world() and "
+                         "read_quantities(world) (docs/audit.md)")
+    parser.add_argument("--own", metavar="PROGRAM", help="the same program stepping on its own, without the "
+                        "library (the same flags but --policy)")
+    parser.add_argument("--out", type=Path, default=Path("audit"), metavar="DIR", help="output directory "
+                        "(default ./audit)")
+    parser.add_argument("--force", action="store_true", help="replace an earlier audit's files in --out")
+    parser.add_argument("--profiles", nargs="+", default=list(audit.DEFAULT_PROFILES), metavar="SPEC",
+                        help=f"frame-time profiles, the first the baseline of the spread (default: "
+                        f"{' '.join(audit.DEFAULT_PROFILES)})")
+    parser.add_argument("--seeds", nargs="+", type=seed_type, default=list(audit.DEFAULT_SEEDS), metavar="N",
+                        help="seeds of the random profiles, each run once per seed (default 1 2 3)")
+    parser.add_argument("--policies", nargs="+", metavar="POLICY", help="default: every policy")
+    parser.add_argument("--duration", type=_positive, default=audit.DEFAULT_DURATION_S, metavar="S",
+                        help=f"simulated seconds per run (default {audit.DEFAULT_DURATION_S:g})")
+    parser.add_argument("--time-limit", type=_positive, default=60.0, metavar="S",
+                        help="wall seconds a run of an executable may take before it is killed and the program "
+                        "refused (default 60)")
+    executor_argument(parser)
+
+
+def command(args, argv) -> int:
+    from steadystep import audit
+    from steadystep.audit_run import Executable, PythonProgram
+
+    found = audit.existing_outputs(args.out)
+    if found and not args.force:  # refused before anything runs
+        raise SteadystepError("exists", f"{found[0]}: an earlier audit is there; pass --force to replace it, or "
+                              "--out another directory")
+    if args.out.exists() and not args.out.is_dir():
+        raise SteadystepError("exists", f"--out {args.out}: exists and is not a directory")
+    if args.python:
+        if args.own:
+            raise SteadystepError("out of range", f"--own {args.own}: a --python program is stepped by the library "
+                                  "and has no own stepping to compare")
+        program = PythonProgram(args.python)
+    else:
+        words = shlex.split(args.program)
+        if not words:
+            raise SteadystepError("out of range", "PROGRAM = '': name the program to audit")
+        own = tuple(shlex.split(args.own)) if args.own else None
+        program = Executable(tuple(words), own, args.time_limit)
+    audit.validate(program, args.profiles, args.seeds, args.policies or [], args.duration)
+    from steadystep import study
+
+    try:
+        with study.make_executor(args.executor) as executor:
+            result = audit.audit(program, args.profiles, args.seeds, args.policies, args.duration, executor)
+    except study.ExecutorUnavailable as error:
+        raise SteadystepError("out of range", f"steadystep audit: {error}") from None
+    path = audit.write(result, args.out, shlex.join(["steadystep", *argv]), force=args.force)
+    print(path)
+    for claim in result.claims:
+        print(f"- {claim['text']}")
+    return 0

@@ -1,0 +1,136 @@
+"""`steadystep audit` end to end on real programs: the three example programs (each against its own stepping), the
+chaotic pendulum that takes part through the lab's audit_flags.h, and a Python program. Short runs, two profiles.
+
+Each page's recommendation is checked claim by claim against its own metrics.json by an independent reader
+(audit_claims_check.py), and the audit's numbers for an example equal those recomputed here from the programs' own
+CSV with the definitions of bench/bench_examples.py (docs/examples.md)."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import audit_claims_check
+
+ROOT = Path(__file__).resolve().parents[2]
+BUILD = ROOT / "build"
+SCRIPT = Path(sys.executable).parent / "steadystep"
+COMMAND = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "steadystep.cli"]
+SHORT = ["--duration", "2", "--profiles", "fixed:60", "uniform:15:45", "--seeds", "1", "2"]
+EXAMPLES = {"vehicle": ["height_m", "pitch_rad"], "chain": ["end_x_m", "end_z_m"],
+            "stack": ["top_z_m", "ground_force_N"]}
+
+pytestmark = pytest.mark.skipif(not (BUILD / "steadystep_example_chain_steadystep").exists(),
+                                reason="needs the example programs built in build/")
+
+
+def steadystep(*args):
+    return subprocess.run([*COMMAND, *map(str, args)], capture_output=True, text=True, timeout=300)
+
+
+def audited(out: Path, *args) -> dict:
+    done = steadystep("audit", *args, "--out", out, *SHORT)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[0] == str(out / "audit.html")
+    for name in ("audit.html", "metrics.json", "metrics.csv"):
+        assert (out / name).stat().st_size > 0
+    return json.loads((out / "metrics.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def examples(tmp_path_factory) -> dict:
+    out = {}
+    for program in EXAMPLES:
+        directory = tmp_path_factory.mktemp(program)
+        out[program] = (directory, audited(directory, BUILD / f"steadystep_example_{program}_steadystep",
+                                           "--own", BUILD / f"steadystep_example_{program}_ode"))
+    return out
+
+
+@pytest.mark.parametrize("program", EXAMPLES)
+def test_example_page_agrees_with_its_tables(examples, program):
+    directory, metrics = examples[program]
+    assert metrics["quantities"] == EXAMPLES[program]
+    assert metrics["variants"][0] == "own" and "implicit-euler" in metrics["variants"]
+    kinds = audit_claims_check.check(metrics)
+    assert {"least_spread", "least_deviation", "cheapest", "recommend"} <= set(kinds)
+    page = (directory / "audit.html").read_text()
+    for claim in metrics["claims"]:  # each claim on the page, linked to a table that is there
+        assert f"href='#{claim['table']}'" in page and f"id='{claim['table']}'" in page
+    # The adopted programs move alike at every frame rate; their own stepping does not (docs/examples.md).
+    spread = metrics["spread"]["window"]
+    assert max(spread["implicit-euler"].values()) < max(spread["own"].values())
+
+
+def _csv(program: str, variant: str, profile: str, seed: int) -> dict:
+    command = ([str(BUILD / f"steadystep_example_{program}_ode")] if variant == "own" else
+               [str(BUILD / f"steadystep_example_{program}_steadystep"), "--policy", variant])
+    if variant == "reference":
+        command = [str(BUILD / f"steadystep_example_{program}_steadystep"), "--policy", "implicit-euler",
+                   "--max-step", "0.001"]
+    text = subprocess.run(command + ["--profile", profile, "--seed", str(seed), "--duration", "2"],
+                          capture_output=True, text=True, check=True).stdout.split()
+    table = np.array([[float(x) for x in line.split(",")] for line in text[1:]])
+    return {name: table[:, i] for i, name in enumerate(text[0].split(","))}
+
+
+def test_numbers_equal_the_bench_definitions(examples):
+    """bench_examples.py's spread and error, computed here from the programs' CSV: the same as the audit's."""
+    _, metrics = examples["chain"]
+    reference = _csv("chain", "reference", "fixed:1000", 1)
+    runs = [(p["profile"], p["seed"]) for p in metrics["profile_runs"]]
+    assert runs == [("fixed:60", 1), ("uniform:15:45", 1), ("uniform:15:45", 2)]
+    for variant in ("own", "implicit-euler", "fixed"):
+        csvs = [_csv("chain", variant, profile, seed) for profile, seed in runs]
+        for q in EXAMPLES["chain"]:
+            scale = np.ptp(reference[q])
+            assert metrics["amplitudes"][q] == scale
+
+            def mean_square(others, against):
+                return np.mean([np.mean((np.interp(against["t_s"], run["t_s"], run[q]) - against[q]) ** 2)
+                                for run in others])
+            spread = np.sqrt(mean_square(csvs[1:], csvs[0])) / scale
+            error = np.sqrt(mean_square(csvs, reference)) / scale
+            assert metrics["spread"]["whole"][variant][q] == pytest.approx(spread, rel=1e-12, abs=1e-15)
+            assert metrics["deviation"]["whole"][variant][q] == pytest.approx(error, rel=1e-12, abs=1e-15)
+
+
+def test_chaos_limits_the_claims_to_where_the_reference_holds(tmp_path):
+    """The double pendulum parts from itself at a finer step after a few seconds: the audit says where, and every
+    claim is measured up to there."""
+    pendulum = BUILD / "steadystep_example_audit_pendulum"
+    done = steadystep("audit", pendulum, "--own", pendulum, "--out", tmp_path, "--duration", "8", "--profiles",
+                      "fixed:60", "uniform:15:45", "--seeds", "1", "--policies", "implicit-euler", "exact", "fixed")
+    assert done.returncode == 0, done.stderr
+    metrics = json.loads((tmp_path / "metrics.json").read_text())
+    check = metrics["reference_check"]
+    assert not check["holds_whole_run"] and len(check["not_held"]) >= 1, check
+    parted_s, end_s = check["not_held"][0][0], check["not_held"][-1][1]
+    assert 1.0 < parted_s < 6.0 and end_s == pytest.approx(8.0), check  # parted for good after a few seconds
+    kinds = audit_claims_check.check(metrics)
+    assert "recommend" in kinds and "served" in kinds
+    # The window's numbers are not the whole run's: after the parting, every run wanders off.
+    assert metrics["deviation"]["window"]["exact"]["tip_x_m"] < metrics["deviation"]["whole"]["exact"]["tip_x_m"]
+    # exact hands the pendulum's near-rigid hinge rows to implicit Euler, every one of them: the same numbers.
+    served = metrics["served"]["exact"]
+    assert served["rows_handed_to_implicit_euler"] > 0
+    assert metrics["spread"]["window"]["exact"] == metrics["spread"]["window"]["implicit-euler"]
+
+
+def test_python_program(tmp_path):
+    done = steadystep("audit", "--python", ROOT / "examples" / "audit_slider.py", "--out", tmp_path, "--duration",
+                      "2", "--profiles", "fixed:60", "uniform:15:45", "--seeds", "1", "--policies",
+                      "implicit-euler", "exact", "fixed")
+    assert done.returncode == 0, done.stderr
+    metrics = json.loads((tmp_path / "metrics.json").read_text())
+    assert metrics["quantities"] == ["x_m", "v_m_per_s"] and metrics["own"] is None
+    audit_claims_check.check(metrics)
+    # The spring is linear with a known mass: exact follows it far closer than implicit Euler's damping does.
+    deviation = metrics["deviation"]["window"]
+    assert deviation["exact"]["x_m"] < 0.5 * deviation["implicit-euler"]["x_m"]
+    # One step of at most 1/60 s per frame at 60 fps: the steps column the audit counted itself.
+    steps = {(r["variant"], r["profile"]): r["steps_per_frame"] for r in metrics["runs"]}
+    assert steps["exact", "fixed:60"] == 1.0 and steps["exact", "uniform:15:45"] > 1.0
