@@ -63,6 +63,16 @@
  *  finite at all 64 corners (both solvers, h, erp, cfm and mass at their bounds); from 1e90, 16 of them abort. */
 #define SS_MAX_SAFE_SPEED 1e50
 
+/** The farthest a known body's centre may be from the origin along any axis (m): 1e6 (1000 km). ODE's collision
+ *  spaces turn positions into cell indices: a hash space (dHashSpaceCreate, default levels -3 to 10) aborts the
+ *  process (`aabbBound < dMaxIntExact`) once a geom's cell index leaves the int range, at 2^31 cells of its level.
+ *  Probed with tests/c/space_probe.c (two touching boxes collided once, then stepped): boxes of 0.01 m abort from
+ *  3e8 m (2^31 cells of 1/8 m), boxes of 100 m from 1e12 m; simple, quadtree and sweep-and-prune spaces collide
+ *  and step finite up to 1e100 m. The bound sits 268 times inside the smallest default-level edge, and inside it
+ *  too for a hash space whose smallest level a program lowered to -10 (2^21 m); a body beyond it is refused by name
+ *  (SS_ERROR_POSITION_LIMIT) before its next step, and a step at max_speed below 1e4 m/s moves at most 3.6e7 m. */
+#define SS_MAX_POSITION_M 1e6
+
 /** The largest force (N) or torque (N·m) the library hands to ODE: 1e30, the program's frame forces that the
  *  stepper puts back before each substep and the load corrections of ssRegistry_SetJointLoad alike. With masses of
  *  at least SS_MIN_MASS_KG and steps of at most SS_MAX_STEP_S, one step changes a speed by at most 3.6e45, inside

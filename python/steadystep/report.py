@@ -396,7 +396,8 @@ def _as_json(report: Report, command: str) -> dict:
                   "deviation": dict(r.deviations),
                   "steps_per_frame": r.steps_per_frame, "steps_per_second": r.steps_per_second,
                   "rms_vs_exact": r.rms_vs_exact, "rows_handed_to_implicit_euler": r.rows_handed_to_implicit_euler,
-                  "contacts_handed_to_implicit_euler": r.contacts_handed_to_implicit_euler, **({"grid": r.grid} if r.grid else {})}
+                  "contacts_handed_to_implicit_euler": r.contacts_handed_to_implicit_euler,
+                  **({"grid": r.grid} if r.grid else {})}
                  for r in report.rows],
         "spread": report.spreads,
         "consistency": report.consistency,

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <limits>
 #include <string>
@@ -32,11 +33,8 @@ std::string Number(double value) {
   return text;
 }
 
-// Runs the probe in a child (fork + exec, output discarded) and waits for it.
-Outcome Probe(const std::string& solver, double step_s, double erp, double cfm, double mass, int steps,
-              double speed = 1) {
-  std::vector<std::string> args = {ODE_PROBE, solver, Number(step_s), Number(erp), Number(cfm),
-                                   Number(mass), Number(mass), std::to_string(steps), Number(speed)};
+// Runs a probe program in a child (fork + exec, output discarded) and waits for it.
+Outcome Run(std::vector<std::string> args) {
   std::vector<char*> argv;
   for (std::string& arg : args) argv.push_back(arg.data());
   argv.push_back(nullptr);
@@ -44,7 +42,7 @@ Outcome Probe(const std::string& solver, double step_s, double erp, double cfm, 
   if (child == 0) {
     std::freopen("/dev/null", "w", stdout);
     std::freopen("/dev/null", "w", stderr);
-    execv(ODE_PROBE, argv.data());
+    execv(argv[0], argv.data());
     _exit(127);
   }
   Outcome outcome;
@@ -54,6 +52,18 @@ Outcome Probe(const std::string& solver, double step_s, double erp, double cfm, 
   if (outcome.exited) outcome.code = WEXITSTATUS(status);
   if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
   return outcome;
+}
+
+// The ODE step probe (tests/c/ode_probe.c).
+Outcome Probe(const std::string& solver, double step_s, double erp, double cfm, double mass, int steps,
+              double speed = 1) {
+  return Run({ODE_PROBE, solver, Number(step_s), Number(erp), Number(cfm), Number(mass), Number(mass),
+              std::to_string(steps), Number(speed)});
+}
+
+// The collision space probe (tests/c/space_probe.c): two touching boxes of size_m at position_m, collided once.
+Outcome SpaceProbe(const std::string& space, double position_m, double size_m) {
+  return Run({SPACE_PROBE, space, Number(position_m), Number(size_m)});
 }
 
 struct Corner {
@@ -138,6 +148,21 @@ TEST(Limits, TheChecksRefuseByNameOutsideAndAcceptTheEdges) {
   EXPECT_EQ(ssCheckMass("body 3 mass", 1e-320), SS_ERROR_OUT_OF_RANGE);
   EXPECT_EQ(ssCheckMass("body 3 mass", 0), SS_ERROR_OUT_OF_RANGE);
   EXPECT_EQ(ssCheckMass("body 3 mass", -inf), SS_ERROR_NOT_FINITE);
+}
+
+// SS_MAX_POSITION_M keeps every collision space finite: ODE's hash space aborts far beyond it (so the probe can
+// fail), and no space aborts at it, whatever the geom's size down to a centimetre.
+TEST(Limits, CollisionSpacesStayFiniteWithinThePositionBound) {
+  for (const char* space : {"simple", "hash", "quadtree", "sap"})
+    for (double size_m : {0.01, 1.0, 100.0})
+      for (double position_m : {SS_MAX_POSITION_M, -SS_MAX_POSITION_M}) {
+        Outcome outcome = SpaceProbe(space, position_m, size_m);
+        EXPECT_TRUE(outcome.exited && outcome.code == 0)
+            << space << " at " << position_m << " m, boxes of " << size_m << " m: signal " << outcome.signal;
+      }
+  Outcome beyond = SpaceProbe("hash", 1e9, 0.01);  // 2^31 cells of 1/8 m end at 2.7e8 m
+  EXPECT_FALSE(beyond.exited);
+  EXPECT_EQ(beyond.signal, SIGABRT);
 }
 
 }  // namespace

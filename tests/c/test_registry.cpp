@@ -353,6 +353,63 @@ TEST_F(RegistryTest, BindingAgainReplacesAndUnbindRemoves) {
   ssRegistry_Destroy(registry);
 }
 
+// Many bindings, rebound, unbound in a scattered order and bound again: each row is found (or not) as a plain list of
+// what is bound says, and Apply writes each bound row's own spring.
+TEST_F(RegistryTest, ManyBindingsAreFoundAfterRebindingAndUnbindingInAnyOrder) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  const int count = 3000;
+  std::vector<dJointID> hinges;
+  std::vector<dBodyID> bodies;
+  for (int i = 0; i < count; ++i) {
+    bodies.push_back(MakeBody(1.0, 0.01 * i, 0, 1));
+    hinges.push_back(dJointCreateHinge(world, 0));
+    dJointAttach(hinges.back(), bodies.back(), 0);
+    ASSERT_EQ(ssRegistry_BindJoint(registry, hinges[i], SS_PARAM_STOP, 1, kSpring, 0), SS_OK);
+    ASSERT_EQ(ssRegistry_BindJoint(registry, hinges[i], SS_PARAM_MOTOR, 1, ssSpring{0, 5}, 0), SS_OK);
+    ASSERT_EQ(ssRegistry_BindDamping(registry, bodies[i], 0.1, 0.2), SS_OK);
+  }
+  // rebinding replaces: the stop of every third hinge gets a spring of its own
+  std::vector<double> stiffness(count, kSpring.stiffness);
+  for (int i = 0; i < count; i += 3) {
+    stiffness[i] = 100.0 + i;
+    ASSERT_EQ(ssRegistry_BindJoint(registry, hinges[i], SS_PARAM_STOP, 1, ssSpring{stiffness[i], 12.0}, 0), SS_OK);
+  }
+  EXPECT_EQ(ssRegistry_JointBindingCount(registry), 2 * count);
+  // unbind a scattered half (a multiplicative walk visits every index once)
+  std::vector<bool> bound(count, true);
+  for (int k = 0; k < count / 2; ++k) {
+    int i = (int)((k * 2654435761u) % count);
+    if (!bound[i]) continue;
+    bound[i] = false;
+    ASSERT_EQ(ssRegistry_UnbindJoint(registry, hinges[i]), SS_OK);
+    ASSERT_EQ(ssRegistry_UnbindBody(registry, bodies[i]), SS_OK);
+  }
+  int still = 0;
+  for (int i = 0; i < count; ++i) {
+    still += bound[i];
+    // a load can be declared exactly on the rows still bound
+    EXPECT_EQ(ssRegistry_SetJointLoad(registry, hinges[i], SS_PARAM_STOP, 1, 0.5), bound[i] ? SS_OK : SS_ERROR_NOT_FOUND)
+        << i;
+    EXPECT_EQ(ssRegistry_UnbindBody(registry, bodies[i]), bound[i] ? SS_OK : SS_ERROR_NOT_FOUND) << i;
+    ASSERT_EQ(ssRegistry_BindDamping(registry, bodies[i], 0.1, 0.2), SS_OK);
+  }
+  EXPECT_EQ(ssRegistry_JointBindingCount(registry), 2 * still);
+  // the unbound half bound again, with a spring that says which
+  for (int i = 0; i < count; ++i)
+    if (!bound[i]) {
+      stiffness[i] = 50.0;
+      ASSERT_EQ(ssRegistry_BindJoint(registry, hinges[i], SS_PARAM_STOP, 1, ssSpring{50.0, 12.0}, 0), SS_OK);
+    }
+  EXPECT_EQ(ssRegistry_JointBindingCount(registry), count + still);
+  const double h = 0.01;
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, h, 0, nullptr), SS_OK);
+  for (int i = 0; i < count; ++i) {
+    EXPECT_DOUBLE_EQ(dJointGetHingeParam(hinges[i], dParamStopCFM), 1.0 / (h * stiffness[i] + 12.0)) << i;
+    EXPECT_DOUBLE_EQ(dBodyGetLinearDamping(bodies[i]), -std::expm1(-0.1 * h)) << i;
+  }
+  ssRegistry_Destroy(registry);
+}
+
 TEST_F(RegistryTest, SpringsWithoutSoftnessAtSomeStepAreRefusedAtBindTimeAndApplyErrorsWriteNothing) {
   ssRegistry* registry = ssRegistry_Create(world);
   dJointID first = dJointCreateSlider(world, 0);

@@ -237,14 +237,27 @@ TEST_F(StepperTest, BlowUpsAndRunawaysAreReportedAndStepsAreRefusedUntilReset) {
   OscillatorRig rig;
   rig.def.stepping.max_speed = 100;
   ASSERT_EQ(rig.Build(), SS_OK);
-  dBodyID loose = MakeBody(1.0);
-  ssStepper_WatchBody(rig.stepper, loose);
-  dBodySetLinearVel(loose, 150, 0, 0);
+  EXPECT_EQ(ssStepper_WatchBody(rig.stepper, MakeBody(1.0)), SS_ERROR_OUT_OF_RANGE);  // of the fixture's world
+  EXPECT_NE(std::string(ssLastError()).find("of another world"), std::string::npos) << ssLastError();
+  dBodyID loose = dBodyCreate(rig.world);  // 1 kg
+  ASSERT_EQ(ssStepper_WatchBody(rig.stepper, loose), SS_OK);
   ssFrameReport report;
+  // Set between frames: refused before anything is stepped.
+  dBodySetLinearVel(loose, 150, 0, 0);
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_SPEED_LIMIT);
+  EXPECT_EQ(report.failed_body, loose);
+  EXPECT_EQ(report.steps, 0);
+  EXPECT_NE(std::string(ssLastError()).find("speed 150 m/s before the frame"), std::string::npos) << ssLastError();
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_FAILED);
+  ssStepper_Reset(rig.stepper);
+  // Reached in a step: 99 m/s plus 3000 N on 1 kg for 1/60 s is 149 m/s after the first of three substeps.
+  dBodySetLinearVel(loose, 99, 0, 0);
+  dBodyAddForce(loose, 3000, 0, 0);
   EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_SPEED_LIMIT);
   EXPECT_EQ(report.failed_body, loose);
   EXPECT_EQ(report.steps, 1);  // the frame stops at the step that failed
   EXPECT_NE(std::string(ssLastError()).find("max_speed = 100"), std::string::npos) << ssLastError();
+  EXPECT_NE(std::string(ssLastError()).find("after step 1 of 3"), std::string::npos) << ssLastError();
 
   // Latched: every later frame is refused, names the first failure and touches nothing.
   dBodySetLinearVel(loose, 0, 0, 0);
@@ -280,7 +293,7 @@ TEST_F(StepperTest, TheSpeedGuardIsOnByDefaultForLinearAndAngularSpeed) {
   EXPECT_GT(def.stepping.max_angular_speed, 0);
   OscillatorRig rig;
   ASSERT_EQ(rig.Build(), SS_OK);
-  dBodyID spinning = MakeBody(1.0);
+  dBodyID spinning = dBodyCreate(rig.world);
   ASSERT_EQ(ssStepper_WatchBody(rig.stepper, spinning), SS_OK);
   dBodySetAngularVel(spinning, 0, 0, 2 * def.stepping.max_angular_speed);
   ssFrameReport report;

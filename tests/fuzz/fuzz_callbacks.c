@@ -11,8 +11,9 @@
  * Promises checked: the process never aborts and no sanitizer reports (ODE's asserts included: nothing the program
  * does the ordinary way may make ODE abort); every refusal is a named ssStatus with a non-empty ssLastError(); a
  * frame reported OK that took a step leaves every body finite (unless the program itself set a state after the
- * frame's last check, in the last step_done). Actions fire only in the outermost frame's callbacks: a frame stepped from a callback
- * (before the stepper refused re-entry) runs the contacts only. */
+ * frame's last check, in the last step_done); ssStepper_Step and SetStepping from a callback are refused with
+ * SS_ERROR_REENTERED, and Reset records why it did nothing; a frame whose callback destroyed its stepper returns
+ * SS_OK (stepper.h). */
 #include "fuzz_world.h"
 
 enum { MAX_OPS = 40, MAX_ACTIONS = 6, EVERY_STEP = -1 };
@@ -42,7 +43,7 @@ typedef struct Program {
   World w;
   Action actions[MAX_ACTIONS];
   int action_count;
-  int in_action;          /* an action is running: the frames it steps fire none */
+  int in_action;          /* an action is running: callbacks it causes (a re-entered frame) fire none */
   int steps_done;         /* step_done calls in this frame: step_done gets no step index */
   int set_after_check;    /* a state was set in step_done, after the frame's last check */
   int stepper_destroyed;  /* ssStepper_Destroy was called from a callback in this frame */
@@ -180,8 +181,8 @@ static void fire(Program* p, ssStepper* stepper, const Action* a) {
       ssFrameReport report;
       ssStatus status = ssStepper_Step(stepper, a->values[0], &report);
       if (verbose) fprintf(stderr, "    = %s %s\n", ssStatusName(status), status == SS_OK ? "" : ssLastError());
-      check_status(status, "ssStepper_Step from a callback");
-      if (status == SS_OK) w->steps_left -= report.steps;
+      FUZZ_REQUIRE(status == SS_ERROR_REENTERED && ssLastError()[0] != '\0', "ssStepper_Step from a callback: %s",
+                   ssStatusName(status));
       break;
     }
     case REENTER_SET_STEPPING: {
@@ -190,11 +191,14 @@ static void fire(Program* p, ssStepper* stepper, const Action* a) {
       if (ssSteppingForPolicy(name, 1.0 / 60, &stepping) != SS_OK) break;
       ssStatus status = ssStepper_SetStepping(stepper, &stepping);
       if (verbose) fprintf(stderr, "    = %s %s\n", ssStatusName(status), status == SS_OK ? "" : ssLastError());
-      check_status(status, "ssStepper_SetStepping from a callback");
-      if (status == SS_OK) w->stepping = ssStepper_Stepping(stepper);
+      FUZZ_REQUIRE(status == SS_ERROR_REENTERED && ssLastError()[0] != '\0',
+                   "ssStepper_SetStepping from a callback: %s", ssStatusName(status));
       break;
     }
-    case REENTER_RESET: ssStepper_Reset(stepper); break;
+    case REENTER_RESET:
+      ssStepper_Reset(stepper);
+      FUZZ_REQUIRE(strstr(ssLastError(), "ssStepper_Reset") != NULL, "ssStepper_Reset from a callback said nothing");
+      break;
     case REENTER_RESET_HISTORY: ssStepper_ResetHistory(stepper); break;
     case REENTER_DESTROY:
       ssStepper_Destroy(stepper);
@@ -231,7 +235,7 @@ static void collide(void* context, ssStepper* stepper) {
 static void step_done(void* context, double step_s) {
   (void)step_s;
   Program* p = context;
-  if (p->in_action) return; /* a step of a frame stepped from a callback */
+  if (p->in_action) return;
   run_actions(p, p->w.stepper, WHEN_STEP_DONE, p->steps_done++);
 }
 
@@ -277,6 +281,8 @@ static void frame(Program* p, double frame_s, int op) {
             frame_s, ssStatusName(status), report.steps, status == SS_OK ? "" : ssLastError());
   check_status(status, "ssStepper_Step");
   if (p->stepper_destroyed) {
+    /* stepper.h: the frame stops where it is, the report is filled, SS_OK, and the stepper is freed. */
+    FUZZ_REQUIRE(status == SS_OK, "op %d: the frame that destroyed its stepper returned %s", op, ssStatusName(status));
     replace_stepper(p);
     return;
   }

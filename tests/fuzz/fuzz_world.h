@@ -71,6 +71,11 @@ typedef struct World {
   int adopt;                       /* soft rows come from adoption rather than from binding */
   ssStepping stepping;             /* the stepper's, as last accepted */
   int steps_left;                  /* of STEP_BUDGET */
+  /* fuzz_stepper's before_step in the next frame: at step `at`, `what` (0 nothing) with `value` on island `kind` */
+  struct {
+    int what, at, kind;
+    double value;
+  } plan;
 } World;
 
 typedef struct BodyState {
