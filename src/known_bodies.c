@@ -180,7 +180,11 @@ static int within(const dReal* v, double bound) {
   return fabs(v[0]) <= bound && fabs(v[1]) <= bound && fabs(v[2]) <= bound;
 }
 
-static double squared(const dReal* v) { return v[0] * v[0] + v[1] * v[1] + v[2] * v[2]; }
+/* in double whatever dReal is: a float speed's square overflows from 2e19 m/s, which is still a finite runaway */
+static double squared(const dReal* v) {
+  double x = v[0], y = v[1], z = v[2];
+  return x * x + y * y + z * z;
+}
 
 /* |v| without overflow, for messages: a spin of 1e200 rad/s is named as such, not as inf */
 static double norm(const dReal* v) {

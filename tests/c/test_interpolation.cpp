@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "ode_fixture.h"
+#include "precision.h"
 #include "steadystep/steadystep.h"
 
 namespace {
@@ -90,7 +91,9 @@ class InterpolationTest : public OdeTest {
       ASSERT_EQ(ssStepper_InterpolatedPose(stepper, bodies[b], position, quaternion), SS_OK);
       for (int i = 0; i < 3; ++i) EXPECT_NEAR(position[i], (1 - a) * prev[b].p[i] + a * curr[b].p[i], 1e-12);
       Slerp(prev[b].q, curr[b].q, a, expected);
-      for (int i = 0; i < 4; ++i) EXPECT_NEAR(quaternion[i], expected[i], 1e-12) << "body " << b << " a " << a;
+      // a float ODE's quaternion is unit only to its epsilon: the two slerps part by up to 9e-8 there
+      for (int i = 0; i < 4; ++i)
+        EXPECT_NEAR(quaternion[i], expected[i], ReadBackTolerance(1e-12, 2)) << "body " << b << " a " << a;
     }
   }
 
