@@ -131,9 +131,9 @@ static void push(dBodyID body, uint8_t which, const double* v) {
 }
 
 /* Sets a state the way a program does: which % 3 is the position, the velocity, the spin. */
-static void set_state(dBodyID body, uint8_t which, const double* v) {
+static void set_state(World* w, dBodyID body, uint8_t which, const double* v) {
   switch (which % 3) {
-    case 0: dBodySetPosition(body, v[0], v[1], v[2]); break;
+    case 0: teleport(w, body, v[0], v[1], v[2]); break;
     case 1: dBodySetLinearVel(body, v[0], v[1], v[2]); break;
     default: dBodySetAngularVel(body, v[0], v[1], v[2]); break;
   }
@@ -153,7 +153,7 @@ static void fire(Program* p, ssStepper* stepper, const Action* a) {
     case SET_STATE: {
       dBodyID body = pick_body(w, a->target);
       if (body == 0) break;
-      set_state(body, a->which, a->values);
+      set_state(w, body, a->which, a->values);
       if (a->when == WHEN_STEP_DONE) p->set_after_check = 1;
       break;
     }
@@ -303,7 +303,7 @@ static void repair(World* w) {
   for (int k = 0; k < ISLAND_COUNT; ++k)
     for (int i = 0; i < w->islands[k].body_count; ++i) {
       dBodyID body = w->islands[k].bodies[i];
-      dBodySetPosition(body, 2.0 * k + 0.4 * i, 0, 1.0);
+      dBodySetPosition(body, 2.0 * k + 0.6 * i, 0, 1.0); /* the gears as built: never on each other */
       dBodySetLinearVel(body, 0, 0, 0);
       dBodySetAngularVel(body, 0, 0, 0);
       dBodySetForce(body, 0, 0, 0);
@@ -371,7 +371,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         double v[3];
         read_vector(&in, v);
         if (body == 0) break;
-        if (code % 9 == 3) set_state(body, which, v);
+        if (code % 9 == 3) set_state(w, body, which, v);
         else push(body, which, v);
         if (verbose)
           fprintf(stderr, "  %s %d: %.17g %.17g %.17g\n", code % 9 == 3 ? "state" : "force", which, v[0], v[1], v[2]);

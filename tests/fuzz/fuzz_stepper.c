@@ -37,7 +37,7 @@ static void before_step(void* context, ssStepper* stepper) {
     case 1: if (body) dBodyAddTorque(body, v, 0, 0); break; /* a PD controller's torque, NaN included */
     case 2: if (body) dBodyAddForce(body, 0, v, 0); break;
     case 3: if (body) dBodySetAngularVel(body, 0, 0, v); break;
-    case 4: if (body) dBodySetPosition(body, v, 0, 0.5); break;
+    case 4: if (body) teleport(w, body, v, 0, 0.5); break;
     case 5: /* destroyed and built again inside the frame: the stepper must forget the one and find the other */
       if (v > 0) destroy_island_bodies(w, kind);
       destroy_island_joints(w, kind);
@@ -127,7 +127,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (body == 0) break;
         if (verbose) fprintf(stderr, "  set %d to %.17g\n", which % 5, v);
         switch (which % 5) {
-          case 0: dBodySetPosition(body, v, 0, 0.5); break;
+          case 0: teleport(&w, body, v, 0, 0.5); break;
           case 1: dBodySetLinearVel(body, 0, v, 0); break;
           case 2: dBodySetAngularVel(body, v, 0, 0); break;
           case 3: dBodyAddForce(body, 0, 0, v); break;

@@ -572,6 +572,27 @@ static inline int pick_island(const World* w, uint8_t byte) {
   return -1;
 }
 
+/* A teleport the way a program moves an assembly: the body to (x, y, z) and the rest of its island by the same
+ * offset. Moving one gear of a transmission alone onto its mate makes ODE assert inside the step ("radii[i] > 0",
+ * transmission.cpp), a precondition of the program's own joint geometry that plain ODE has too. */
+static inline void teleport(World* w, dBodyID body, double x, double y, double z) {
+  const dReal* from = dBodyGetPosition(body);
+  double offset[3] = {x - from[0], y - from[1], z - from[2]};
+  for (int k = 0; k < ISLAND_COUNT; ++k)
+    for (int i = 0; i < w->islands[k].body_count; ++i)
+      if (w->islands[k].bodies[i] == body) {
+        for (int j = 0; j < w->islands[k].body_count; ++j) {
+          dBodyID other = w->islands[k].bodies[j];
+          if (other == body) continue;
+          const dReal* at = dBodyGetPosition(other);
+          dBodySetPosition(other, at[0] + offset[0], at[1] + offset[1], at[2] + offset[2]);
+        }
+        dBodySetPosition(body, x, y, z);
+        return;
+      }
+  dBodySetPosition(body, x, y, z);
+}
+
 /* ---- checks ---- */
 
 /* A refused registry call names something and keeps the bindings as they were. */
