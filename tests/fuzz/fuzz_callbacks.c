@@ -71,6 +71,7 @@ static void forget_body(World* w, dBodyID body) {
         for (int j = i + 1; j < island->body_count; ++j) {
           island->bodies[j - 1] = island->bodies[j];
           island->geoms[j - 1] = island->geoms[j];
+          memcpy(island->built_at[j - 1], island->built_at[j], sizeof island->built_at[j]);
         }
         island->body_count -= 1;
         island->bodies[island->body_count] = 0;
@@ -298,12 +299,13 @@ static void frame(Program* p, double frame_s, int op) {
     FUZZ_REQUIRE(report.failed_body != 0, "op %d: %s without a body", op, ssStatusName(status));
 }
 
-/* What a program does after a refused frame: every body back near its island's place, at rest, no forces. */
+/* What a program does after a refused frame: every body back where it was built, at rest, no forces. */
 static void repair(World* w) {
   for (int k = 0; k < ISLAND_COUNT; ++k)
     for (int i = 0; i < w->islands[k].body_count; ++i) {
       dBodyID body = w->islands[k].bodies[i];
-      dBodySetPosition(body, 2.0 * k + 0.6 * i, 0, 1.0); /* the gears as built: never on each other */
+      const dReal* at = w->islands[k].built_at[i];
+      dBodySetPosition(body, at[0], at[1], at[2]);
       dBodySetLinearVel(body, 0, 0, 0);
       dBodySetAngularVel(body, 0, 0, 0);
       dBodySetForce(body, 0, 0, 0);

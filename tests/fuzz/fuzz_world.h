@@ -35,6 +35,7 @@ typedef struct Island {
   int present;               /* chosen by the input's first byte (and not destroyed for good) */
   dBodyID bodies[MAX_ISLAND_BODIES];
   dGeomID geoms[MAX_ISLAND_BODIES];
+  dVector3 built_at[MAX_ISLAND_BODIES]; /* the bodies' positions as built: the island's layout */
   int body_count;
   dJointID joints[MAX_ISLAND_JOINTS];
   int joint_count;
@@ -382,6 +383,8 @@ static inline void build_island(World* w, int kind, const double* tuned) {
     }
   }
   if (joint != 0) island->joints[island->joint_count++] = joint;
+  for (int i = 0; i < island->body_count; ++i) memcpy(island->built_at[i], dBodyGetPosition(island->bodies[i]),
+                                                       sizeof island->built_at[i]);
   if (!w->adopt) {
     for (int i = 0; i < island->joint_count; ++i) bind_defaults(w, island->joints[i]);
   } else {
@@ -572,24 +575,24 @@ static inline int pick_island(const World* w, uint8_t byte) {
   return -1;
 }
 
-/* A teleport the way a program moves an assembly: the body to (x, y, z) and the rest of its island by the same
- * offset. Moving one gear of a transmission alone onto its mate makes ODE assert inside the step ("radii[i] > 0",
- * transmission.cpp), a precondition of the program's own joint geometry that plain ODE has too. */
+/* A teleport the way a program moves an assembly: the body to (x, y, z) and the rest of its island in the layout it
+ * was built in around it. Moving one gear of a transmission alone onto its mate makes ODE assert inside the step
+ * ("radii[i] > 0", transmission.cpp): a precondition of the program's own joint geometry that plain ODE has too.
+ * (Offsets from the current positions would not do: at 1e185 m the gears' 0.6 m apart is lost, and moved back they
+ * coincide.) */
 static inline void teleport(World* w, dBodyID body, double x, double y, double z) {
-  const dReal* from = dBodyGetPosition(body);
-  double offset[3] = {x - from[0], y - from[1], z - from[2]};
-  for (int k = 0; k < ISLAND_COUNT; ++k)
-    for (int i = 0; i < w->islands[k].body_count; ++i)
-      if (w->islands[k].bodies[i] == body) {
-        for (int j = 0; j < w->islands[k].body_count; ++j) {
-          dBodyID other = w->islands[k].bodies[j];
-          if (other == body) continue;
-          const dReal* at = dBodyGetPosition(other);
-          dBodySetPosition(other, at[0] + offset[0], at[1] + offset[1], at[2] + offset[2]);
-        }
-        dBodySetPosition(body, x, y, z);
+  for (int k = 0; k < ISLAND_COUNT; ++k) {
+    Island* island = &w->islands[k];
+    for (int i = 0; i < island->body_count; ++i)
+      if (island->bodies[i] == body) {
+        for (int j = 0; j < island->body_count; ++j)
+          dBodySetPosition(island->bodies[j], x + island->built_at[j][0] - island->built_at[i][0],
+                           y + island->built_at[j][1] - island->built_at[i][1],
+                           z + island->built_at[j][2] - island->built_at[i][2]);
+        dBodySetPosition(body, x, y, z); /* exactly as asked, whatever the sums above rounded */
         return;
       }
+  }
   dBodySetPosition(body, x, y, z);
 }
 
