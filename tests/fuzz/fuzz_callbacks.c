@@ -275,6 +275,7 @@ static void frame(Program* p, double frame_s, int op) {
   p->steps_done = 0;
   p->set_after_check = 0;
   ssFrameReport report;
+  memset(&report, 0, sizeof report); /* what a refusal leaves unwritten reads as nothing */
   ssStatus status = ssStepper_Step(w->stepper, frame_s, &report);
   if (verbose)
     fprintf(stderr, "op %d: %s/%s frame %.17g s: %s, %d steps, %s\n", op,

@@ -63,6 +63,7 @@ static int frame(World* w, double frame_s, int op) {
   int count = snapshot(w, before);
   int planned_destroy = w->plan.what == 5; /* bodies replaced in the frame: states are not compared */
   ssFrameReport report;
+  memset(&report, 0, sizeof report); /* what a refusal leaves unwritten reads as nothing */
   if (verbose) fprintf(stderr, "op %d: stepping %.17g s\n", op, frame_s);
   ssStatus status = ssStepper_Step(w->stepper, frame_s, &report);
   if (snapshot(w, after) != count || planned_destroy) count = snapshot(w, before);
