@@ -16,6 +16,7 @@ void ssKnownFree(ssKnownBodies* known) {
   free(known->ids);
   free(known->first_joints);
   free(known->pushed);
+  free(known->geared);
   memset(known, 0, sizeof *known);
 }
 
@@ -90,6 +91,13 @@ static void listPushed(ssKnownBodies* known) {
     if (known->bodies[i].pushed) known->pushed[known->pushed_count++] = i;
 }
 
+/* Whether a transmission joint gears the body. */
+static int geared(dBodyID body) {
+  for (int i = dBodyGetNumJoints(body) - 1; i >= 0; --i)
+    if (dJointGetType(dBodyGetJoint(body, i)) == dJointTypeTransmission) return 1;
+  return 0;
+}
+
 ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const dBodyID* watched, int watched_count) {
   BodyWalk walk = {.slots = calloc(64, sizeof(dBodyID)), .mask = 63};
   if (walk.slots == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
@@ -127,11 +135,23 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
     first_joints[i] = dBodyGetJoint(walk.list[i], 0);
   }
   free(walk.list);
+  int geared_count = 0;
+  for (size_t i = 0; i < count; ++i) geared_count += geared(ids[i]);
+  dBodyID* geared_ids = geared_count > 0 ? malloc((size_t)geared_count * sizeof *geared_ids) : NULL;
+  if (geared_count > 0 && geared_ids == NULL) {
+    free(bodies);
+    free(ids);
+    free(first_joints);
+    free(pushed);
+    return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
+  }
+  for (size_t i = 0, g = 0; i < count; ++i)
+    if (geared(ids[i])) geared_ids[g++] = ids[i];
   unsigned registry_generation = known->registry_generation, watched_generation = known->watched_generation;
   int carrying = known->carrying;
   ssKnownFree(known);
-  *known = (ssKnownBodies){bodies, ids, first_joints, (int)count, pushed, 0, carrying, 1, registry_generation,
-                           watched_generation};
+  *known = (ssKnownBodies){bodies, ids, first_joints, (int)count, pushed, 0, carrying, geared_ids, geared_count, 1,
+                           registry_generation, watched_generation};
   listPushed(known);
   return SS_OK;
 }
@@ -146,6 +166,8 @@ void ssKnownForget(ssKnownBodies* known, dBodyID body) {
   memmove(&known->ids[k], &known->ids[k + 1], after * sizeof *known->ids);
   memmove(&known->first_joints[k], &known->first_joints[k + 1], after * sizeof *known->first_joints);
   known->count -= 1;
+  for (int g = 0; g < known->geared_count; ++g)
+    if (known->geared[g] == body) known->geared[g--] = known->geared[--known->geared_count];
   listPushed(known);
 }
 
@@ -232,41 +254,50 @@ static ssStatus describe(dBodyID body, const ssBodyBounds* bounds, const char* w
   return ssFail(SS_ERROR_BLOWUP, "body %p: failed a check %s", (void*)body, when); /* not reached */
 }
 
-/* Whether a transmission joint gears the body (read only for a body spinning fast enough to matter). */
-static int geared(dBodyID body) {
-  for (int i = dBodyGetNumJoints(body) - 1; i >= 0; --i)
-    if (dJointGetType(dBodyGetJoint(body, i)) == dJointTypeTransmission) return 1;
-  return 0;
+/* How far a geared body turns its gear in a step of step_s (rad): its spin, and its speed over the gear's radius (a
+ * gear moved sideways by its radius turns the point where the gears mesh as far as a turn of one radian would). The
+ * largest over its transmission joints. */
+static double gearTurn(dBodyID body, double step_s) {
+  double spin = sqrt(squared(dBodyGetAngularVel(body))), speed = sqrt(squared(dBodyGetLinearVel(body)));
+  double turn = 0;
+  for (int i = dBodyGetNumJoints(body) - 1; i >= 0; --i) {
+    dJointID joint = dBodyGetJoint(body, i);
+    if (dJointGetType(joint) != dJointTypeTransmission) continue;
+    double radius = dJointGetBody(joint, 0) == body ? dJointGetTransmissionRadius1(joint)
+                                                    : dJointGetTransmissionRadius2(joint);
+    double slide = radius > 0 ? speed / radius : 0; /* a radius ODE has not computed yet: the spin alone */
+    turn = fmax(turn, (spin + slide) * step_s);
+  }
+  return turn;
 }
 
 ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       dBodyID* failed) {
   const double max_speed2 = bounds->max_speed * bounds->max_speed;
   const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
-  const double gear_spin = bounds->gear_step_s > 0 ? SS_MAX_GEAR_TURN_RAD / bounds->gear_step_s : INFINITY;
-  const double gear_spin2 = gear_spin * gear_spin;
+  char named[64];
   for (int k = 0; k < known->count; ++k) {
     dBodyID body = known->ids[k];
-    double spin2 = squared(dBodyGetAngularVel(body));
     /* every comparison is false for a NaN, and an infinity is beyond every bound: one test a number */
     int ok = within(dBodyGetPosition(body), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(body)) <= max_speed2 &&
-             spin2 <= max_spin2;
+             squared(dBodyGetAngularVel(body)) <= max_spin2;
     if (ok && bounds->forces)
       ok = within(dBodyGetForce(body), SS_MAX_FORCE_N) && within(dBodyGetTorque(body), SS_MAX_FORCE_N);
-    char named[64];
     if (!ok) {
       *failed = body;
       snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
       return describe(body, bounds, named);
     }
-    if (spin2 > gear_spin2 && geared(body)) {
-      *failed = body;
-      snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
-      return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: angular speed %g rad/s %s turns its transmission gear %g rad in a "
-                    "step of %g s: above SS_MAX_GEAR_TURN_RAD = %g rad (ODE 0.16 aborts from pi)", (void*)body,
-                    sqrt(spin2), named, sqrt(spin2) * bounds->gear_step_s, bounds->gear_step_s,
-                    SS_MAX_GEAR_TURN_RAD);
-    }
+  }
+  for (int g = 0; g < known->geared_count && bounds->gear_step_s > 0; ++g) {
+    dBodyID body = known->geared[g];
+    double turn = gearTurn(body, bounds->gear_step_s);
+    if (turn <= SS_MAX_GEAR_TURN_RAD) continue;
+    *failed = body;
+    snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
+    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: turns its transmission gear %g rad in a step of %g s %s (spin, and "
+                  "speed over the gear's radius): above SS_MAX_GEAR_TURN_RAD = %g rad (ODE 0.16 aborts from pi)",
+                  (void*)body, turn, bounds->gear_step_s, named, SS_MAX_GEAR_TURN_RAD);
   }
   return SS_OK;
 }

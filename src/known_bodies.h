@@ -28,6 +28,8 @@ typedef struct ssKnownBodies {
   int* pushed; /* indices into bodies of those with pushed set */
   int pushed_count;
   int carrying; /* whether any body may carry momentum */
+  dBodyID* geared; /* the listed bodies a transmission joint gears (ODE aborts when one turns by pi in a step) */
+  int geared_count;
   int valid;
   unsigned registry_generation, watched_generation; /* of the sets the list was built from */
 } ssKnownBodies;
