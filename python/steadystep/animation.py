@@ -1,8 +1,11 @@
-"""Something to watch: the chain swinging under the naive and the adopted policy at 15-45 fps, beside the fine-step
+"""Something to watch: the chain swinging under naive, implicit-euler and fixed at 15-45 fps, beside the fine-step
 reference, as an animation inside report.html.
 
 The runs are driven frame by frame (runs.Scene) under the profile's frame times; after every frame the chain's
-drawing (ssScene_Points: the pivot and the far end of each link) is recorded with the scene's time. The page plays
+drawing is recorded with the scene's time, as a program would draw it: on the poses the stepper gives to draw
+(ssScene_InterpolatedPoints, from ssStepper_InterpolatedPose: the pivot and the far end of each link). Under fixed
+those are blended between the last two physics steps at the frame's interpolation factor, so fixed moves smoothly
+one step behind; under the other policies they are ODE's own. The page plays
 them back on one clock: each panel shows the last frame its run rendered at or before that time, as a player of
 that frame rate would see it. The page is self-contained: an inline SVG and an inline script with the
 trajectories as JSON; nothing is fetched.
@@ -23,7 +26,7 @@ from steadystep.profiles import frames_within
 
 SCENE = "chain"
 PROFILE = "uniform:15:45"
-POLICIES = ("naive", "implicit-euler")
+POLICIES = ("naive", "implicit-euler", "fixed")
 REFERENCE_FRAME_S = runs.REFERENCE_STEP_S
 # The reference is recorded at this rate (its 1000 frames a second would only make the page heavier).
 REFERENCE_RECORD_HZ = 60.0
@@ -34,7 +37,7 @@ def _record(policy: str, frames: list[float], stepping: dict | None, params: dic
             every_s: float = 0.0) -> dict:
     """Plays frames through a Scene; returns {"policy", "t": [...], "points": [[[x, z], ...], ...], "status"}."""
     scene = runs.Scene(SCENE, policy, params=params, stepping=stepping)
-    times, points, status = [0.0], [scene.points()[:, [0, 2]].round(4).tolist()], "ok"
+    times, points, status = [0.0], [scene.points(interpolated=True)[:, [0, 2]].round(4).tolist()], "ok"
     next_record_s = every_s
     try:
         for frame_s in frames:
@@ -48,14 +51,14 @@ def _record(policy: str, frames: list[float], stepping: dict | None, params: dic
                 continue
             next_record_s += every_s
             times.append(round(now, 6))
-            points.append(scene.points()[:, [0, 2]].round(4).tolist())
+            points.append(scene.points(interpolated=True)[:, [0, 2]].round(4).tolist())
     finally:
         scene.close()
     return {"policy": policy, "t": times, "points": points, "status": status}
 
 
 def record(duration_s: float = 5.0, seed: int = 1, params: dict | None = None) -> dict:
-    """The chain under naive and implicit-euler at 15-45 fps and the reference (1 ms steps), for duration_s (s)."""
+    """The chain under POLICIES at 15-45 fps and the reference (1 ms steps), for duration_s (s)."""
     frames = list(frames_within(PROFILE, duration_s, seed))
     reference_frames = [REFERENCE_FRAME_S] * int(round(duration_s / REFERENCE_FRAME_S))
     panels = [_record("implicit-euler", reference_frames, runs.reference_stepping(), params,

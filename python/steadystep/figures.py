@@ -27,6 +27,7 @@ from steadystep.profiles import frame_times
 
 POLICY_COLORS = {
     "naive": "#e6550d",    # orange
+    "substeps-frozen": "#fdae6b",  # light orange: naive's softness, implicit-euler's cut
     "implicit-euler": "#756bb1",   # purple
     "matched": "#8c6d31",  # brown
     "exact": "#17becf",    # cyan
