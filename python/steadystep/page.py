@@ -290,7 +290,7 @@ def _cost(report) -> Markup | None:
     medians = {p: statistics.median(v) for p, v in by_policy.items()}
     text = _and(f"{p} {_x(medians[p])}" for p in sorted(medians, key=medians.get))
     library = _and(f"{p} {_x(statistics.median(v))}" for p, v in overhead.items())
-    return (Markup("the cheapest policy whose softness follows the frames, per scene, a tie where the ranges over "
+    return (Markup("the cheapest policy that cuts the frame (naive aside), per scene, a tie where the ranges over "
                    "the benchmark's blocks overlap: {}. Wall time per frame against a program's own loop (one "
                    "plain ODE step a frame) under {} frames, median over scenes: {}. That is the substeps (steps "
                    "per frame in the table): against plain ODE taking the same steps, the library itself costs {}. ")

@@ -96,6 +96,8 @@ def served_table(report: Report) -> dict:
     rows = []
     for scene, by_policy in report.served.items():
         for policy in (p for p in page.ACCURATE if p in by_policy):
+            if not any(sum(by_policy[policy][what].values()) for what in ("rows", "contacts")):
+                continue  # nothing bound and nothing softened through the stepper: nothing to serve
             row = [page.link(scene, scene), policy_cell(policy)]
             for what in ("rows", "contacts"):
                 mapped, matched, implicit, total = page.served_shares(by_policy[policy][what])

@@ -22,7 +22,7 @@ body { font-family: system-ui, sans-serif; max-width: 1400px; margin: 2em auto; 
 table { border-collapse: collapse; margin: 0.5em 0 0.5em; font-size: 0.9em; }
 th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: right; }
 th { background: #f3f3f3; } td:first-child, td:nth-child(2) { text-align: left; }
-#policies td, #per-scene td { text-align: left; }
+#policies td, #per-scene td, #policies th, #per-scene th { text-align: left; }
 img { max-width: 100%; display: block; margin: 0.5em 0 1.5em; }
 .dot { display: inline-block; width: 0.7em; height: 0.7em; border-radius: 50%; margin-right: 0.4em; }
 .bad { color: #b00; font-weight: bold; }
@@ -88,7 +88,8 @@ another mapping).</p>
 bound joint row counted once per physics step, and every contact softened with ssStepper_SoftenContact. Served by the
 mapping: matched or exact gave the row its softness; handed to matched: exact found no finite softness at that step
 length; handed to implicit Euler: above the step's Nyquist frequency, undamped, no effective mass, a static load, or
-no finite softness. Where the mapping serves nothing, the policy is implicit Euler at its cost.</p>
+no finite softness. Where the mapping serves nothing, the policy is implicit Euler at its cost. Scenes with nothing
+bound and no contact softened through the stepper are left out.</p>
 {% endif %}
 {% if side_by_side %}
 <h2>Oscillator against the exact solution</h2>
