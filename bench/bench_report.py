@@ -5,7 +5,9 @@ and the cost benchmark) in one process against a local process pool over every c
 Prints each timing with its phases (report_tasks: runs, figures still drawing after the runs, the cost benchmark,
 which runs in this process alone either way), the ratio one process / local pool, and the load average before and
 after (the machine may be shared). The order is serial, local, local, serial (ABBA), so that a drift in the load
-falls on both sides alike; --once measures serial, local once each (half the time).
+falls on both sides alike; --once measures serial, local once each (half the time). First it prints the
+parallelism the machine gives two processes at that moment (two CPU-bound loops in one process, then in two): a
+shared machine whose cores others take gives about 1, and then no pool can be faster.
 Usage: python bench/bench_report.py [DURATION_S] [--once] (default 5, the report's)
 """
 
@@ -31,12 +33,36 @@ def wall_s(executor: str, duration_s: float) -> tuple[float, dict]:
         return time.perf_counter() - started, result.phases_s
 
 
+def _spin(count: int) -> int:
+    total = 0
+    for i in range(count):
+        total += i
+    return total
+
+
+def parallelism(count: int = 3_000_000) -> float:
+    """What the machine gives two processes at this moment: the time of two CPU-bound loops one after the other
+    over their time in two processes at once (2 on two idle cores; about 1 when others take the cores)."""
+    import concurrent.futures
+
+    started = time.perf_counter()
+    _spin(count), _spin(count)
+    serial = time.perf_counter() - started
+    with study.make_executor("local") as pool:
+        pool.submit(_spin, 1).result()  # the workers started
+        started = time.perf_counter()
+        concurrent.futures.wait([pool.submit(_spin, count) for _ in range(2)])
+        return serial / (time.perf_counter() - started)
+
+
 def main() -> None:
     arguments = [a for a in sys.argv[1:] if a != "--once"]
     duration_s = float(arguments[0]) if arguments else 5.0
     order = ("serial", "local") if "--once" in sys.argv[1:] else ("serial", "local", "local", "serial")
     print(f"report wall time, duration {duration_s:g} s per run, {study.usable_cores()} usable cores, "
           f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}", flush=True)
+    print(f"two CPU-bound loops: {parallelism():.2f} times faster in two processes than in one (the machine's "
+          "parallelism now; 2 on two idle cores)", flush=True)
     times: dict[str, list[float]] = {"serial": [], "local": []}
     for executor in order:
         total_s, phases = wall_s(executor, duration_s)
