@@ -10,6 +10,7 @@ command -v ninja >/dev/null || missing+=(ninja-build)
 command -v g++ >/dev/null || missing+=(g++)
 command -v pkg-config >/dev/null || missing+=(pkg-config)
 pkg-config --exists ode 2>/dev/null || missing+=(libode-dev)
+command -v dpkg-source >/dev/null || missing+=(dpkg-dev)  # scripts/ode-single.sh unpacks ODE's source package
 [ -f /usr/include/gtest/gtest.h ] || missing+=(libgtest-dev)
 python3 -c 'import ensurepip, venv' 2>/dev/null || missing+=(python3-venv)
 command -v chromium >/dev/null || [ "${0##*/}" = report ] || missing+=(chromium)  # tests/python/test_page.py

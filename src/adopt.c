@@ -53,9 +53,10 @@ typedef struct Plan {
   int out_of_memory;
 } Plan;
 
+/* As the registry's index (binding_index.c): objects made together stay near each other in the set. */
 static size_t slotOf(const void* pointer, size_t capacity) {
-  uint64_t x = (uint64_t)(uintptr_t)pointer * 0x9E3779B97F4A7C15ull;
-  return (size_t)(x >> 32) & (capacity - 1);
+  uint64_t address = (uint64_t)(uintptr_t)pointer;
+  return (size_t)((address >> 4) + ((address >> 20) * 0x9E3779B97F4A7C15ull >> 32)) & (capacity - 1);
 }
 
 /* Adds pointer; returns 1 if it was new, 0 if seen before, -1 when out of memory. */

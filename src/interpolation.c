@@ -28,9 +28,12 @@ struct ssPoseHistory {
   double interpolation;
 };
 
+/* Element by element: dReal is float in a single-precision ODE. */
 static void poseNow(dBodyID body, Pose* pose) {
-  memcpy(pose->position, dBodyGetPosition(body), sizeof pose->position);
-  memcpy(pose->quaternion, dBodyGetQuaternion(body), sizeof pose->quaternion);
+  const dReal* position = dBodyGetPosition(body);
+  const dReal* quaternion = dBodyGetQuaternion(body);
+  for (int i = 0; i < 3; ++i) pose->position[i] = position[i];
+  for (int i = 0; i < 4; ++i) pose->quaternion[i] = quaternion[i];
 }
 
 static void restartAt(History* history) {
@@ -119,6 +122,16 @@ void ssPoseHistory_EndFrame(ssPoseHistory* history, int steps, double interpolat
   }
 }
 
+void ssPoseHistory_ForgetBody(ssPoseHistory* history, dBodyID body) {
+  if (history == NULL || history->count == 0) return;
+  History* found = bsearch(body, history->bodies, (size_t)history->count, sizeof *history->bodies, compareBody);
+  if (found == NULL) return;
+  int at = (int)(found - history->bodies);
+  memmove(found, found + 1, (size_t)(history->count - at - 1) * sizeof *found);
+  memmove(history->ids + at, history->ids + at + 1, (size_t)(history->count - at - 1) * sizeof *history->ids);
+  history->count -= 1;
+}
+
 void ssPoseHistory_Forget(ssPoseHistory* history) {
   if (history != NULL) history->restart = 1;
 }
@@ -176,8 +189,10 @@ ssStatus ssStepper_InterpolatedPose(const ssStepper* stepper, dBodyID body, doub
   /* Other cuts end every frame on a physics state; before the first fixed frame, just reset, or with the
    * interpolation off, there is no history: ODE's pose either way. */
   if (ssStepper_Stepping(stepper).cut != SS_CUT_FIXED || history == NULL || history->restart || history->off) {
-    memcpy(position, dBodyGetPosition(body), 3 * sizeof *position);
-    memcpy(quaternion, dBodyGetQuaternion(body), 4 * sizeof *quaternion);
+    Pose now;
+    poseNow(body, &now);
+    memcpy(position, now.position, sizeof now.position);
+    memcpy(quaternion, now.quaternion, sizeof now.quaternion);
     return SS_OK;
   }
   return ssPoseHistory_Pose(history, body, position, quaternion);

@@ -22,6 +22,9 @@ void ssPoseHistory_BeforeLastStep(ssPoseHistory* history);
  *  current state (the program set it between frames) starts again from there. interpolation: the frame's factor. */
 void ssPoseHistory_EndFrame(ssPoseHistory* history, int steps, double interpolation);
 
+/** A body the stepper destroys (ssStepper_DestroyBody, from a callback too): never read again. */
+void ssPoseHistory_ForgetBody(ssPoseHistory* history, dBodyID body);
+
 /** Every body starts again from its pose at the next frame (ssStepper_Reset, ssStepper_SetStepping). */
 void ssPoseHistory_Forget(ssPoseHistory* history);
 

@@ -62,10 +62,11 @@ static ssStatus validate(ssSpring spring, double mass, double step_s, const ssSo
  * intermediate overflow or underflow end as a refusal, never as output. */
 static ssStatus finish(double a, double erp, double step_s, double mass, ssSoftness* out) {
   double cfm = a * step_s / mass;
-  if (!(isfinite(erp) && isfinite(cfm) && cfm > 0 && cfm <= SS_MAX_CFM && fabs(erp) <= SS_MAX_ERP))
+  if (!(isfinite(erp) && isfinite(cfm) && cfm >= SS_MIN_POSITIVE_CFM && cfm <= SS_MAX_CFM && fabs(erp) <= SS_MAX_ERP))
     return ssFail(SS_ERROR_NO_FINITE_MAPPING,
-                  "step_s = %g s gives erp = %g, cfm = %g: not a usable softness (finite, |erp| <= %g, 0 < cfm <= %g)",
-                  step_s, erp, cfm, SS_MAX_ERP, SS_MAX_CFM);
+                  "step_s = %g s gives erp = %g, cfm = %g: not a usable softness "
+                  "(finite, |erp| <= %g, %g <= cfm <= %g)",
+                  step_s, erp, cfm, SS_MAX_ERP, SS_MIN_POSITIVE_CFM, SS_MAX_CFM);
   *out = (ssSoftness){.erp = erp, .cfm = cfm};
   return SS_OK;
 }

@@ -30,8 +30,10 @@ ssStatus ssCheckSoftnessForOde(const char* name, double erp, double cfm) {
 
 ssStatus ssCheckComputedSoftness(const char* name, ssSoftness softness) {
   ssStatus status = ssCheckSoftnessForOde(name, softness.erp, softness.cfm);
-  if (status == SS_OK && !(softness.cfm > 0))
-    status = ssFail(SS_ERROR_OUT_OF_RANGE, "%s: cfm = %g: a spring's cfm must be positive", name, softness.cfm);
+  if (status == SS_OK && !(softness.cfm >= SS_MIN_POSITIVE_CFM))
+    status = ssFail(SS_ERROR_OUT_OF_RANGE,
+                    "%s: cfm = %g: a spring's cfm must be positive, at least %g (the smallest normal dReal)", name,
+                    softness.cfm, SS_MIN_POSITIVE_CFM);
   return status;
 }
 

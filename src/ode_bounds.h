@@ -18,7 +18,8 @@ ssStatus ssCheckStepLength(const char* name, double step_s);
  * "hinge 3 stop: cfm = 1e+307: ...". */
 ssStatus ssCheckSoftnessForOde(const char* name, double erp, double cfm);
 
-/* The same for a softness the library computed from a spring: as ssCheckSoftnessForOde, and cfm > 0. */
+/* The same for a softness the library computed from a spring: as ssCheckSoftnessForOde, and cfm at least
+ * SS_MIN_POSITIVE_CFM (it reaches ODE's dReal as a positive normal number, not as 0). */
 ssStatus ssCheckComputedSoftness(const char* name, ssSoftness softness);
 
 /* A body mass (kg) for dBodySetMass: finite and in [SS_MIN_MASS_KG, SS_MAX_MASS_KG]. */

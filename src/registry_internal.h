@@ -48,9 +48,67 @@ ssSoftness ssRegistryTunedWorld(const ssRegistry* registry);
 /* Undoes ssRegistry_AdoptWorld, when the rest of an adoption failed. */
 void ssRegistryForgetWorldAdoption(ssRegistry* registry);
 
-/* ssContactSoften for a law, without checking its arguments; *fallback (may be NULL) says whether the accurate
- * mapping handed the contact on (to matched, or to implicit Euler). */
-ssStatus ssContactSoftenLaw(dContact* contact, dBodyID body1, dBodyID body2, const ssRowLaw* law, ssMapping mapping,
-                            double step_s, double previous_step_s, ssRowFallback* fallback);
+/* One bound joint row as bound, for the reference Apply (apply_reference.h): no cache, no derived state. */
+typedef struct ssJointRowBinding {
+  dJointID joint;
+  ssJointParam param;
+  int axis;
+  ssRowLaw law;
+  double effective_mass; /* 0: measured from the bodies */
+  double load;           /* 0: none declared */
+  int unwritten;         /* nothing written since it was bound: the next Apply writes it whatever ODE holds */
+} ssJointRowBinding;
+
+/* The i-th bound joint row (0 <= i < ssRegistry_JointBindingCount), in the order Apply writes them. */
+ssJointRowBinding ssRegistryJointRowAt(const ssRegistry* registry, int i);
+
+/* Records that the i-th row was given softness (the reference Apply's part of the registry's state). */
+void ssRegistrySetRowWritten(ssRegistry* registry, int i, ssSoftness softness);
+
+/* The i-th body binding (0 <= i < ssRegistryBodyBindingCount). */
+ssBodyBinding* ssRegistryBodyAt(ssRegistry* registry, int i);
+
+/* The effective mass the world's rows are bound with (kg; 1 when none was given). */
+double ssRegistryWorldMass(const ssRegistry* registry);
+
+/* Apply's caches (apply.c states each one's invariant), for measuring what each buys and testing Apply without it. */
+enum {
+  SS_CACHE_SAME_STEP = 1 << 0, /* implicit Euler at the last step with nothing rebound: nothing to write */
+  SS_CACHE_BY_LAW = 1 << 1,    /* implicit Euler: one softness per law of the table, rows written by law */
+  SS_CACHE_BODIES = 1 << 2,    /* each body's inverse mass and inertia computed once per Apply */
+  SS_CACHE_SHARED = 1 << 3,    /* within an Apply, rows with the same law and mass share one softness */
+  SS_CACHE_REUSE = 1 << 4,     /* accurate mappings: a row's softness kept while its inputs are the same */
+  SS_CACHE_SAME_AXIS = 1 << 5, /* a stop and a motor on one axis share the mass measured for the first */
+  SS_CACHE_ALL = (1 << 6) - 1
+};
+
+/* Turns off the caches in mask (and on the others). The values Apply writes are the same either way. */
+void ssRegistryDisableCaches(ssRegistry* registry, unsigned mask);
+
+/* The last contact's softness, for the contacts that follow with the same numbers. A program softens every contact
+ * of a step with one or a few surfaces: a contact whose tuned erp/cfm, tuned step, mapping and step (and, for the
+ * exact mapping, previous step) are the last one's reuses its law and, where the softness does not depend on the
+ * bodies (implicit Euler, naive, hard rows) or the effective mass is the same, its softness, with no conversion and
+ * no check repeated: they were made, and passed, for the same inputs. */
+typedef struct ssContactCache {
+  double tuned_erp, tuned_cfm, tuned_step_s; /* NAN: empty */
+  ssRowLaw law;
+  ssMapping mapping;
+  double step_s, previous_step_s, mass; /* mass: NAN where the softness does not read it */
+  int has_softness;
+  ssSoftness softness;
+  ssRowFallback handed_on;
+} ssContactCache;
+
+/* An empty cache. */
+ssContactCache ssContactCacheEmpty(void);
+
+/* Softens contact as the law that tuned_erp and tuned_cfm stand for at tuned_step_s (ssRowLawFromTuned), for a step
+ * of step_s under mapping, through the cache; *handed_on (may be NULL) says whether the accurate mapping handed the
+ * contact on (to matched, or to implicit Euler). Errors, with contact unchanged: those of ssRowLawFromTuned and
+ * ssContactSoften. */
+ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID body1, dBodyID body2,
+                               double tuned_erp, double tuned_cfm, double tuned_step_s, ssMapping mapping,
+                               double step_s, double previous_step_s, ssRowFallback* handed_on);
 
 #endif

@@ -37,11 +37,12 @@ ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tune
 ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law) {
   if (law->hard) return SS_OK;
   double k = law->spring.stiffness, c = law->spring.damping;
-  if (!isfinite(SS_MAX_STEP_S * k + c) || !(SS_MIN_STEP_S * k + c >= 1.0 / SS_MAX_CFM))
+  /* cfm = 1/(h·k + c) is largest at the shortest step and smallest at the longest */
+  if (!(SS_MAX_STEP_S * k + c <= 1.0 / SS_MIN_POSITIVE_CFM) || !(SS_MIN_STEP_S * k + c >= 1.0 / SS_MAX_CFM))
     return ssFail(SS_ERROR_NO_FINITE_MAPPING,
                   "%s: k = %g N/m, c = %g N*s/m: no softness ODE handles at every step from %g s to %g s "
-                  "(h*k + c must stay finite and at least 1/SS_MAX_CFM = %g)",
-                  what, k, c, SS_MIN_STEP_S, SS_MAX_STEP_S, 1.0 / SS_MAX_CFM);
+                  "(h*k + c must stay within [1/SS_MAX_CFM, 1/SS_MIN_POSITIVE_CFM] = [%g, %g])",
+                  what, k, c, SS_MIN_STEP_S, SS_MAX_STEP_S, 1.0 / SS_MAX_CFM, 1.0 / SS_MIN_POSITIVE_CFM);
   return SS_OK;
 }
 

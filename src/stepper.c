@@ -1,6 +1,6 @@
 /* The stepper: a frame's time becomes physics steps, each with its softness rewritten for its length, the frame's
- * forces put back before each one, and the known bodies checked after it. A failure is latched: a broken world is
- * never stepped again until the program says it has repaired it. */
+ * forces put back before each one, and the known bodies checked before and after it. A failure is latched: a broken
+ * world is never stepped again until the program says it has repaired it. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -10,6 +10,7 @@
 #include "array.h"
 #include "error.h"
 #include "interpolation_internal.h"
+#include "known_bodies.h"
 #include "ode_bounds.h"
 #include "registry_internal.h"
 #include "steadystep/adopt.h"
@@ -18,12 +19,13 @@
 /* Frame times are sums of floating-point parts: a frame of exactly 2·max_step_s must not become 3 substeps. */
 static const double kStepCountSlack = 1e-9;
 
-/* A body whose forces the stepper keeps over a frame and whose state it checks. */
-typedef struct KnownBody {
-  dBodyID body;
-  double frame_force[6]; /* force (N) and torque (N·m) the program added for this frame */
-  double carried[6];     /* momentum (N·s, N·m·s) of frames that took no step, delivered with the next steps */
-} KnownBody;
+/* A space the stepper adopted from, as it was when last walked: ODE adds a geom at the head of a space's list, so a
+ * new geom changes the count or the first geom (sweep-and-prune appends: there only the count tells). */
+typedef struct SeenSpace {
+  dSpaceID space;
+  int geoms;
+  dGeomID first;
+} SeenSpace;
 
 struct ssStepper {
   ssStepperDef def;            /* def.registry: the registry in use, the given one or owned_registry */
@@ -36,19 +38,14 @@ struct ssStepper {
   dBodyID* watched;
   int watched_count, watched_capacity;
   unsigned watched_generation;
-  /* the registry's bodies and the watched ones, each once, sorted; rebuilt when either set changes */
-  KnownBody* known;
-  dBodyID* known_ids; /* known[i].body, packed: the checks after every step read nothing else */
-  int known_count;
-  int carrying; /* whether any known body may carry momentum: without, the forces' capture reads no carried */
-  unsigned known_registry_generation, known_watched_generation;
-  int known_valid;
-  int* pushed; /* indices into known of the bodies with a force or carried momentum this frame */
-  int pushed_count;
+  ssKnownBodies known; /* rebuilt when the registry's bindings, the watch list or a known body's joints change */
+  SeenSpace* spaces;    /* def.space and the spaces nested in it */
+  int space_count, space_capacity;
+  int apply_due;         /* bindings were added within the frame: the next step applies whatever the mapping */
+  int in_step;           /* inside ssStepper_Step: its callbacks are running */
+  int destroy_requested; /* ssStepper_Destroy was called from a callback: done when ssStepper_Step returns */
   ssStepInfo current;
-  /* a program softens many contacts with the same tuned numbers: the last ones' law is kept */
-  ssSoftness contact_tuned;
-  ssRowLaw contact_law;
+  ssContactCache contact_cache; /* a program softens many contacts with the same numbers */
   ssFrameReport* report; /* the frame being stepped, for ssStepper_SoftenContact's counts */
   ssPoseHistory* poses;  /* SS_CUT_FIXED: the known bodies' last two states, to draw (interpolation.c) */
   /* the first failure, latched until ssStepper_Reset */
@@ -67,8 +64,8 @@ static ssStatus validateDef(const ssStepperDef* def) {
   if (def == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "def = NULL: a definition is required");
   if (def->world == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "world = NULL: a world is required");
   if (def->registry != NULL && ssRegistryWorld(def->registry) != def->world)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "registry of world %p: not def.world = %p", (void*)ssRegistryWorld(def->registry),
-                  (void*)def->world);
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "registry of world %p: not def.world = %p",
+                  (void*)ssRegistryWorld(def->registry), (void*)def->world);
   if (def->space != 0 && def->tuned_step_s == 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "tuned_step_s = 0 s: with a space, say which step the program was tuned for");
   if (def->tuned_step_s != 0) {
@@ -86,8 +83,10 @@ static ssStatus resolveSteps(ssStepping* stepping, double tuned_step_s) {
                         : stepping->cut == SS_CUT_FIXED && stepping->fixed_step_s == 0 ? "fixed_step_s"
                                                                                         : NULL;
   if (missing == NULL) return SS_OK;
-  return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.%s = 0 s (the tuned step), but there is no tuned step: set "
-                                       "def.tuned_step_s, adopt into the registry, or give stepping.%s", missing, missing);
+  return ssFail(SS_ERROR_OUT_OF_RANGE,
+                "stepping.%s = 0 s (the tuned step), but there is no tuned step: set def.tuned_step_s, adopt into "
+                "the registry, or give stepping.%s",
+                missing, missing);
 }
 
 /* The step length a step's softness is computed for: its own, or the frozen one. */
@@ -122,20 +121,25 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   stepper->def.stepping = stepping;
   stepper->tuned_step_s = tuned_step_s;
   if (def->space != 0) {
+    /* the space is walked again at the first frame (geoms -1): a body adoption did not reach is adopted then */
     ssRegistry* registry = def->registry;
-    if (registry == NULL && (registry = stepper->owned_registry = ssRegistry_Create(def->world)) == NULL) {
+    if (!ssReserveOne((void**)&stepper->spaces, 0, &stepper->space_capacity, sizeof(SeenSpace)) ||
+        (registry == NULL && (registry = stepper->owned_registry = ssRegistry_Create(def->world)) == NULL)) {
+      free(stepper->spaces);
       free(stepper);
-      return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating the stepper's registry");
+      return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating a stepper");
     }
+    stepper->spaces[stepper->space_count++] = (SeenSpace){def->space, -1, 0};
     if ((status = ssRegistry_Adopt(registry, tuned_step_s, def->space, &stepper->adopted)) != SS_OK) {
       ssRegistry_Destroy(stepper->owned_registry);
+      free(stepper->spaces);
       free(stepper);
       return status;
     }
     stepper->def.registry = registry;
   }
   resolveSpeeds(&stepper->def.stepping);
-  stepper->contact_tuned = (ssSoftness){NAN, NAN};
+  stepper->contact_cache = ssContactCacheEmpty();
   describeNextStep(stepper);
   *out = stepper;
   return SS_OK;
@@ -143,11 +147,14 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
 
 void ssStepper_Destroy(ssStepper* stepper) {
   if (stepper == NULL) return;
+  if (stepper->in_step) { /* from its own callback: the frame stops, and ssStepper_Step frees it on return */
+    stepper->destroy_requested = 1;
+    return;
+  }
   ssRegistry_Destroy(stepper->owned_registry);
   free(stepper->watched);
-  free(stepper->known);
-  free(stepper->known_ids);
-  free(stepper->pushed);
+  ssKnownFree(&stepper->known);
+  free(stepper->spaces);
   ssPoseHistory_Destroy(stepper->poses);
   free(stepper);
 }
@@ -155,9 +162,18 @@ void ssStepper_Destroy(ssStepper* stepper) {
 #define REQUIRE_STEPPER(stepper) \
   if ((stepper) == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "stepper = NULL: a stepper is required")
 
+/* Functions that would step or reset the frame being stepped are refused inside it. */
+#define REFUSE_IN_STEP(stepper, what)                                                                     \
+  if ((stepper)->in_step)                                                                                 \
+  return ssFail(SS_ERROR_REENTERED, "%s: called from a callback of the same stepper, inside its frame (%s)", \
+                what, "call it between frames")
+
 ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body) {
   REQUIRE_STEPPER(stepper);
   if (body == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "body = NULL: a body is required");
+  if (dBodyGetWorld(body) != stepper->def.world)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "body %p: of another world (%p), not the stepper's (%p)", (void*)body,
+                  (void*)dBodyGetWorld(body), (void*)stepper->def.world);
   for (int i = 0; i < stepper->watched_count; ++i)
     if (stepper->watched[i] == body) return SS_OK;
   if (!ssReserveOne((void**)&stepper->watched, stepper->watched_count, &stepper->watched_capacity, sizeof body))
@@ -193,7 +209,8 @@ ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body) {
       if (ssRegistryHasJoint(registry, joint)) ssRegistry_UnbindJoint(registry, joint);
     }
   }
-  stepper->watched_generation += 1; /* the known list is rebuilt without it before it is read again */
+  ssKnownForget(&stepper->known, body); /* at once: inside a frame, the next check must not read it */
+  ssPoseHistory_ForgetBody(stepper->poses, body);
   dBodyDestroy(body);
   return SS_OK;
 }
@@ -203,14 +220,15 @@ ssStatus ssStepper_DestroyJoint(ssStepper* stepper, dJointID joint) {
   if (joint == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "joint = NULL: a joint is required");
   ssRegistry* registry = stepper->def.registry;
   if (registry != NULL && ssRegistryHasJoint(registry, joint)) ssRegistry_UnbindJoint(registry, joint);
-  stepper->watched_generation += 1;
+  stepper->watched_generation += 1; /* what the joint reached may be known no longer */
   dJointDestroy(joint);
   return SS_OK;
 }
 
 static void forgetCarried(ssStepper* stepper) {
-  for (int i = 0; i < stepper->known_count; ++i) memset(stepper->known[i].carried, 0, sizeof stepper->known[i].carried);
-  stepper->carrying = 0;
+  for (int i = 0; i < stepper->known.count; ++i)
+    memset(stepper->known.bodies[i].carried, 0, sizeof stepper->known.bodies[i].carried);
+  stepper->known.carrying = 0;
 }
 
 void ssStepper_ResetHistory(ssStepper* stepper) {
@@ -219,6 +237,11 @@ void ssStepper_ResetHistory(ssStepper* stepper) {
 
 void ssStepper_Reset(ssStepper* stepper) {
   if (stepper == NULL) return;
+  if (stepper->in_step) {
+    ssFail(SS_ERROR_REENTERED, "ssStepper_Reset: called from a callback of the same stepper, inside its frame "
+                               "(call it between frames)");
+    return;
+  }
   stepper->failed_status = SS_OK;
   stepper->failed_message[0] = '\0';
   stepper->previous_step_s = 0;
@@ -231,6 +254,7 @@ void ssStepper_Reset(ssStepper* stepper) {
 
 ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping) {
   REQUIRE_STEPPER(stepper);
+  REFUSE_IN_STEP(stepper, "ssStepper_SetStepping");
   ssStatus status = ssValidateStepping(stepping);
   if (status != SS_OK) return status;
   ssStepping resolved = *stepping;
@@ -270,17 +294,10 @@ ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID 
   const dSurfaceParameters* surface = &contact->surface;
   double erp = (surface->mode & dContactSoftERP) ? surface->soft_erp : world.erp;
   double cfm = (surface->mode & dContactSoftCFM) ? surface->soft_cfm : world.cfm;
-  if (erp != stepper->contact_tuned.erp || cfm != stepper->contact_tuned.cfm) {
-    ssRowLaw law;
-    ssStatus status = ssRowLawFromTuned("contact", erp, cfm, tuned_step_s, &law);
-    if (status != SS_OK) return status;
-    stepper->contact_tuned = (ssSoftness){erp, cfm};
-    stepper->contact_law = law;
-  }
   const ssStepInfo* step = &stepper->current;
   ssRowFallback handed_on;
-  ssStatus status = ssContactSoftenLaw(contact, body1, body2, &stepper->contact_law, step->mapping,
-                                       step->softness_step_s, step->previous_step_s, &handed_on);
+  ssStatus status = ssContactSoftenCached(&stepper->contact_cache, contact, body1, body2, erp, cfm, tuned_step_s,
+                                          step->mapping, step->softness_step_s, step->previous_step_s, &handed_on);
   if (status != SS_OK) return status;
   if (stepper->report != NULL) {
     ssServedCounts* contacts = &stepper->report->contacts;
@@ -291,98 +308,103 @@ ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID 
   return SS_OK;
 }
 
-static int compareKnown(const void* a, const void* b) {
-  uintptr_t x = (uintptr_t)((const KnownBody*)a)->body, y = (uintptr_t)((const KnownBody*)b)->body;
-  return (x > y) - (x < y);
-}
+/* ---- the bodies the stepper knows ---- */
 
-typedef struct KnownList {
-  KnownBody* bodies;
-  int count, capacity;
-} KnownList;
-
-static void appendKnown(void* context, dBodyID body) {
-  KnownList* list = context;
-  if (list->count < list->capacity) list->bodies[list->count++] = (KnownBody){.body = body};
-}
-
-/* The known bodies, each once, sorted; rebuilt only when the registry's bindings or the watch list changed. Momentum
- * carried for a body that stays known is kept. */
+/* The known list, rebuilt when the registry's bindings or the watch list changed since it was built. */
 static ssStatus refreshKnown(ssStepper* stepper) {
   const ssRegistry* registry = stepper->def.registry;
   unsigned generation = registry != NULL ? ssRegistryGeneration(registry) : 0;
-  if (stepper->known_valid && stepper->known_registry_generation == generation &&
-      stepper->known_watched_generation == stepper->watched_generation)
+  ssKnownBodies* known = &stepper->known;
+  if (known->valid && known->registry_generation == generation &&
+      known->watched_generation == stepper->watched_generation)
     return SS_OK;
-  int most = stepper->watched_count;
-  if (registry != NULL) most += 2 * ssRegistry_JointBindingCount(registry) + ssRegistryBodyBindingCount(registry);
-  KnownList list = {calloc((size_t)(most > 0 ? most : 1), sizeof(KnownBody)), 0, most};
-  int* pushed = calloc((size_t)(most > 0 ? most : 1), sizeof(int));
-  dBodyID* ids = calloc((size_t)(most > 0 ? most : 1), sizeof(dBodyID));
-  if (list.bodies == NULL || pushed == NULL || ids == NULL) {
-    free(list.bodies);
-    free(pushed);
-    free(ids);
-    return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
-  }
-  if (registry != NULL) ssRegistry_VisitBodies(registry, appendKnown, &list);
-  for (int i = 0; i < stepper->watched_count; ++i) appendKnown(&list, stepper->watched[i]);
-  qsort(list.bodies, (size_t)list.count, sizeof(KnownBody), compareKnown);
-  int unique = 0;
-  for (int i = 0; i < list.count; ++i) {
-    if (unique > 0 && list.bodies[unique - 1].body == list.bodies[i].body) continue;
-    KnownBody* kept = &list.bodies[unique++];
-    *kept = list.bodies[i];
-    const KnownBody* old = stepper->known_valid ? bsearch(kept, stepper->known, (size_t)stepper->known_count,
-                                                          sizeof(KnownBody), compareKnown)
-                                                : NULL;
-    if (old != NULL) memcpy(kept->carried, old->carried, sizeof kept->carried);
-    ids[unique - 1] = kept->body;
-  }
-  free(stepper->known);
-  free(stepper->known_ids);
-  free(stepper->pushed);
-  stepper->known = list.bodies;
-  stepper->known_ids = ids;
-  stepper->known_count = unique;
-  stepper->pushed = pushed;
-  stepper->known_registry_generation = generation;
-  stepper->known_watched_generation = stepper->watched_generation;
-  stepper->known_valid = 1;
+  ssStatus status = ssKnownRebuild(known, registry, stepper->watched, stepper->watched_count);
+  if (status != SS_OK) return status;
+  known->registry_generation = generation;
+  known->watched_generation = stepper->watched_generation;
   return SS_OK;
 }
+
+/* Adopts body and what it reaches, when the stepper adopts (def.space); otherwise the known list reaches it through
+ * its joints when rebuilt. */
+static ssStatus adoptBody(ssStepper* stepper, dBodyID body) {
+  if (stepper->def.space == 0) return SS_OK;
+  ssStatus status = ssRegistry_AdoptBody(stepper->def.registry, body, &stepper->adopted);
+  if (status == SS_OK) stepper->apply_due = 1;
+  return status;
+}
+
+static int spacesChanged(const ssStepper* stepper) {
+  for (int i = 0; i < stepper->space_count; ++i) {
+    const SeenSpace* seen = &stepper->spaces[i];
+    int geoms = dSpaceGetNumGeoms(seen->space);
+    if (geoms != seen->geoms || (geoms > 0 && dSpaceGetGeom(seen->space, 0) != seen->first)) return 1;
+  }
+  return 0;
+}
+
+/* Walks def.space and the spaces in it: each geom's body that is not known is adopted (a box spawned after the
+ * stepper was made), and the spaces are remembered as they are now. */
+static ssStatus walkSpaces(ssStepper* stepper) {
+  stepper->space_count = 0;
+  dSpaceID next = stepper->def.space;
+  for (int walked = 0; next != 0; ++walked) {
+    if (!ssReserveOne((void**)&stepper->spaces, stepper->space_count, &stepper->space_capacity, sizeof(SeenSpace)))
+      return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
+    dSpaceID space = next;
+    int geoms = dSpaceGetNumGeoms(space);
+    stepper->spaces[stepper->space_count++] = (SeenSpace){space, geoms, geoms > 0 ? dSpaceGetGeom(space, 0) : 0};
+    for (int i = 0; i < geoms; ++i) {
+      dGeomID geom = dSpaceGetGeom(space, i);
+      if (dGeomIsSpace(geom)) continue; /* listed above, walked below */
+      dBodyID body = dGeomGetBody(geom);
+      if (body == 0 || ssKnownContains(&stepper->known, body)) continue;
+      ssStatus status = adoptBody(stepper, body); /* idempotent: a body of two geoms, or reached twice, once */
+      if (status != SS_OK) return status;
+    }
+    /* the nested spaces, breadth first: those of spaces walked so far that are not listed yet */
+    next = 0;
+    for (int s = walked; s < stepper->space_count && next == 0; ++s)
+      for (int i = 0, n = stepper->spaces[s].geoms; i < n && next == 0; ++i) {
+        dGeomID geom = dSpaceGetGeom(stepper->spaces[s].space, i);
+        if (!dGeomIsSpace(geom)) continue;
+        int listed = 0;
+        for (int k = 0; k < stepper->space_count; ++k) listed |= stepper->spaces[k].space == (dSpaceID)geom;
+        if (!listed) next = (dSpaceID)geom;
+      }
+  }
+  return refreshKnown(stepper);
+}
+
+/* Finds what was made since the last look, before a step: bodies in the adopted spaces, joints attached to known
+ * bodies (and the bodies beyond them). */
+static ssStatus findNew(ssStepper* stepper, int look_at_joints) {
+  ssStatus status = refreshKnown(stepper);
+  if (status == SS_OK && stepper->def.space != 0 && spacesChanged(stepper)) status = walkSpaces(stepper);
+  dBodyID changed;
+  while (status == SS_OK && look_at_joints && ssKnownJointsChanged(&stepper->known, &changed)) {
+    status = adoptBody(stepper, changed);
+    stepper->known.valid = 0; /* rebuilt with what the joint reaches, and the body's first joint as it is now */
+    if (status == SS_OK) status = refreshKnown(stepper);
+  }
+  return status;
+}
+
+/* ---- the frame's forces ---- */
 
 static int anyNonZero(const double* values) {
   return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
 }
 
-/* Reads the forces the program added for this frame, and lists the bodies that have one or carried momentum. A
- * force ODE cannot step (non-finite, or beyond SS_MAX_FORCE_N) refuses the frame before anything is touched. */
-static ssStatus captureForces(ssStepper* stepper) {
-  stepper->pushed_count = 0;
-  for (int i = 0; i < stepper->known_count; ++i) {
-    const dReal* force = dBodyGetForce(stepper->known_ids[i]);
-    const dReal* torque = dBodyGetTorque(stepper->known_ids[i]);
-    double f[6] = {force[0], force[1], force[2], torque[0], torque[1], torque[2]};
-    KnownBody* known = &stepper->known[i];
-    if (!anyNonZero(f) && !(stepper->carrying && anyNonZero(known->carried))) continue;
-    for (int j = 0; j < 6; ++j)
-      if (!(fabs(f[j]) <= SS_MAX_FORCE_N))
-        return ssFail(isfinite(f[j]) ? SS_ERROR_OUT_OF_RANGE : SS_ERROR_NOT_FINITE,
-                      "body %p: %s %g N or N·m added for the frame: must be finite and at most SS_MAX_FORCE_N = %g",
-                      (void*)known->body, j < 3 ? "force" : "torque", f[j], SS_MAX_FORCE_N);
-    memcpy(known->frame_force, f, sizeof f);
-    stepper->pushed[stepper->pushed_count++] = i;
-  }
-  return SS_OK;
-}
-
 /* Before each of a frame's `steps` steps of step_s: each pushed body gets the force that delivers its frame's
- * momentum F·frame_s (plus what was carried) evenly over the frame's simulated time. */
+ * momentum F·frame_s (plus what was carried) evenly over the frame's simulated time. A frame of one step of its own
+ * length with nothing carried leaves the program's forces as it added them (F·h/h may differ from F in its last
+ * bit): a naive stepper is then the program's own stepping bit for bit. */
 static void putForces(ssStepper* stepper, double frame_s, int steps, double step_s) {
   double simulated_s = steps * step_s;
-  for (int p = 0; p < stepper->pushed_count; ++p) {
-    KnownBody* known = &stepper->known[stepper->pushed[p]];
+  for (int p = 0; p < stepper->known.pushed_count; ++p) {
+    ssKnownBody* known = &stepper->known.bodies[stepper->known.pushed[p]];
+    if (steps == 1 && simulated_s == frame_s && !(stepper->known.carrying && anyNonZero(known->carried))) continue;
     double f[6];
     for (int j = 0; j < 6; ++j) f[j] = (known->frame_force[j] * frame_s + known->carried[j]) / simulated_s;
     dBodySetForce(known->body, f[0], f[1], f[2]);
@@ -390,51 +412,43 @@ static void putForces(ssStepper* stepper, double frame_s, int steps, double step
   }
 }
 
-/* A frame that takes no step: its forces' momentum waits for the next steps, and the accumulators are emptied so
- * that the program's next additions are not counted twice. */
+/* A frame that takes no step: its forces' momentum waits for the next steps (F·0 = 0 for a frame of 0 s), and the
+ * accumulators are emptied so that the program's next additions are not counted twice. */
 static void carryForces(ssStepper* stepper, double frame_s) {
-  for (int p = 0; p < stepper->pushed_count; ++p) {
-    KnownBody* known = &stepper->known[stepper->pushed[p]];
+  for (int p = 0; p < stepper->known.pushed_count; ++p) {
+    ssKnownBody* known = &stepper->known.bodies[stepper->known.pushed[p]];
     for (int j = 0; j < 6; ++j) known->carried[j] += known->frame_force[j] * frame_s;
-    stepper->carrying = 1;
+    stepper->known.carrying = 1;
     dBodySetForce(known->body, 0, 0, 0);
     dBodySetTorque(known->body, 0, 0, 0);
   }
 }
 
-/* After a frame's steps: every body that carried momentum was pushed for them (captureForces), so none carries now. */
+/* After a frame's steps: every body that carried momentum was pushed for them (ssKnownStartFrame), so none carries
+ * now. */
 static void clearCarried(ssStepper* stepper) {
-  for (int p = 0; p < stepper->pushed_count; ++p)
-    memset(stepper->known[stepper->pushed[p]].carried, 0, sizeof stepper->known[0].carried);
-  stepper->carrying = 0;
+  for (int p = 0; p < stepper->known.pushed_count; ++p)
+    memset(stepper->known.bodies[stepper->known.pushed[p]].carried, 0, sizeof stepper->known.bodies[0].carried);
+  stepper->known.carrying = 0;
 }
 
-/* Checks one body after a step; returns SS_OK or records the failure. A runaway is stopped while its numbers are
- * still finite: ODE 0.16 aborts inside the next step when a rotation becomes non-finite (dxNormalize4). */
-static ssStatus checkBody(const ssStepper* stepper, dBodyID body) {
-  const dReal* position = dBodyGetPosition(body);
-  const dReal* velocity = dBodyGetLinearVel(body);
-  const dReal* spin = dBodyGetAngularVel(body);
-  /* a NaN or an infinity anywhere makes the sum non-finite: one test for nine numbers */
-  double sum = position[0] + position[1] + position[2] + velocity[0] + velocity[1] + velocity[2] + spin[0] + spin[1] +
-               spin[2];
-  double speed2 = velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2];
-  double spin2 = spin[0] * spin[0] + spin[1] * spin[1] + spin[2] * spin[2];
-  double max_speed = stepper->def.stepping.max_speed, max_spin = stepper->def.stepping.max_angular_speed;
-  if (isfinite(sum) && speed2 <= max_speed * max_speed && spin2 <= max_spin * max_spin) return SS_OK;
-  if (!isfinite(sum) || !isfinite(speed2) || !isfinite(spin2))
-    return ssFail(SS_ERROR_BLOWUP, "body %p: position or velocity is not finite", (void*)body);
-  if (speed2 > max_speed * max_speed)
-    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: speed %g m/s is above max_speed = %g m/s", (void*)body,
-                  sqrt(speed2), max_speed);
-  return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: angular speed %g rad/s is above max_angular_speed = %g rad/s",
-                (void*)body, sqrt(spin2), max_spin);
-}
+/* ---- the checks at the boundary ---- */
 
 static ssStatus latch(ssStepper* stepper, ssStatus status) {
   stepper->failed_status = status;
   snprintf(stepper->failed_message, sizeof stepper->failed_message, "%s", ssLastError());
   stepper->previous_step_s = 0;
+  return status;
+}
+
+/* Every known body's state and forces (as asked) within limits.h and the stepping's speeds. */
+static ssStatus checkKnown(ssStepper* stepper, int forces, const char* when, int index, int steps,
+                           ssFrameReport* report) {
+  const ssStepping* stepping = &stepper->def.stepping;
+  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, forces};
+  dBodyID failed = 0;
+  ssStatus status = ssKnownCheck(&stepper->known, &bounds, when, index + 1, steps, &failed);
+  if (status != SS_OK) report->failed_body = failed;
   return status;
 }
 
@@ -455,9 +469,18 @@ static void addServed(ssServedCounts* sum, const ssServedCounts* counts) {
   sum->handed_to_implicit_euler += counts->handed_to_implicit_euler;
 }
 
+/* A step refused at the boundary: nothing was stepped, and the world is left as it was before the step (the
+ * contacts made for it removed, the known bodies' accumulators as the program left them for the frame, or empty
+ * after an earlier step). */
+static ssStatus refuseStep(ssStepper* stepper, ssStatus status, int index) {
+  if (stepper->def.contact_group) dJointGroupEmpty(stepper->def.contact_group);
+  ssKnownResetAccumulators(&stepper->known, index == 0);
+  return latch(stepper, status);
+}
+
 /* Takes a frame's `steps` steps of step_s: everything else about them (mapping, the softness' step, history)
- * follows from the stepping. Errors of Apply leave the world as the previous step left it; a failed check
- * latches. */
+ * follows from the stepping. frame_s is the time whose forces' momentum the steps deliver. Errors of Apply leave
+ * the world as the previous step left it; a failed check latches. */
 static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double frame_s, ssFrameReport* report) {
   const ssStepperDef* def = &stepper->def;
   const ssStepping* stepping = &def->stepping;
@@ -470,14 +493,29 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
   ssApplyReport applied;
   for (int i = 0; i < steps; ++i) {
     double previous_step_s = use_history ? stepper->previous_step_s : 0;
+    /* bodies made in the last step's callbacks (joints made there are found before the next frame) */
+    ssStatus status = i == 0 ? SS_OK : findNew(stepper, 0);
+    if (status != SS_OK) return status;
     putForces(stepper, frame_s, steps, step_s);
-    if (i == 0 || apply_every_step) {
-      ssStatus status = apply(stepper, mapping, softness_step_s, previous_step_s, &applied, report);
-      if (status != SS_OK) return status;
+    if (i == 0 || apply_every_step || stepper->apply_due) {
+      stepper->apply_due = 0;
+      if ((status = apply(stepper, mapping, softness_step_s, previous_step_s, &applied, report)) != SS_OK)
+        return status;
     }
     stepper->current = (ssStepInfo){mapping, step_s, softness_step_s, previous_step_s, i, steps};
     if (def->before_step) def->before_step(def->before_step_context, stepper);
-    if (def->collide) def->collide(def->collide_context, stepper);
+    if (!stepper->destroy_requested && def->collide) def->collide(def->collide_context, stepper);
+    if (stepper->destroy_requested) { /* the frame stops here: this step is not taken */
+      if (def->contact_group) dJointGroupEmpty(def->contact_group);
+      return SS_OK;
+    }
+    /* the boundary: whatever the program or its callbacks did, ODE gets a state and forces it can step. Without
+     * callbacks only the stepper wrote since the last check (after the last step, or before the frame): the
+     * frame's checked forces spread over its steps, and load corrections within SS_MAX_FORCE_N */
+    int called_back = def->before_step || def->collide;
+    if ((status = refreshKnown(stepper)) != SS_OK ||
+        (called_back && (status = checkKnown(stepper, 1, "before", i, steps, report)) != SS_OK))
+      return refuseStep(stepper, status, i);
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistory_BeforeLastStep(stepper->poses);
     int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, step_s)
                                                       : dWorldQuickStep(def->world, step_s);
@@ -487,21 +525,16 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     addServed(&report->rows, &applied.rows);
     report->step_s = step_s;
     report->simulated_s += step_s;
-    for (int k = 0; k < stepper->known_count; ++k) {
-      ssStatus status = checkBody(stepper, stepper->known_ids[k]);
-      if (status != SS_OK) {
-        report->failed_body = stepper->known_ids[k];
-        return latch(stepper, status);
-      }
-    }
+    if ((status = checkKnown(stepper, 0, "after", i, steps, report)) != SS_OK) return latch(stepper, status);
     stepper->previous_step_s = use_history ? step_s : 0;
     if (def->step_done) def->step_done(def->step_done_context, step_s);
+    if (stepper->destroy_requested) return SS_OK;
   }
   return SS_OK;
 }
 
-/* WHOLE_FRAME: one step of the frame. SUBSTEPS: n equal substeps no longer than max_step_s. A frame too short to
- * step waits for the next one. */
+/* WHOLE_FRAME: one step of the frame. SUBSTEPS: n equal substeps no longer than max_step_s, at most
+ * max_steps_per_frame. A frame too short to step waits for the next one. */
 static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
   double total_s = frame_s + stepper->short_frame_s;
@@ -514,16 +547,12 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
   int steps = 1;
   if (stepping->cut == SS_CUT_SUBSTEPS) {
     double count = ceil(total_s / stepping->max_step_s - kStepCountSlack);
-    if (count > (double)INT32_MAX) /* max_step_s >= SS_MIN_STEP_S and frame_s <= SS_MAX_FRAME_S: never */
-      return ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: more than %d substeps of max_step_s = %g s", frame_s,
-                    INT32_MAX, stepping->max_step_s);
-    steps = count < 1 ? 1 : (int)count;
+    steps = count < 1 ? 1 : count > stepping->max_steps_per_frame ? stepping->max_steps_per_frame : (int)count;
   }
   stepper->short_frame_s = 0;
   double step_s = total_s / steps;
-  if (stepping->cut == SS_CUT_SUBSTEPS && steps > stepping->max_steps_per_frame) {
+  if (stepping->cut == SS_CUT_SUBSTEPS && step_s > stepping->max_step_s * (1 + kStepCountSlack)) {
     /* a long frame (a breakpoint, a hitch) is cut off like the fixed cut's: the rest is dropped, and reported */
-    steps = stepping->max_steps_per_frame;
     step_s = stepping->max_step_s;
     report->dropped_s = total_s - steps * step_s;
   }
@@ -536,7 +565,7 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
 static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
   double step_s = stepping->fixed_step_s;
-  ssStatus status = ssPoseHistory_BeginFrame(&stepper->poses, stepper->known_ids, stepper->known_count);
+  ssStatus status = ssPoseHistory_BeginFrame(&stepper->poses, stepper->known.ids, stepper->known.count);
   if (status != SS_OK) return status;
   double accumulator_s = stepper->accumulator_s + frame_s;
   double due = floor(accumulator_s / step_s + kStepCountSlack);
@@ -559,7 +588,28 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
   return status;
 }
 
+/* Before the frame, in one pass over the known bodies: joints made since the last frame found, every known body's
+ * state and forces checked before any callback runs (a collide callback's dSpaceCollide is where a body beyond
+ * SS_MAX_POSITION_M would abort), and the frame's forces read. Nothing is touched on an error. */
+static ssStatus startFrame(ssStepper* stepper, ssFrameReport* report) {
+  const ssStepping* stepping = &stepper->def.stepping;
+  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, 1};
+  ssStatus status = findNew(stepper, 0);
+  for (int joints_changed = 1; status == SS_OK && joints_changed;) {
+    dBodyID failed = 0;
+    status = ssKnownStartFrame(&stepper->known, &bounds, &failed, &joints_changed);
+    if (status != SS_OK) {
+      report->failed_body = failed;
+      return latch(stepper, status);
+    }
+    if (joints_changed) status = findNew(stepper, 1);
+  }
+  return status;
+}
+
 ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* report) {
+  /* from its own callback: refused, and the frame's report left alone */
+  if (stepper != NULL) REFUSE_IN_STEP(stepper, "ssStepper_Step");
   ssFrameReport local;
   if (report == NULL) report = &local;
   memset(report, 0, sizeof *report);
@@ -567,17 +617,33 @@ ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* repor
   if (stepper->failed_status != SS_OK)
     return ssFail(SS_ERROR_FAILED, "an earlier frame failed (%s): repair or restore the bodies, then call "
                                    "ssStepper_Reset", stepper->failed_message);
-  /* any frame from 0 up is taken: one shorter than SS_MIN_STEP_S waits for the next */
+  /* any frame from 0 up is taken: one shorter than SS_MIN_STEP_S (0 included) waits for the next, with its forces */
   ssStatus status = ssCheckNonNegative("frame_s", "s", frame_s);
   if (status == SS_OK && frame_s > SS_MAX_FRAME_S)
     status = ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: must be at most SS_MAX_FRAME_S = %g s", frame_s,
                     (double)SS_MAX_FRAME_S);
-  if (status != SS_OK || frame_s == 0) return status;
-  if ((status = refreshKnown(stepper)) != SS_OK) return status;
-  if ((status = captureForces(stepper)) != SS_OK) return status;
+  if (status != SS_OK) return status;
+  if ((status = startFrame(stepper, report)) != SS_OK) return status;
   stepper->report = report;
+  stepper->in_step = 1;
   status = stepper->def.stepping.cut == SS_CUT_FIXED ? stepFixed(stepper, frame_s, report)
                                                       : stepFrame(stepper, frame_s, report);
+  stepper->in_step = 0;
   stepper->report = NULL;
+  if (stepper->destroy_requested) ssStepper_Destroy(stepper);
   return status;
+}
+
+ssAdoptReport ssStepper_Adopted(const ssStepper* stepper) {
+  if (stepper != NULL) return stepper->adopted;
+  ssFail(SS_ERROR_OUT_OF_RANGE, "stepper = NULL: a stepper is required");
+  return (ssAdoptReport){0};
+}
+
+int ssStepper_KnownBodyCount(ssStepper* stepper) {
+  if (stepper == NULL) {
+    ssFail(SS_ERROR_OUT_OF_RANGE, "stepper = NULL: a stepper is required");
+    return -1;
+  }
+  return refreshKnown(stepper) == SS_OK ? stepper->known.count : -1;
 }

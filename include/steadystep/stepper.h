@@ -1,9 +1,10 @@
 /* steadystep: the stepper, one call per rendered frame instead of dWorldQuickStep.
  *
  * A frame of dt seconds becomes n = ceil(dt / max_step_s) equal substeps of h = dt / n (the article: "make sure to
- * specify a largest time step the simulation can handle"). Before each substep the stepper puts back the forces the
- * program added for the frame, the registry rewrites every soft thing for h, the program's callbacks run, ODE
- * steps with the program's own solver settings, the contact group is emptied and the known bodies are checked.
+ * specify a largest time step the simulation can handle"), at most stepping.max_steps_per_frame. Before each
+ * substep the stepper puts back the forces the program added for the frame, the registry rewrites every soft thing
+ * for h, the program's callbacks run, the known bodies are checked, ODE steps with the ODE step the program named
+ * and its own solver settings, the contact group is emptied and the known bodies are checked again.
  *
  *     ssStepperDef def = ssDefaultStepperDef();
  *     def.world = world; def.space = space; def.tuned_step_s = 1.0 / 60.0;   // the step the program was tuned for
@@ -17,6 +18,9 @@
  *                                                                        ssStepper_Reset(stepper); }
  *     }
  *
+ * A near callback that already uses dSpaceCollide's `data` for its own context keeps it: put the stepper in that
+ * context (struct { MyGame* game; ssStepper* stepper; }) and pass it as data; the stepper takes nothing over.
+ *
  * Threads. Each stepper's world may be stepped from its own thread, one thread per world, on ODE 0.16's terms:
  * every world shares one process-wide default threading implementation, and stepping two worlds with it at once
  * crashes the process. Before a world is stepped off the main thread, give it its own:
@@ -28,14 +32,47 @@
  * not reproducible run to run; dWorldStep is. A stepper and its registry are used from one thread at a time.
  * tests/c/test_threads.cpp shows two worlds on two threads.
  *
- * Known bodies: the bodies of the registry (bound, adopted) and those given to ssStepper_WatchBody. They are the
- * ones whose forces are kept for the whole frame and whose state is checked after every step.
+ * Known bodies: the bodies of the registry (bound, adopted), those given to ssStepper_WatchBody, and every body
+ * reachable from those through joints other than contacts. They are the ones whose forces are kept for the whole
+ * frame and whose state and forces are checked at every step. With def.space, bodies and joints made later are
+ * found and adopted at the tuned step: before each frame and each step the stepper looks at the adopted spaces
+ * (their geom count and first geom: a geom added to any of them, a nested space too), and before each frame at
+ * every known body's first joint (ODE attaches a new joint at the head of its body's list), one read each, and
+ * walks the spaces or the joints only when one changed. A body made in a callback is found before the next step; a
+ * joint made in a callback, before the next frame. What nothing reaches the stepper cannot see: a body with no geom in
+ * the space and no joint to a known body (a bob hung from the static world, a free projectile without a geom).
+ * Its forces would act on the first substep only: make it known with ssStepper_WatchBody (or adopt it,
+ * ssRegistry_AdoptBody, into the registry). ssStepper_Adopted and ssStepper_KnownBodyCount tell what was reached,
+ * for a program to compare with the bodies it made.
+ *
+ * The boundary with ODE. ODE 0.16 aborts the process inside a step or a collision rather than return an error for
+ * a state it cannot handle, so the stepper checks every known body before the frame (before any callback) and
+ * again just before every physics step (after before_step and collide, whatever they did): position within
+ * SS_MAX_POSITION_M, linear and angular velocity finite and within stepping.max_speed and max_angular_speed, force
+ * and torque accumulators finite and within SS_MAX_FORCE_N (whatever added them: the program before the frame,
+ * before_step or collide). After every step it checks the state again. A failure refuses the frame by name (the
+ * body, the quantity, its value) with nothing of that step taken: the world as the previous step left it (the
+ * step's contacts removed, the accumulators as the program left them for the frame, or empty after an earlier
+ * step), report->failed_body set, and every later frame refused until ssStepper_Reset. A state set inside
+ * before_step reaches the program's own dSpaceCollide before this check; one set between frames does not.
+ *
+ * Callbacks (before_step, collide, step_done) may call, on their own stepper:
+ *  - ssStepper_CurrentStep, ssStepper_SoftenContact, ssStepper_Stepping, ssStepper_ResetHistory, WatchBody,
+ *    UnwatchBody: as between frames; the known list follows before the next check.
+ *  - ssStepper_DestroyBody, ssStepper_DestroyJoint: the body or joint leaves the stepper and the registry at once
+ *    (no later part of the frame reads it), then ODE destroys it.
+ *  - ssStepper_Destroy: deferred. The frame stops where it is (from before_step or collide, that step is not taken
+ *    and its contacts are removed; from step_done, no further step), ssStepper_Step fills the report and returns
+ *    SS_OK, and then the stepper is freed: do not use it after that ssStepper_Step returns.
+ *  - ssStepper_Step, ssStepper_SetStepping, ssStepper_Reset: refused with SS_ERROR_REENTERED, named (Reset, which
+ *    returns nothing, records the message for ssLastError and does nothing).
  */
 #ifndef STEADYSTEP_STEPPER_H
 #define STEADYSTEP_STEPPER_H
 
 #include <ode/ode.h>
 
+#include "steadystep/adopt.h"
 #include "steadystep/export.h"
 #include "steadystep/limits.h"
 #include "steadystep/registry.h"
@@ -126,26 +163,37 @@ SS_API ssStepperDef ssDefaultStepperDef(void);
  *  ssRegistry_Adopt; SS_ERROR_OUT_OF_MEMORY. */
 SS_API ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out);
 
-/** Destroys the stepper. NULL is a no-op. */
+/** Destroys the stepper (and the registry it made for def.space). NULL is a no-op. From the stepper's own callback
+ *  it is deferred to the end of that ssStepper_Step (see the top). */
 SS_API void ssStepper_Destroy(ssStepper* stepper);
 
-/** Advances the world by one frame of frame_s seconds (0 <= frame_s <= SS_MAX_FRAME_S; 0 does nothing). report may
+/** Advances the world by one frame of frame_s seconds (0 <= frame_s <= SS_MAX_FRAME_S; 0 takes no step). report may
  *  be NULL.
  *  Forces and torques that the program added to known bodies before this call act for the whole frame: they are
  *  put back before every substep (ODE clears them after each step), and under SS_CUT_FIXED they are scaled so
  *  that the frame's steps deliver the momentum F·frame_s (carried to the next frame when this one takes no step).
- *  Errors, with the world left as it was: SS_ERROR_OUT_OF_RANGE (stepper NULL, frame_s out of range, a force or
- *  torque on a known body beyond SS_MAX_FORCE_N, named with its body), SS_ERROR_NOT_FINITE (frame_s, a force);
+ *  A frame of 0 s (or shorter than SS_MIN_STEP_S) takes no step: its forces are read and cleared (F·0 = 0 for 0 s;
+ *  a shorter frame's momentum is carried), so they never act again with the next frame. A frame of one step of
+ *  exactly its own length with nothing carried leaves the forces in ODE's accumulators as the program added them.
+ *  Under SUBSTEPS and FIXED, time beyond max_steps_per_frame steps is dropped (report->dropped_s), with its share
+ *  of the forces' momentum.
+ *  Errors, with the world left as it was: SS_ERROR_OUT_OF_RANGE (stepper NULL, frame_s out of range),
+ *  SS_ERROR_NOT_FINITE (frame_s); SS_ERROR_REENTERED (called from one of its own callbacks; report untouched);
  *  errors of ssRegistry_Apply (found at the frame's first step: what can fail depends on the step length and the
  *  bound springs alone, and every row an accurate mapping cannot serve falls back to implicit Euler);
  *  SS_ERROR_FAILED when an earlier frame failed and ssStepper_Reset has not been called.
- *  Errors after stepping: SS_ERROR_BLOWUP (a known body's position or velocity is not finite) and
- *  SS_ERROR_SPEED_LIMIT (faster than max_speed or max_angular_speed): the frame stops at that step,
- *  report->failed_body names the body, and the stepper refuses every later frame until ssStepper_Reset. */
+ *  Errors of the boundary (see the top), before the frame or before a step, named with the body and the value,
+ *  nothing of that step taken: SS_ERROR_BLOWUP (a position or velocity not finite), SS_ERROR_POSITION_LIMIT,
+ *  SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a force or torque), SS_ERROR_OUT_OF_RANGE (one beyond
+ *  SS_MAX_FORCE_N); and after a step: SS_ERROR_BLOWUP, SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT. Each stops
+ *  the frame, names the body in report->failed_body, and the stepper refuses every later frame until
+ *  ssStepper_Reset. */
 SS_API ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* report);
 
 /** After a failure, once the program has repaired or restored its bodies: accepts frames again. Also forgets the
- *  step history, the FIXED accumulator and the momentum carried for the next frame. NULL is a no-op. */
+ *  step history, the FIXED accumulator and the momentum carried for the next frame. NULL is a no-op. A body left as
+ *  it failed (still too fast, or beyond a bound) is refused again, by name, before the next frame touches it.
+ *  From the stepper's own callback: does nothing, and records SS_ERROR_REENTERED's message for ssLastError. */
 SS_API void ssStepper_Reset(ssStepper* stepper);
 
 /** The step about to be taken. Meaningful inside before_step and collide; between frames it describes the next
@@ -164,8 +212,8 @@ SS_API ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
  *  first, or a tuned erp outside [0, 1] or cfm < 0); SS_ERROR_NOT_FINITE. */
 SS_API ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2);
 
-/** Adds a body to the known bodies: forces kept for the whole frame and checks after each step.
- *  Errors: SS_ERROR_OUT_OF_RANGE (NULL), SS_ERROR_OUT_OF_MEMORY. */
+/** Adds a body to the known bodies: forces kept for the whole frame and checks at each step.
+ *  Errors: SS_ERROR_OUT_OF_RANGE (NULL, or a body of another world), SS_ERROR_OUT_OF_MEMORY. */
 SS_API ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body);
 
 /** Stops watching a body; call it before dBodyDestroy. Errors: SS_ERROR_OUT_OF_RANGE (NULL), SS_ERROR_NOT_FOUND. */
@@ -188,9 +236,19 @@ SS_API ssStatus ssStepper_DestroyJoint(ssStepper* stepper, dJointID joint);
  *  after teleporting a body or setting its velocity. NULL is a no-op. */
 SS_API void ssStepper_ResetHistory(ssStepper* stepper);
 
-/** Changes how frames become steps, between frames (resets the history and the FIXED accumulator).
- *  Errors, with nothing changed: those of ssValidateStepping; SS_ERROR_OUT_OF_RANGE for a NULL stepper. */
+/** Changes how frames become steps, between frames (resets the history and the FIXED accumulator). max_step_s and
+ *  fixed_step_s of 0 are the stepper's tuned step.
+ *  Errors, with nothing changed: those of ssValidateStepping; SS_ERROR_OUT_OF_RANGE for a NULL stepper or a step of
+ *  0 with no tuned step; SS_ERROR_REENTERED from the stepper's own callback. */
 SS_API ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping);
+
+/** What the stepper's own adoption reached (def.space): at ssStepper_Create and since, summed (ssAdoptReport,
+ *  adopt.h; all zero without a space). A NULL stepper gives all zero and records SS_ERROR_OUT_OF_RANGE. */
+SS_API ssAdoptReport ssStepper_Adopted(const ssStepper* stepper);
+
+/** How many bodies the stepper knows now (see the top): compare it with the bodies the program made to find one
+ *  nothing reaches. -1 for a NULL stepper (SS_ERROR_OUT_OF_RANGE recorded) or when out of memory listing them. */
+SS_API int ssStepper_KnownBodyCount(ssStepper* stepper);
 
 /** The stepper's stepping. A NULL stepper gives ssDefaultStepping() and records SS_ERROR_OUT_OF_RANGE for
  *  ssLastError. */

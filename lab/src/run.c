@@ -115,7 +115,7 @@ static ssStatus play(ssRun* run, ssScene* scene, ssProfile* profile, double dura
     if (run->too_many_steps)
       return ssFail(SS_ERROR_OUT_OF_RANGE, "run: %d steps after %g s of duration_s = %g s: a run takes at most %d steps",
                     run->count, elapsed_s, duration_s, SS_MAX_RUN_STEPS);
-    if (status == SS_ERROR_BLOWUP || status == SS_ERROR_SPEED_LIMIT) {
+    if (status == SS_ERROR_BLOWUP || status == SS_ERROR_SPEED_LIMIT || status == SS_ERROR_POSITION_LIMIT) {
       run->status = status;
       run->outcome = SS_RUN_BLEW_UP;
       strncpy(run->message, ssLastError(), sizeof run->message - 1);

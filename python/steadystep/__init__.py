@@ -23,7 +23,8 @@ from steadystep.study import grid, make_executor, sweep
 
 __all__ = [
     "AdoptReport", "ApplyReport", "FrameCut", "FrameReport", "JointParam", "Mapping", "Profile", "Registry",
-    "ServedCounts", "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper", "SteadystepError", "Stepping", "contact_soften",
+    "ServedCounts", "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper", "SteadystepError", "Stepping",
+    "contact_soften",
     "exact_softness", "frame_times", "frequency_from_spring", "grid", "joint_effective_mass", "joint_supports",
     "make_executor", "matched_softness", "policy_names", "softness_for", "softness_from_spring",
     "spring_from_frequency", "spring_from_softness", "sweep",

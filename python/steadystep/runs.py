@@ -143,11 +143,11 @@ def reference_stepping() -> dict:
     return _as_dict(lib.ssReferenceStepping(REFERENCE_STEP_S))
 
 
-# How a run ends (RunResult.status): "ok" ran to the end within the scene's sanity bounds; "blow-up" and
-# "speed limit" ended early with a state that was not finite or absurdly fast; "broken" ended early, finite but
-# physically wrong: a step left one of the scene's sanity bounds (scene.h: a torn joint, a box through the floor,
-# energy made). Only "ok" is a run to measure: a report counts every other status as failed.
-BLOW_UP_STATUSES = frozenset({"blow-up", "speed limit"})
+# How a run ends (RunResult.status): "ok" ran to the end within the scene's sanity bounds; "blow-up", "speed limit"
+# and "position limit" ended early with a state that was not finite, absurdly fast or absurdly far; "broken" ended
+# early, finite but physically wrong: a step left one of the scene's sanity bounds (scene.h: a torn joint, a box
+# through the floor, energy made). Only "ok" is a run to measure: a report counts every other status as failed.
+BLOW_UP_STATUSES = frozenset({"blow-up", "speed limit", "position limit"})
 BROKEN = "broken"
 
 
@@ -168,7 +168,7 @@ class RunResult:
     units: dict[str, str]
     frame_count: int
     wall_s: float                      # wall-clock seconds of stepping (scene building excluded)
-    status: str                        # "ok", "broken", or the blow-up status ("blow-up", "speed limit")
+    status: str                        # "ok", "broken", or a blow-up status (BLOW_UP_STATUSES)
     message: str = ""                  # why a run that is not "ok" ended: the bound, body or joint, value, time
     initial: dict[str, float] = field(default_factory=dict)  # the quantities before the first step (t = 0)
     bound_use: float = 0.0             # the largest value/bound ratio of the scene's sanity bounds (> 1: broken)

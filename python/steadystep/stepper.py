@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from steadystep import _handles
 from steadystep._native import SteadystepError, check, ffi, lib, number, shown
 from steadystep.enums import Mapping, Solver, Status
-from steadystep.registry import Registry, ServedCounts, from_struct
+from steadystep.registry import AdoptReport, Registry, ServedCounts, from_struct
 from steadystep.stepping import Stepping, stepping_from
 
 
@@ -141,8 +141,8 @@ class Stepper:
 
     def _between_frames(self, what: str):
         if self._in_frame:
-            raise SteadystepError("out of range", f"stepper.{what}: called from a callback of the same stepper, "
-                                  "inside its frame")
+            raise SteadystepError("reentered", f"stepper.{what}: called from a callback of the same stepper, "
+                                  "inside its frame", int(Status.REENTERED))
         return self._handle()
 
     @property
@@ -163,13 +163,15 @@ class Stepper:
         self._stepping = stepping
 
     def step(self, frame_s: float) -> FrameReport:
-        """Advances the world by one frame of frame_s seconds (0 <= frame_s <= 3600; 0 does nothing). Forces the
-        program added to known bodies before this call act for the whole frame. Raises SteadystepError with the
-        library's message (the world left as it was for a refused frame); for a blow-up or a runaway
-        (Status.BLOWUP, Status.SPEED_LIMIT) the error's `report` is the FrameReport, whose failed_body names the
-        body, and every later frame is refused (Status.FAILED) until reset(). An exception raised by a callback
-        is raised here, after the frame, with the frame's FrameReport (or its error) as its `steadystep_report`
-        (or `__context__`)."""
+        """Advances the world by one frame of frame_s seconds (0 <= frame_s <= 3600; 0 takes no step). Forces the
+        program added to known bodies before this call act for the whole frame (a frame of 0 s reads and clears
+        them: F·0 = 0). Raises SteadystepError with the
+        library's message (the world left as it was for a refused frame); for a body refused at the boundary
+        before the frame or a step (a state or force ODE cannot step, Status.POSITION_LIMIT, ...) or one that blew
+        up or ran away in a step (Status.BLOWUP, Status.SPEED_LIMIT) the error's `report` is the FrameReport, whose
+        failed_body names the body, and every later frame is refused (Status.FAILED) until reset(). An exception
+        raised by a callback is raised here, after the frame, with the frame's FrameReport (or its error) as its
+        `steadystep_report` (or `__context__`)."""
         handle = self._between_frames("step")
         frame_s = number("frame_s", frame_s, "s")
         report = ffi.new("ssFrameReport*")
@@ -185,7 +187,7 @@ class Stepper:
         try:
             check(status)
         except SteadystepError as failure:
-            if status in (Status.BLOWUP, Status.SPEED_LIMIT):
+            if made.failed_body:  # a body refused at the boundary, or that blew up or ran away in a step
                 failure.report = made
             error = failure
         if pending is not None:
@@ -199,6 +201,21 @@ class Stepper:
         if error is not None:
             raise error
         return made
+
+    @property
+    def adopted(self) -> AdoptReport:
+        """What the stepper's own adoption (space=...) reached, at creation and since (ssStepper_Adopted)."""
+        return from_struct(AdoptReport, lib.ssStepper_Adopted(self._handle()))
+
+    @property
+    def known_body_count(self) -> int:
+        """How many bodies the stepper knows now (ssStepper_KnownBodyCount): forces kept over a frame, checked at
+        every step. A body nothing reaches (no geom in the space, no joint to a known body) is not among them:
+        watch_body() it."""
+        count = lib.ssStepper_KnownBodyCount(self._handle())
+        if count < 0:
+            check(lib.SS_ERROR_OUT_OF_MEMORY)
+        return count
 
     def current_step(self) -> StepInfo:
         """The step about to be taken: meaningful inside before_step and collide; between frames, the next step of

@@ -8,6 +8,7 @@
 #include "test_stepping.h"
 #include "ode_fixture.h"
 #include "oscillator_rig.h"
+#include "precision.h"
 
 namespace {
 
@@ -46,8 +47,8 @@ TEST_F(StepperTest, NaiveTakesOneStepWithSoftnessFrozenAtTheReference) {
     ASSERT_EQ(ssStepper_Step(rig.stepper, frame_s, &report), SS_OK);
     EXPECT_EQ(report.steps, 1);
     EXPECT_DOUBLE_EQ(report.step_s, frame_s);
-    EXPECT_DOUBLE_EQ(dJointGetSliderParam(rig.slider, dParamStopERP), reference.erp);
-    EXPECT_DOUBLE_EQ(dJointGetSliderParam(rig.slider, dParamStopCFM), reference.cfm);
+    EXPECT_DOUBLE_EQ(dJointGetSliderParam(rig.slider, dParamStopERP), AsDReal(reference.erp));
+    EXPECT_DOUBLE_EQ(dJointGetSliderParam(rig.slider, dParamStopCFM), AsDReal(reference.cfm));
   }
 }
 
@@ -244,14 +245,27 @@ TEST_F(StepperTest, BlowUpsAndRunawaysAreReportedAndStepsAreRefusedUntilReset) {
   OscillatorRig rig;
   rig.def.stepping.max_speed = 100;
   ASSERT_EQ(rig.Build(), SS_OK);
-  dBodyID loose = MakeBody(1.0);
-  ssStepper_WatchBody(rig.stepper, loose);
-  dBodySetLinearVel(loose, 150, 0, 0);
+  EXPECT_EQ(ssStepper_WatchBody(rig.stepper, MakeBody(1.0)), SS_ERROR_OUT_OF_RANGE);  // of the fixture's world
+  EXPECT_NE(std::string(ssLastError()).find("of another world"), std::string::npos) << ssLastError();
+  dBodyID loose = dBodyCreate(rig.world);  // 1 kg
+  ASSERT_EQ(ssStepper_WatchBody(rig.stepper, loose), SS_OK);
   ssFrameReport report;
+  // Set between frames: refused before anything is stepped.
+  dBodySetLinearVel(loose, 150, 0, 0);
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_SPEED_LIMIT);
+  EXPECT_EQ(report.failed_body, loose);
+  EXPECT_EQ(report.steps, 0);
+  EXPECT_NE(std::string(ssLastError()).find("speed 150 m/s before the frame"), std::string::npos) << ssLastError();
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_FAILED);
+  ssStepper_Reset(rig.stepper);
+  // Reached in a step: 99 m/s plus 3000 N on 1 kg for 1/60 s is 149 m/s after the first of three substeps.
+  dBodySetLinearVel(loose, 99, 0, 0);
+  dBodyAddForce(loose, 3000, 0, 0);
   EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_SPEED_LIMIT);
   EXPECT_EQ(report.failed_body, loose);
   EXPECT_EQ(report.steps, 1);  // the frame stops at the step that failed
   EXPECT_NE(std::string(ssLastError()).find("max_speed = 100"), std::string::npos) << ssLastError();
+  EXPECT_NE(std::string(ssLastError()).find("after step 1 of 3"), std::string::npos) << ssLastError();
 
   // Latched: every later frame is refused, names the first failure and touches nothing.
   dBodySetLinearVel(loose, 0, 0, 0);
@@ -287,7 +301,7 @@ TEST_F(StepperTest, TheSpeedGuardIsOnByDefaultForLinearAndAngularSpeed) {
   EXPECT_GT(def.stepping.max_angular_speed, 0);
   OscillatorRig rig;
   ASSERT_EQ(rig.Build(), SS_OK);
-  dBodyID spinning = MakeBody(1.0);
+  dBodyID spinning = dBodyCreate(rig.world);
   ASSERT_EQ(ssStepper_WatchBody(rig.stepper, spinning), SS_OK);
   dBodySetAngularVel(spinning, 0, 0, 2 * def.stepping.max_angular_speed);
   ssFrameReport report;
@@ -372,8 +386,8 @@ TEST_F(StepperTest, WithASpaceTheStepperAdoptsIntoARegistryOfItsOwnAtTheTunedSte
   EXPECT_EQ(report.rows.by_mapping, 3);  // adopted: the world's ERP/CFM, the slider's stop and its motor row
   // The stop's spring, k = erp / (h0 cfm), c = (1 - erp) / cfm, written for the step of 1/100 s.
   const double h0 = 1.0 / 50, h = 1.0 / 100, k = 0.4 / (h0 * 1e-3), c = 0.6 / 1e-3;
-  EXPECT_NEAR(dJointGetSliderParam(slider, dParamStopERP), h * k / (h * k + c), 1e-12);
-  EXPECT_NEAR(dJointGetSliderParam(slider, dParamStopCFM), 1 / (h * k + c), 1e-12);
+  EXPECT_NEAR(dJointGetSliderParam(slider, dParamStopERP), h * k / (h * k + c), ReadBackTolerance(1e-12, 1));
+  EXPECT_NEAR(dJointGetSliderParam(slider, dParamStopCFM), 1 / (h * k + c), ReadBackTolerance(1e-12, 1 / (h * k + c)));
   ssStepper_Destroy(stepper);  // and its registry
 
   // A registry of another world is refused by name.

@@ -8,12 +8,15 @@
  * policies, or cut, mapping, frozen step and limits fuzzed, valid or not), rebinding rows with fuzzed springs and
  * effective masses, loads, damping, auto-disable, the world's ERP/CFM, the contact softness, body masses, resets,
  * and destroying an island through the stepper (ssStepper_DestroyJoint/DestroyBody, in either order, with a frame in
- * between or not) and building it again.
+ * between or not) and building it again; states and forces the program sets between frames (fuzzed numbers on a
+ * body's position, velocities, force, torque); and callbacks that, at a fuzzed step of the next frame, add a fuzzed
+ * force or torque, set a state, destroy an island, or call ssStepper_Step, SetStepping and Reset again.
  *
  * Promises checked: the process never aborts; a refusal names something (ssLastError) and changes nothing (binding
  * count, body states for frame refusals); a frame reported OK leaves every body's state finite; a blow-up names the
- * body, and the stepper then refuses frames until ssStepper_Reset. Masses stay within [1e-3, 1e3] kg: the program,
- * not the library, hands them to ODE. */
+ * body, and the stepper then refuses frames until ssStepper_Reset; so does a state or force refused at the boundary
+ * (before the frame or a step), by name; re-entering is refused with SS_ERROR_REENTERED. Masses stay within [1e-3, 1e3]
+ * kg: the program, not the library, hands them to ODE. */
 #include <ode/ode.h>
 
 #include "fuzz_input.h"
@@ -48,6 +51,11 @@ struct World {
   int adopt;                 /* soft rows come from adoption rather than from binding */
   struct World* self;        /* what the geoms' data points at, so that the near callback finds the world */
   ssStepping stepping;       /* the stepper's, as last accepted */
+  /* what before_step does in the next frame: at step `at`, `what` (0 nothing) with `value` on island `kind` */
+  struct {
+    int what, at, kind;
+    double value;
+  } plan;
 };
 
 typedef struct BodyState {
@@ -379,6 +387,40 @@ static void collide(void* context, ssStepper* stepper) {
   dSpaceCollide(w->space, stepper, near_callback);
 }
 
+static int destroy_island(World* w, int kind, int bodies_first, int frame_between);
+static void build_island(World* w, int kind, const double* tuned);
+
+/* A program's before_step doing what the plan says, once. */
+static void before_step(void* context, ssStepper* stepper) {
+  World* w = context;
+  if (w->plan.what == 0 || ssStepper_CurrentStep(stepper).index != w->plan.at) return;
+  int what = w->plan.what;
+  w->plan.what = 0;
+  Island* island = &w->islands[w->plan.kind];
+  dBodyID body = island->body_count > 0 ? island->bodies[0] : 0;
+  double v = w->plan.value;
+  if (verbose) fprintf(stderr, "  before_step %d: plan %d, island %d, %.17g\n", w->plan.at, what, w->plan.kind, v);
+  switch (what) {
+    case 1: if (body) dBodyAddTorque(body, v, 0, 0); break; /* a PD controller's torque, NaN included */
+    case 2: if (body) dBodyAddForce(body, 0, v, 0); break;
+    case 3: if (body) dBodySetAngularVel(body, 0, 0, v); break;
+    case 4: if (body) dBodySetPosition(body, v, 0, 0.5); break;
+    case 5: /* destroyed and built again inside the frame: the stepper must forget the one and find the other */
+      destroy_island(w, w->plan.kind, v > 0, 0);
+      build_island(w, w->plan.kind, NULL);
+      break;
+    default: {
+      ssFrameReport inner;
+      FUZZ_REQUIRE(ssStepper_Step(stepper, 1.0 / 60, &inner) == SS_ERROR_REENTERED, "Step from before_step: %s",
+                   ssLastError());
+      ssStepping stepping = ssStepper_Stepping(stepper);
+      FUZZ_REQUIRE(ssStepper_SetStepping(stepper, &stepping) == SS_ERROR_REENTERED, "SetStepping from before_step");
+      ssStepper_Reset(stepper);
+      FUZZ_REQUIRE(strstr(ssLastError(), "ssStepper_Reset: called from a callback") != NULL, "Reset from before_step");
+    }
+  }
+}
+
 /* ---- states ---- */
 
 static int snapshot(const World* w, BodyState* out, int capacity) {
@@ -427,10 +469,11 @@ static int frame(World* w, double frame_s, int op) {
   enum { CAPACITY = ISLAND_COUNT * MAX_ISLAND_BODIES };
   BodyState before[CAPACITY], after[CAPACITY];
   int count = snapshot(w, before, CAPACITY);
+  int planned_destroy = w->plan.what == 5; /* bodies replaced in the frame: states are not compared */
   ssFrameReport report;
   if (verbose) fprintf(stderr, "op %d: stepping %.17g s\n", op, frame_s);
   ssStatus status = ssStepper_Step(w->stepper, frame_s, &report);
-  snapshot(w, after, CAPACITY);
+  if (snapshot(w, after, CAPACITY) != count || planned_destroy) count = snapshot(w, before, CAPACITY);
   if (verbose)
     fprintf(stderr, "op %d: %s/%s frame %.17g s: %s, %d steps, %s\n", op,
             NAME_OR_UNKNOWN(ssFrameCutName(w->stepping.cut)), NAME_OR_UNKNOWN(ssMappingName(w->stepping.mapping)),
@@ -445,7 +488,9 @@ static int frame(World* w, double frame_s, int op) {
                    report.steps);
       return 1;
     case SS_ERROR_BLOWUP:
-    case SS_ERROR_SPEED_LIMIT: {
+    case SS_ERROR_SPEED_LIMIT:
+    case SS_ERROR_POSITION_LIMIT:
+    latched: {
       FUZZ_REQUIRE(ssLastError()[0] != '\0' && report.failed_body != 0, "op %d: %s without a message or a body", op,
                    ssStatusName(status));
       /* Latched: the next frame is refused and changes nothing. The run ends: the world is the program's to repair. */
@@ -457,6 +502,7 @@ static int frame(World* w, double frame_s, int op) {
       return 0;
     }
     default:
+      if (report.failed_body != 0) goto latched; /* a force refused at the boundary, named with its body */
       FUZZ_REQUIRE(ssLastError()[0] != '\0', "op %d: frame %.17g s refused (%s) without a message", op, frame_s,
                    ssStatusName(status));
       FUZZ_REQUIRE(memcmp(before, after, count * sizeof before[0]) == 0,
@@ -542,6 +588,8 @@ static void make_world(World* w, FuzzInput* in) {
   def.registry = w->registry;
   def.collide = collide;
   def.collide_context = w;
+  def.before_step = before_step;
+  def.before_step_context = w;
   def.contact_group = w->contacts;
   uint8_t how = fuzz_byte(in);
   def.stepping.cut = (ssFrameCut)(how % 4);           /* 3 is unknown */
@@ -569,6 +617,8 @@ static void make_world(World* w, FuzzInput* in) {
     fallback.registry = def.registry;
     fallback.collide = def.collide;
     fallback.collide_context = def.collide_context;
+    fallback.before_step = def.before_step;
+    fallback.before_step_context = def.before_step_context;
     fallback.contact_group = def.contact_group;
     fallback.stepping.solver = SS_SOLVER_QUICK;
     fallback.stepping.max_step_s = fallback.stepping.fixed_step_s = 1.0 / 60;
@@ -618,9 +668,32 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   make_world(&w, &in);
   for (int op = 0; op < MAX_OPS && !fuzz_empty(&in); ++op) {
     uint8_t code = fuzz_byte(&in);
-    if (verbose) fprintf(stderr, "op %d: code %d\n", op, code % 14);
+    if (verbose) fprintf(stderr, "op %d: code %d\n", op, code % 16);
     int bindings = ssRegistry_JointBindingCount(w.registry);
-    switch (code % 14) {
+    switch (code % 16) {
+      case 14: {
+        /* A state or force the program sets between frames (a corrupt save, a teleport, a huge spin). */
+        dBodyID body = pick_body(&w, fuzz_byte(&in) & 0x7F);
+        uint8_t which = fuzz_byte(&in);
+        double v = fuzz_double(&in);
+        if (verbose) fprintf(stderr, "  set %d to %.17g\n", which % 5, v);
+        switch (which % 5) {
+          case 0: dBodySetPosition(body, v, 0, 0.5); break;
+          case 1: dBodySetLinearVel(body, 0, v, 0); break;
+          case 2: dBodySetAngularVel(body, v, 0, 0); break;
+          case 3: dBodyAddForce(body, 0, 0, v); break;
+          default: dBodyAddTorque(body, 0, v, 0); break;
+        }
+        break;
+      }
+      case 15: {
+        /* What before_step does in the next frame. */
+        w.plan.what = 1 + fuzz_byte(&in) % 6;
+        w.plan.at = fuzz_byte(&in) % 4;
+        w.plan.kind = fuzz_byte(&in) % ISLAND_COUNT;
+        w.plan.value = fuzz_double(&in);
+        break;
+      }
       case 0:
         if (!frame(&w, fuzz_double(&in), op)) goto done;
         break;

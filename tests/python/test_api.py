@@ -34,7 +34,8 @@ def test_each_enum_has_exactly_the_c_enumerators(enum, ctype, prefix):
 
 
 @pytest.mark.parametrize("cls, ctype", [
-    (ss.ServedCounts, "ssServedCounts"), (ss.ApplyReport, "ssApplyReport"), (ss.AdoptReport, "ssAdoptReport"), (ss.FrameReport, "ssFrameReport"),
+    (ss.ServedCounts, "ssServedCounts"), (ss.ApplyReport, "ssApplyReport"), (ss.AdoptReport, "ssAdoptReport"),
+    (ss.FrameReport, "ssFrameReport"),
     (ss.StepInfo, "ssStepInfo"), (ss.Stepping, "ssStepping")])
 def test_each_dataclass_has_exactly_the_c_fields_in_order(cls, ctype):
     assert [field.name for field in dataclasses.fields(cls)] == [name for name, _ in ffi.typeof(ctype).fields]

@@ -369,7 +369,8 @@ def test_an_exception_in_a_callback_is_raised_by_step_and_the_stepper_goes_on(wo
         if len(calls) == 2:
             raise KeyError("from before_step")
 
-    stepper = ss.Stepper(world, None, before_step=before, policy="implicit-euler", solver=ss.Solver.QUICK, tuned_step_s=1 / 60)
+    stepper = ss.Stepper(world, None, before_step=before, policy="implicit-euler", solver=ss.Solver.QUICK,
+                         tuned_step_s=1 / 60)
     stepper.watch_body(body)
     with pytest.raises(KeyError, match="from before_step") as raised:
         stepper.step(0.05)  # 3 substeps: the second raises, the third is taken without the callback
@@ -381,8 +382,9 @@ def test_an_exception_in_a_callback_is_raised_by_step_and_the_stepper_goes_on(wo
         stepper.step(0.01)
 
     again = ss.Stepper(world, None, before_step=reenter, solver=ss.Solver.QUICK, tuned_step_s=1 / 60)
-    with pytest.raises(ss.SteadystepError, match="called from a callback of the same stepper"):
+    with pytest.raises(ss.SteadystepError, match="called from a callback of the same stepper") as raised:
         again.step(0.01)
+    assert raised.value.code == ss.Status.REENTERED
     done = ss.Stepper(world, None, step_done=lambda step_s: 1 / 0, solver=ss.Solver.QUICK, tuned_step_s=1 / 60)
     with pytest.raises(ZeroDivisionError):
         done.step(0.01)
@@ -407,3 +409,38 @@ def test_after_a_runaway_frames_are_refused_until_reset(world):
     assert stepper.step(0.1).steps == 6
     assert odepy.dBodyGetPosition(body)[0] - x == pytest.approx(0.1, rel=1e-12)
     stepper.close()
+
+
+def test_a_stepper_made_from_a_space_knows_what_is_spawned_and_refuses_a_nan_torque_by_name(world):
+    odepy.dWorldSetGravity(world, 0.0, 0.0, 0.0)
+    space = odepy.dHashSpaceCreate(None)
+    first = box_body(world)
+    odepy.dGeomSetBody(odepy.dCreateSphere(space, 0.1), first)
+    torques = []
+
+    def before(stepper):  # a controller that divides by a span that is zero on the fourth step
+        torques.append(1.0)
+        if len(torques) == 4:
+            odepy.dBodyAddTorque(first, math.nan, 0.0, 0.0)
+
+    stepper = ss.Stepper(world, space=space, tuned_step_s=1 / 60, solver=ss.Solver.QUICK, before_step=before)
+    assert stepper.adopted.bodies == 1 and stepper.known_body_count == 1
+    assert stepper.stepping.max_step_s == 1 / 60  # 0: the tuned step
+    stepper.step(0.05)
+    spawned = box_body(world, mass_kg=1.0, x=3.0)  # spawned between frames, forced once a frame
+    odepy.dGeomSetBody(odepy.dCreateSphere(space, 0.1), spawned)
+    odepy.dBodyAddForce(spawned, 1.0, 0.0, 0.0)
+    with pytest.raises(ss.SteadystepError, match=r"torque \(nan, 0, 0\) N\*m before step 1 of 3") as refused:
+        stepper.step(0.05)
+    assert refused.value.code == ss.Status.NOT_FINITE and refused.value.report.failed_body == address(first)
+    assert stepper.adopted.bodies == 2 and stepper.known_body_count == 2
+    assert odepy.dBodyGetForce(spawned)[0] == 1.0  # the refused frame left the program's forces as it added them
+    odepy.dBodySetTorque(first, 0.0, 0.0, 0.0)  # the repair; the refused frame is not played again
+    odepy.dBodySetForce(spawned, 0.0, 0.0, 0.0)
+    stepper.reset()
+    for _ in range(10):
+        odepy.dBodyAddForce(spawned, 1.0, 0.0, 0.0)
+        stepper.step(0.05)
+    assert odepy.dBodyGetLinearVel(spawned)[0] == pytest.approx(0.5, abs=1e-9)  # F·t / m, every frame whole
+    stepper.close()
+    odepy.dSpaceDestroy(space)

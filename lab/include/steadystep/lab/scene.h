@@ -135,9 +135,9 @@ SS_LAB_API ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
 SS_LAB_API ssStatus ssLabStepping(const char* policy, ssStepping* out);
 
 /** The stepping of a reference run: implicit Euler with substeps of at most step_s (s, in the step range; e.g.
- *  1/1000), fixed_step_s also step_s, solver SS_SOLVER_QUICK, the other fields as ssDefaultStepping. Run it under the profile "fixed:N"
- *  with N = 1/step_s (e.g. "fixed:1000") so that every frame is one step. step_s is not checked here:
- *  ssScene_Create refuses a bad one. */
+ *  1/1000), fixed_step_s also step_s, solver SS_SOLVER_QUICK, the other fields as ssDefaultStepping. Run it under the
+ *  profile "fixed:N" with N = 1/step_s (e.g. "fixed:1000") so that every frame is one step. step_s is not checked
+ *  here: ssScene_Create refuses a bad one. */
 SS_LAB_API ssStepping ssReferenceStepping(double step_s);
 
 typedef struct ssScene ssScene;
@@ -243,8 +243,8 @@ typedef struct ssRun ssRun;
 typedef enum ssRunOutcome {
   SS_RUN_NONE = -1,      /* only for run = NULL */
   SS_RUN_COMPLETED = 0,  /* ran for duration_s within every sanity bound */
-  SS_RUN_BLEW_UP = 1,    /* ended early by SS_ERROR_BLOWUP or SS_ERROR_SPEED_LIMIT (ssRun_Status says which):
-                          * the state became non-finite or absurdly fast */
+  SS_RUN_BLEW_UP = 1,    /* ended early by SS_ERROR_BLOWUP, SS_ERROR_SPEED_LIMIT or SS_ERROR_POSITION_LIMIT
+                          * (ssRun_Status says which): the state became non-finite, absurdly fast or far */
   SS_RUN_BROKEN = 2,     /* ended early at the first step outside a sanity bound (ssScene_Broken): finite but
                           * physically wrong */
 } ssRunOutcome;

@@ -1,0 +1,159 @@
+/* What each of Apply's caches buys (apply.c states their invariants): 1000 bodies in hanging hinge chains with a soft
+ * stop and a damper on every motor row (2000 rows, as bench_stepper's), one world per configuration (every cache on,
+ * each one off alone, all off), stepped through the same frames. Only ssRegistry_Apply is timed, each frame right
+ * after the world's dWorldQuickStep (which evicts the registry from the caches, as in a program). The worlds are
+ * stepped in alternating blocks in a rotating order, and the measurement is repeated: the median of each world's
+ * time over the all-on time is printed, with Apply's share of a QuickStep. A first block is stepped untimed: the
+ * first Apply computes every row whatever the caches.
+ *
+ *   bench_apply [frames] [repeats]      (default 120 frames, 5 repeats) */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "registry_internal.h"
+#include "steadystep/steadystep.h"
+
+enum { kChains = 50, kLinks = 20, kBlock = 10, kMaxRepeats = 32 };
+enum { kConfigs = 8 };
+static const unsigned kDisabled[kConfigs] = {0,
+                                             SS_CACHE_SAME_STEP,
+                                             SS_CACHE_BY_LAW,
+                                             SS_CACHE_BODIES,
+                                             SS_CACHE_SHARED,
+                                             SS_CACHE_REUSE,
+                                             SS_CACHE_SAME_AXIS,
+                                             SS_CACHE_ALL};
+static const char* const kConfigNames[kConfigs] = {"all on", "-same step", "-by law", "-bodies",
+                                                   "-shared", "-reuse",    "-same axis", "all off"};
+static const ssSpring kLimit = {5.0, 0.05}, kFriction = {0.0, 0.01};
+static const double kFrame_s = 1.0 / 60.0;
+
+static double nowSeconds(void) { /* this thread's CPU time: waiting for a core is not counted */
+  struct timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void check(ssStatus status, const char* what) {
+  if (status == SS_OK) return;
+  fprintf(stderr, "bench_apply: %s: %s\n", what, ssLastError());
+  exit(1);
+}
+
+typedef struct Scene {
+  dWorldID world;
+  ssRegistry* registry;
+  double previous_s;
+} Scene;
+
+static Scene build(int distinct, unsigned disabled) {
+  Scene scene = {dWorldCreate(), NULL, 0};
+  dWorldSetGravity(scene.world, 0, 0, -9.81);
+  dWorldSetQuickStepNumIterations(scene.world, 20);
+  scene.registry = ssRegistry_Create(scene.world);
+  for (int chain = 0; chain < kChains; ++chain) {
+    dBodyID previous = 0;
+    for (int link = 0; link < kLinks; ++link) {
+      int index = chain * kLinks + link;
+      dBodyID body = dBodyCreate(scene.world);
+      dMass mass;
+      dMassSetBoxTotal(&mass, distinct ? 1.0 + 0.5 * index / (kChains * kLinks - 1) : 1.0, 0.2, 0.05, 0.05);
+      dBodySetMass(body, &mass);
+      dBodySetPosition(body, 0.2 * link + 0.1, 1.0 * chain, 0);
+      dJointID hinge = dJointCreateHinge(scene.world, 0);
+      dJointAttach(hinge, body, previous);
+      dJointSetHingeAnchor(hinge, 0.2 * link, 1.0 * chain, 0);
+      dJointSetHingeAxis(hinge, 0, 1, 0);
+      dJointSetHingeParam(hinge, dParamLoStop, -0.3);
+      dJointSetHingeParam(hinge, dParamHiStop, 0.3);
+      dJointSetHingeParam(hinge, dParamFMax, 0);
+      check(ssRegistry_BindJoint(scene.registry, hinge, SS_PARAM_STOP, 1, kLimit, 0), "bind stop");
+      check(ssRegistry_BindJoint(scene.registry, hinge, SS_PARAM_MOTOR, 1, kFriction, 0), "bind motor");
+      previous = body;
+    }
+  }
+  ssRegistryDisableCaches(scene.registry, disabled);
+  return scene;
+}
+
+/* Seconds of Apply over a block; each frame is one step, as a stepper with max_step_s = 1/60 s takes it. */
+static double stepBlock(Scene* scene, ssMapping mapping, const double* frames_s, int count) {
+  double timed = 0;
+  for (int i = 0; i < count; ++i) {
+    double start = nowSeconds();
+    check(ssRegistry_Apply(scene->registry, mapping, frames_s[i], scene->previous_s, NULL), "apply");
+    timed += nowSeconds() - start;
+    dWorldQuickStep(scene->world, frames_s[i]);
+    scene->previous_s = frames_s[i];
+  }
+  return timed;
+}
+
+static int compareDoubles(const void* a, const void* b) {
+  double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
+static double median(double* values, int count) {
+  qsort(values, (size_t)count, sizeof(double), compareDoubles);
+  return values[count / 2];
+}
+
+static void report(ssMapping mapping, int varying, int distinct, int frames, int repeats) {
+  static double seconds[kConfigs][kMaxRepeats], ratios[kConfigs][kMaxRepeats], step_s[kMaxRepeats];
+  unsigned random = 12345;
+  for (int r = 0; r < repeats; ++r) {
+    Scene scenes[kConfigs];
+    for (int c = 0; c < kConfigs; ++c) scenes[c] = build(distinct, kDisabled[c]), seconds[c][r] = 0;
+    double frames_s[kBlock];
+    /* a first block untimed: the first Apply computes and writes every row and builds the caches once */
+    for (int i = 0; i < kBlock; ++i) frames_s[i] = kFrame_s;
+    for (int c = 0; c < kConfigs; ++c) stepBlock(&scenes[c], mapping, frames_s, kBlock);
+    for (int done = 0, block = 0; done < frames; done += kBlock, ++block) {
+      for (int i = 0; i < kBlock; ++i) {
+        random = random * 1664525u + 1013904223u;
+        frames_s[i] = varying ? 1.0 / (60.0 + 30.0 * (random >> 8) / 16777216.0) : kFrame_s;
+      }
+      for (int k = 0; k < kConfigs; ++k) {
+        int c = (k + block + r) % kConfigs;
+        seconds[c][r] += stepBlock(&scenes[c], mapping, frames_s, kBlock) / frames;
+      }
+    }
+    double start = nowSeconds();
+    for (int i = 0; i < kBlock; ++i) dWorldQuickStep(scenes[0].world, kFrame_s);
+    step_s[r] = (nowSeconds() - start) / kBlock;
+    for (int c = 0; c < kConfigs; ++c) {
+      ratios[c][r] = seconds[c][r] / seconds[0][r];
+      ssRegistry_Destroy(scenes[c].registry);
+      dWorldDestroy(scenes[c].world);
+    }
+  }
+  double apply_us = 1e6 * median(seconds[0], repeats);
+  printf("  %-14s %-8s %-8s %8.2f %6.2f%%", ssMappingName(mapping), varying ? "varying" : "1/60 s",
+         distinct ? "distinct" : "shared", apply_us, 100 * apply_us / (1e6 * median(step_s, repeats)));
+  for (int c = 1; c < kConfigs; ++c) printf(" %10.2f", median(ratios[c], repeats));
+  printf("\n");
+}
+
+int main(int argc, char** argv) {
+  int frames = argc > 1 ? atoi(argv[1]) : 120;
+  int repeats = argc > 2 ? atoi(argv[2]) : 5;
+  if (frames <= 0 || repeats <= 0 || repeats > kMaxRepeats || argc > 3) {
+    fprintf(stderr, "usage: bench_apply [frames > 0] [repeats 1..%d]\n", kMaxRepeats);
+    return 2;
+  }
+  dInitODE2(0);
+  frames = (frames + kBlock - 1) / kBlock * kBlock;
+  printf("bench_apply: %d bodies, %d rows, %d frames a repeat, medians of %d repeats; Apply with every cache on "
+         "(us a frame, and its share of a QuickStep), and each configuration's Apply time over that\n",
+         kChains * kLinks, 2 * kChains * kLinks, frames, repeats);
+  printf("  %-14s %-8s %-8s %8s %7s", "mapping", "frames", "masses", "Apply us", "of step");
+  for (int c = 1; c < kConfigs; ++c) printf(" %10s", kConfigNames[c]);
+  printf("\n");
+  for (int m = SS_MAPPING_IMPLICIT_EULER; m <= SS_MAPPING_EXACT; ++m)
+    for (int varying = 0; varying < 2; ++varying)
+      for (int distinct = 0; distinct < 2; ++distinct) report((ssMapping)m, varying, distinct, frames, repeats);
+  return 0;
+}

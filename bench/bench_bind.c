@@ -1,0 +1,146 @@
+/* What binding and adopting cost per row as a world grows: worlds of 1,000, 10,000 and 100,000 soft rows (hinge
+ * chains, a stop and a motor row on every hinge) are bound row by row with ssRegistry_BindJoint and adopted whole
+ * with ssRegistry_Adopt, each into a fresh registry, and one dWorldQuickStep of the same world is timed beside them.
+ * The sizes are measured in a rotating order within every repeat, so that all see the same machine; the median of
+ * the repeats is printed. Binding is linear when the time per row stays flat across the sizes.
+ *
+ *   bench_bind [repeats]      (default 5) */
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include <steadystep/steadystep.h>
+
+enum { kSizes = 3, kLinks = 50, kMaxRepeats = 64 };
+static const int kRows[kSizes] = {1000, 10000, 100000};
+static const double kTuned_s = 1.0 / 60.0;
+static const ssSpring kLimit = {5.0, 0.05}, kFriction = {0.0, 0.01};
+
+/* CPU time of this thread: time spent waiting for a core on a shared machine is not counted. */
+static double nowSeconds(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void check(ssStatus status, const char* what) {
+  if (status == SS_OK) return;
+  fprintf(stderr, "bench_bind: %s: %s\n", what, ssLastError());
+  exit(1);
+}
+
+typedef struct World {
+  dWorldID world;
+  dSpaceID space;
+  dJointID* hinges;
+  int hinge_count;
+} World;
+
+/* rows / 2 hinges in chains of kLinks boxes hanging from the static world, every box with a geom in one space. */
+static World build(int rows) {
+  World w = {dWorldCreate(), dSimpleSpaceCreate(0), malloc((size_t)(rows / 2) * sizeof(dJointID)), rows / 2};
+  dWorldSetGravity(w.world, 0, 0, -9.81);
+  dWorldSetQuickStepNumIterations(w.world, 20);
+  dBodyID previous = 0;
+  for (int i = 0; i < w.hinge_count; ++i) {
+    int link = i % kLinks, chain = i / kLinks;
+    if (link == 0) previous = 0;
+    dBodyID body = dBodyCreate(w.world);
+    dMass mass;
+    dMassSetBoxTotal(&mass, 1.0, 0.2, 0.05, 0.05);
+    dBodySetMass(body, &mass);
+    dBodySetPosition(body, 0.2 * link + 0.1, 1.0 * chain, 0);
+    dGeomSetBody(dCreateBox(w.space, 0.2, 0.05, 0.05), body);
+    dJointID hinge = dJointCreateHinge(w.world, 0);
+    dJointAttach(hinge, body, previous);
+    dJointSetHingeAnchor(hinge, 0.2 * link, 1.0 * chain, 0);
+    dJointSetHingeAxis(hinge, 0, 1, 0);
+    dJointSetHingeParam(hinge, dParamLoStop, -0.3);
+    dJointSetHingeParam(hinge, dParamHiStop, 0.3);
+    dJointSetHingeParam(hinge, dParamStopERP, 0.4);
+    dJointSetHingeParam(hinge, dParamStopCFM, 1e-3);
+    dJointSetHingeParam(hinge, dParamCFM, 1e-2);
+    w.hinges[i] = hinge;
+    previous = body;
+  }
+  return w;
+}
+
+static void destroy(World* w) {
+  dSpaceDestroy(w->space);
+  dWorldDestroy(w->world);
+  free(w->hinges);
+}
+
+/* Seconds to bind every row by hand, to adopt the whole world, and for one QuickStep of it. */
+static void measure(int rows, double* bind_s, double* adopt_s, double* step_s) {
+  World w = build(rows);
+  ssRegistry* registry = ssRegistry_Create(w.world);
+  double start = nowSeconds();
+  for (int i = 0; i < w.hinge_count; ++i) {
+    check(ssRegistry_BindJoint(registry, w.hinges[i], SS_PARAM_STOP, 1, kLimit, 0), "bind stop");
+    check(ssRegistry_BindJoint(registry, w.hinges[i], SS_PARAM_MOTOR, 1, kFriction, 0), "bind motor");
+  }
+  *bind_s = nowSeconds() - start;
+  ssRegistry_Destroy(registry);
+
+  registry = ssRegistry_Create(w.world);
+  ssAdoptReport adopted = {0};
+  start = nowSeconds();
+  check(ssRegistry_Adopt(registry, kTuned_s, w.space, &adopted), "adopt");
+  *adopt_s = nowSeconds() - start;
+  if (ssRegistry_JointBindingCount(registry) != rows) {
+    fprintf(stderr, "bench_bind: adopted %d rows, expected %d\n", ssRegistry_JointBindingCount(registry), rows);
+    exit(1);
+  }
+  ssRegistry_Destroy(registry);
+
+  start = nowSeconds();
+  dWorldQuickStep(w.world, kTuned_s);
+  *step_s = nowSeconds() - start;
+  destroy(&w);
+}
+
+static int compareDoubles(const void* a, const void* b) {
+  double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
+static double median(double* values, int count) {
+  qsort(values, (size_t)count, sizeof(double), compareDoubles);
+  return values[count / 2];
+}
+
+int main(int argc, char** argv) {
+  int repeats = argc > 1 ? atoi(argv[1]) : 5;
+  if (repeats <= 0 || repeats > kMaxRepeats || argc > 2) {
+    fprintf(stderr, "usage: bench_bind [repeats 1..%d]\n", kMaxRepeats);
+    return 2;
+  }
+  dInitODE2(0);
+  static double bind[kSizes][kMaxRepeats], adopt[kSizes][kMaxRepeats], step[kSizes][kMaxRepeats];
+  for (int r = 0; r < repeats; ++r)
+    for (int k = 0; k < kSizes; ++k) {
+      int s = (k + r) % kSizes; /* rotate the order of the sizes */
+      measure(kRows[s], &bind[s][r], &adopt[s][r], &step[s][r]);
+    }
+  printf("bench_bind: hinge chains, a stop and a motor row a hinge; medians of %d repeats\n", repeats);
+  printf("  %8s %14s %14s %14s %16s\n", "rows", "bind us/row", "adopt us/row", "QuickStep ms", "bind/QuickStep");
+  double bind_us[kSizes], adopt_us[kSizes];
+  for (int s = 0; s < kSizes; ++s) {
+    double bind_s = median(bind[s], repeats), adopt_s = median(adopt[s], repeats), step_s = median(step[s], repeats);
+    bind_us[s] = 1e6 * bind_s / kRows[s];
+    adopt_us[s] = 1e6 * adopt_s / kRows[s];
+    printf("  %8d %14.3f %14.3f %14.3f %16.3f\n", kRows[s], bind_us[s], adopt_us[s], 1e3 * step_s, bind_s / step_s);
+  }
+  double bind_lo = bind_us[0], bind_hi = bind_us[0], adopt_lo = adopt_us[0], adopt_hi = adopt_us[0];
+  for (int s = 1; s < kSizes; ++s) {
+    bind_lo = bind_us[s] < bind_lo ? bind_us[s] : bind_lo;
+    bind_hi = bind_us[s] > bind_hi ? bind_us[s] : bind_hi;
+    adopt_lo = adopt_us[s] < adopt_lo ? adopt_us[s] : adopt_lo;
+    adopt_hi = adopt_us[s] > adopt_hi ? adopt_us[s] : adopt_hi;
+  }
+  printf("  largest over smallest time per row: bind %.2f, adopt %.2f (target: within 2)\n", bind_hi / bind_lo,
+         adopt_hi / adopt_lo);
+  return 0;
+}

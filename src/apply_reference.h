@@ -1,0 +1,24 @@
+/* Internal, built for tests only: Apply as its documentation states it, with no cache. Every row's mass is measured
+ * from its bodies (or given), every softness computed and checked, every load correction bounded; then each value
+ * that differs from what ODE holds is written. The differential test and fuzz target (tests/c/apply_differential.c)
+ * drive it beside ssRegistry_Apply on twin worlds and require the same values in ODE. */
+#ifndef STEADYSTEP_APPLY_REFERENCE_H
+#define STEADYSTEP_APPLY_REFERENCE_H
+
+#include "steadystep/registry.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ssRegistry_Apply's contract, computed plainly; row_writes counts the parameter sets written: those whose value ODE
+ * did not hold already, and those bound since the last Apply. Errors: those of ssRegistry_Apply, with nothing
+ * written. */
+ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
+                                  ssApplyReport* report);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

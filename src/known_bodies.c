@@ -1,0 +1,287 @@
+/* The bodies a stepper knows: listed once from the registry, the watch list and the joints between them, and checked
+ * at the boundary with ODE in one pass over their packed handles. */
+#include "known_bodies.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "steadystep/limits.h"
+
+void ssKnownFree(ssKnownBodies* known) {
+  free(known->bodies);
+  free(known->ids);
+  free(known->first_joints);
+  free(known->pushed);
+  memset(known, 0, sizeof *known);
+}
+
+/* ---- the walk through joints: a growing list with an open-addressing set of the bodies in it ---- */
+
+typedef struct BodyWalk {
+  dBodyID* list;
+  int count, capacity;
+  dBodyID* slots; /* 0: empty */
+  size_t mask;
+  int failed; /* out of memory */
+} BodyWalk;
+
+static size_t slotOf(const BodyWalk* walk, dBodyID body) {
+  return (size_t)((((uintptr_t)body >> 4) * UINT64_C(0x9E3779B97F4A7C15)) >> 17) & walk->mask;
+}
+
+static int insertSlot(BodyWalk* walk, dBodyID body) {
+  size_t i = slotOf(walk, body);
+  while (walk->slots[i] != 0) {
+    if (walk->slots[i] == body) return 0;
+    i = (i + 1) & walk->mask;
+  }
+  walk->slots[i] = body;
+  return 1;
+}
+
+/* Adds body to the walk unless it is there already. */
+static void visitBody(void* context, dBodyID body) {
+  BodyWalk* walk = context;
+  if (walk->failed || body == 0) return;
+  if (2 * (size_t)(walk->count + 1) > walk->mask + 1) { /* keep the set at most half full */
+    size_t size = 2 * (walk->mask + 1);
+    dBodyID* slots = calloc(size, sizeof *slots);
+    if (slots == NULL) {
+      walk->failed = 1;
+      return;
+    }
+    dBodyID* old = walk->slots;
+    walk->slots = slots;
+    walk->mask = size - 1;
+    for (int i = 0; i < walk->count; ++i) insertSlot(walk, walk->list[i]);
+    free(old);
+  }
+  if (walk->count == walk->capacity) {
+    int capacity = walk->capacity > 0 ? 2 * walk->capacity : 64;
+    dBodyID* list = realloc(walk->list, (size_t)capacity * sizeof *list);
+    if (list == NULL) {
+      walk->failed = 1;
+      return;
+    }
+    walk->list = list;
+    walk->capacity = capacity;
+  }
+  if (insertSlot(walk, body)) walk->list[walk->count++] = body;
+}
+
+static int compareIds(const void* a, const void* b) {
+  uintptr_t x = (uintptr_t) * (const dBodyID*)a, y = (uintptr_t) * (const dBodyID*)b;
+  return (x > y) - (x < y);
+}
+
+static const ssKnownBody* findOld(const ssKnownBodies* known, dBodyID body) {
+  if (!known->valid) return NULL;
+  const dBodyID* found = bsearch(&body, known->ids, (size_t)known->count, sizeof body, compareIds);
+  return found != NULL ? &known->bodies[found - known->ids] : NULL;
+}
+
+static void listPushed(ssKnownBodies* known) {
+  known->pushed_count = 0;
+  for (int i = 0; i < known->count; ++i)
+    if (known->bodies[i].pushed) known->pushed[known->pushed_count++] = i;
+}
+
+ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const dBodyID* watched, int watched_count) {
+  BodyWalk walk = {.slots = calloc(64, sizeof(dBodyID)), .mask = 63};
+  if (walk.slots == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
+  ssRegistry_VisitBodies(registry, visitBody, &walk);
+  for (int i = 0; i < watched_count; ++i) visitBody(&walk, watched[i]);
+  /* what they reach through joints (contacts are transient, and reach only what collision reaches anyway) */
+  for (int i = 0; i < walk.count && !walk.failed; ++i) {
+    dBodyID body = walk.list[i];
+    for (int j = 0, joints = dBodyGetNumJoints(body); j < joints; ++j) {
+      dJointID joint = dBodyGetJoint(body, j);
+      if (dJointGetType(joint) == dJointTypeContact) continue;
+      visitBody(&walk, dJointGetBody(joint, 0));
+      visitBody(&walk, dJointGetBody(joint, 1));
+    }
+  }
+  size_t count = (size_t)walk.count, room = count > 0 ? count : 1;
+  ssKnownBody* bodies = walk.failed ? NULL : calloc(room, sizeof *bodies);
+  dBodyID* ids = walk.failed ? NULL : malloc(room * sizeof *ids);
+  dJointID* first_joints = walk.failed ? NULL : malloc(room * sizeof *first_joints);
+  int* pushed = walk.failed ? NULL : malloc(room * sizeof *pushed);
+  free(walk.slots);
+  if (bodies == NULL || ids == NULL || first_joints == NULL || pushed == NULL) {
+    free(walk.list);
+    free(bodies);
+    free(ids);
+    free(first_joints);
+    free(pushed);
+    return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
+  }
+  if (count > 0) qsort(walk.list, count, sizeof(dBodyID), compareIds);
+  for (size_t i = 0; i < count; ++i) {
+    const ssKnownBody* old = findOld(known, walk.list[i]);
+    bodies[i] = old != NULL ? *old : (ssKnownBody){.body = walk.list[i]};
+    ids[i] = walk.list[i];
+    first_joints[i] = dBodyGetJoint(walk.list[i], 0);
+  }
+  free(walk.list);
+  unsigned registry_generation = known->registry_generation, watched_generation = known->watched_generation;
+  int carrying = known->carrying;
+  ssKnownFree(known);
+  *known = (ssKnownBodies){bodies, ids, first_joints, (int)count, pushed, 0, carrying, 1, registry_generation,
+                           watched_generation};
+  listPushed(known);
+  return SS_OK;
+}
+
+int ssKnownContains(const ssKnownBodies* known, dBodyID body) { return findOld(known, body) != NULL; }
+
+void ssKnownForget(ssKnownBodies* known, dBodyID body) {
+  const ssKnownBody* found = findOld(known, body);
+  if (found == NULL) return;
+  size_t k = (size_t)(found - known->bodies), after = (size_t)known->count - k - 1;
+  memmove(&known->bodies[k], &known->bodies[k + 1], after * sizeof *known->bodies);
+  memmove(&known->ids[k], &known->ids[k + 1], after * sizeof *known->ids);
+  memmove(&known->first_joints[k], &known->first_joints[k + 1], after * sizeof *known->first_joints);
+  known->count -= 1;
+  listPushed(known);
+}
+
+/* Whether a body's first joint is not the one listed; a contact there hides nothing (ODE attaches the step's
+ * contacts after the program's joints, and the stepper empties them after each step). */
+static int firstJointChanged(dJointID first, dJointID listed) {
+  return first != listed && (first == 0 || dJointGetType(first) != dJointTypeContact);
+}
+
+int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body) {
+  for (int i = 0; i < known->count; ++i)
+    if (firstJointChanged(dBodyGetJoint(known->ids[i], 0), known->first_joints[i])) {
+      if (body != NULL) *body = known->ids[i];
+      return 1;
+    }
+  return 0;
+}
+
+void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces) {
+  for (int i = 0; i < known->count; ++i) {
+    const ssKnownBody* body = &known->bodies[i];
+    const double* f = body->frame_force;
+    int pushed = with_frame_forces && body->pushed;
+    dBodySetForce(body->body, pushed ? f[0] : 0, pushed ? f[1] : 0, pushed ? f[2] : 0);
+    dBodySetTorque(body->body, pushed ? f[3] : 0, pushed ? f[4] : 0, pushed ? f[5] : 0);
+  }
+}
+
+/* ---- the check ---- */
+
+static int within(const dReal* v, double bound) {
+  return fabs(v[0]) <= bound && fabs(v[1]) <= bound && fabs(v[2]) <= bound;
+}
+
+/* in double whatever dReal is: a float speed's square overflows from 2e19 m/s, which is still a finite runaway */
+static double squared(const dReal* v) {
+  double x = v[0], y = v[1], z = v[2];
+  return x * x + y * y + z * z;
+}
+
+/* |v| without overflow, for messages: a spin of 1e200 rad/s is named as such, not as inf */
+static double norm(const dReal* v) {
+  double largest = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
+  if (!(largest > 0) || isinf(largest)) return largest;
+  double x = v[0] / largest, y = v[1] / largest, z = v[2] / largest;
+  return largest * sqrt(x * x + y * y + z * z);
+}
+
+/* The failure of a body that did not pass, named: the quantity, its value, the bound. */
+static ssStatus describe(dBodyID body, const ssBodyBounds* bounds, const char* when) {
+  struct {
+    const char* name;
+    const char* unit;
+    const dReal* value;
+  } quantities[] = {{"position", "m", dBodyGetPosition(body)},
+                    {"linear velocity", "m/s", dBodyGetLinearVel(body)},
+                    {"angular velocity", "rad/s", dBodyGetAngularVel(body)},
+                    {"force", "N", dBodyGetForce(body)},
+                    {"torque", "N*m", dBodyGetTorque(body)}};
+  int checked = bounds->forces ? 5 : 3;
+  for (int q = 0; q < checked; ++q) {
+    const dReal* v = quantities[q].value;
+    if (isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2])) continue;
+    return ssFail(q < 3 ? SS_ERROR_BLOWUP : SS_ERROR_NOT_FINITE, "body %p: %s (%g, %g, %g) %s %s: not finite",
+                  (void*)body, quantities[q].name, v[0], v[1], v[2], quantities[q].unit, when);
+  }
+  const dReal* p = quantities[0].value;
+  if (!within(p, SS_MAX_POSITION_M))
+    return ssFail(SS_ERROR_POSITION_LIMIT, "body %p: position (%g, %g, %g) m %s: beyond SS_MAX_POSITION_M = %g m, "
+                  "where ODE's collision spaces overflow", (void*)body, p[0], p[1], p[2], when, SS_MAX_POSITION_M);
+  double speed = norm(quantities[1].value), spin = norm(quantities[2].value);
+  if (!(speed <= bounds->max_speed))
+    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: speed %g m/s %s: above max_speed = %g m/s", (void*)body, speed,
+                  when, bounds->max_speed);
+  if (!(spin <= bounds->max_angular_speed))
+    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: angular speed %g rad/s %s: above max_angular_speed = %g rad/s",
+                  (void*)body, spin, when, bounds->max_angular_speed);
+  for (int q = 3; q < checked; ++q) {
+    const dReal* v = quantities[q].value;
+    if (!within(v, SS_MAX_FORCE_N))
+      return ssFail(SS_ERROR_OUT_OF_RANGE, "body %p: %s (%g, %g, %g) %s %s: beyond SS_MAX_FORCE_N = %g",
+                    (void*)body, quantities[q].name, v[0], v[1], v[2], quantities[q].unit, when, SS_MAX_FORCE_N);
+  }
+  return ssFail(SS_ERROR_BLOWUP, "body %p: failed a check %s", (void*)body, when); /* not reached */
+}
+
+ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
+                      dBodyID* failed) {
+  const double max_speed2 = bounds->max_speed * bounds->max_speed;
+  const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
+  for (int k = 0; k < known->count; ++k) {
+    dBodyID body = known->ids[k];
+    /* every comparison is false for a NaN, and an infinity is beyond every bound: one test a number */
+    int ok = within(dBodyGetPosition(body), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(body)) <= max_speed2 &&
+             squared(dBodyGetAngularVel(body)) <= max_spin2;
+    if (ok && bounds->forces)
+      ok = within(dBodyGetForce(body), SS_MAX_FORCE_N) && within(dBodyGetTorque(body), SS_MAX_FORCE_N);
+    if (!ok) {
+      *failed = body;
+      char named[64];
+      snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
+      return describe(body, bounds, named);
+    }
+  }
+  return SS_OK;
+}
+
+static int anyNonZero(const double* values) {
+  return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
+}
+
+ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBodyID* failed, int* joints_changed) {
+  const double max_speed2 = bounds->max_speed * bounds->max_speed;
+  const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
+  *joints_changed = 0;
+  known->pushed_count = 0;
+  for (int k = 0; k < known->count; ++k) {
+    dBodyID id = known->ids[k];
+    if (firstJointChanged(dBodyGetJoint(id, 0), known->first_joints[k])) {
+      *joints_changed = 1;
+      return SS_OK;
+    }
+    const dReal* force = dBodyGetForce(id);
+    const dReal* torque = dBodyGetTorque(id);
+    int ok = within(dBodyGetPosition(id), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(id)) <= max_speed2 &&
+             squared(dBodyGetAngularVel(id)) <= max_spin2 && within(force, SS_MAX_FORCE_N) &&
+             within(torque, SS_MAX_FORCE_N);
+    if (!ok) {
+      *failed = id;
+      return describe(id, bounds, "before the frame");
+    }
+    ssKnownBody* body = &known->bodies[k];
+    double* f = body->frame_force;
+    f[0] = force[0], f[1] = force[1], f[2] = force[2], f[3] = torque[0], f[4] = torque[1], f[5] = torque[2];
+    body->pushed = anyNonZero(f) || (known->carrying && anyNonZero(body->carried));
+    if (body->pushed) known->pushed[known->pushed_count++] = k;
+  }
+  return SS_OK;
+}

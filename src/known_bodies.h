@@ -1,0 +1,74 @@
+/* Internal: the bodies a stepper knows, and the checks at its boundary with ODE.
+ *
+ * Known: the registry's bodies (bound, adopted), the watched ones, and every body reachable from those through
+ * joints other than contacts (a bob hung by a hinge from a known body is known whether or not it was bound), each
+ * once, sorted by address. Their forces are kept over a frame and their state and forces are checked before every
+ * physics step. ODE attaches a new joint at the head of a body's list, so a body's first joint, kept here, changes
+ * when a joint is attached to it: that is how joints made since the list was built are found, for one read a body. */
+#ifndef STEADYSTEP_KNOWN_BODIES_H
+#define STEADYSTEP_KNOWN_BODIES_H
+
+#include <ode/ode.h>
+
+#include "steadystep/registry.h"
+#include "steadystep/status.h"
+
+typedef struct ssKnownBody {
+  dBodyID body;
+  int pushed;            /* has a frame force or carried momentum this frame */
+  double frame_force[6]; /* force (N) and torque (N·m) the program added for this frame */
+  double carried[6];     /* momentum (N·s, N·m·s) of frames that took no step, delivered with the next steps */
+} ssKnownBody;
+
+typedef struct ssKnownBodies {
+  ssKnownBody* bodies;
+  dBodyID* ids;           /* bodies[i].body, packed: the checks read nothing else */
+  dJointID* first_joints; /* each body's first joint when listed */
+  int count;
+  int* pushed; /* indices into bodies of those with pushed set */
+  int pushed_count;
+  int carrying; /* whether any body may carry momentum */
+  int valid;
+  unsigned registry_generation, watched_generation; /* of the sets the list was built from */
+} ssKnownBodies;
+
+void ssKnownFree(ssKnownBodies* known);
+
+/* Builds the list again from the registry's bodies (registry may be NULL) and the watched ones, with what they reach
+ * through joints; a body that stays known keeps its frame force and carried momentum. Errors, with the list as it
+ * was: SS_ERROR_OUT_OF_MEMORY. */
+ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const dBodyID* watched, int watched_count);
+
+/* Whether body is on the list. */
+int ssKnownContains(const ssKnownBodies* known, dBodyID body);
+
+/* Takes body off the list at once (it is about to be destroyed). */
+void ssKnownForget(ssKnownBodies* known, dBodyID body);
+
+/* Whether a body's first joint differs from the one listed (a joint was attached or detached since), giving the
+ * first such body. */
+int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body);
+
+/* Sets every listed body's force and torque accumulators to its frame force (with_frame_forces) or to zero. */
+void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces);
+
+/* What a check reads of a body, and its bounds. */
+typedef struct ssBodyBounds {
+  double max_speed, max_angular_speed; /* m/s, rad/s */
+  int forces;                          /* the force and torque accumulators, within SS_MAX_FORCE_N */
+} ssBodyBounds;
+
+/* Checks every listed body, one pass over the packed handles: its position within SS_MAX_POSITION_M, velocities finite
+ * and within the bounds, and with bounds->forces its accumulators. On the first failure records the message (the body,
+ * the quantity, its value, "`when` step `step` of `steps`", formatted then only), sets *failed to the body and returns
+ * SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a force or
+ * torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). */
+ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
+                      dBodyID* failed);
+
+/* Before a frame, one pass: *joints_changed says whether a body's first joint changed (then nothing else was done:
+ * the caller rebuilds the list and calls again); else every body is checked as ssKnownCheck with state and forces,
+ * and, all passing, its accumulators become its frame force (pushed marks a force or carried momentum). */
+ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBodyID* failed, int* joints_changed);
+
+#endif

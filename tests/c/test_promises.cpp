@@ -1,0 +1,430 @@
+// The stepper's promises in ordinary programs (issue 14): nothing a program does the ordinary way aborts ODE, loses
+// a force or changes its physics silently. Each case is a real ODE world doing what real programs do.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "ode_fixture.h"
+#include "test_stepping.h"
+#include "steadystep/steadystep.h"
+
+namespace {
+
+bool Names(const char* text) { return std::string(ssLastError()).find(text) != std::string::npos; }
+
+// A program's world: boxes of 1 kg with geoms in a hash space (ODE's usual broad phase), no gravity unless asked,
+// stepped through a stepper made from the space (adopted as tuned at 1/60 s) in substeps of at most 1/60 s.
+class PromiseTest : public OdeTest {
+ public:  // the callbacks below reach the program's world through it
+  void SetUp() override {
+    OdeTest::SetUp();
+    dWorldSetGravity(world, 0, 0, 0);
+    space = dHashSpaceCreate(0);
+    contacts = dJointGroupCreate(0);
+  }
+  void TearDown() override {
+    ssStepper_Destroy(stepper);
+    dJointGroupDestroy(contacts);
+    dSpaceDestroy(space);
+    OdeTest::TearDown();
+  }
+
+  dBodyID Box(double x, double y, double z) {
+    dBodyID body = MakeBody(1.0, x, y, z);
+    dGeomSetBody(dCreateBox(space, 0.1, 0.1, 0.1), body);
+    return body;
+  }
+
+  // The program's collision: every contact softened for the step, as a program adopted with the stepper does.
+  static void Near(void* data, dGeomID a, dGeomID b) {
+    auto* test = static_cast<PromiseTest*>(data);
+    dContact contact[4];
+    std::memset(contact, 0, sizeof contact);
+    int n = dCollide(a, b, 4, &contact[0].geom, sizeof contact[0]);
+    for (int i = 0; i < n; ++i) {
+      contact[i].surface.mu = 1;
+      dBodyID b1 = dGeomGetBody(a), b2 = dGeomGetBody(b);
+      if (ssStepper_SoftenContact(test->stepper, &contact[i], b1, b2) != SS_OK) continue;
+      dJointAttach(dJointCreateContact(test->world, test->contacts, &contact[i]), b1, b2);
+    }
+  }
+  static void Collide(void* context, ssStepper*) {
+    auto* test = static_cast<PromiseTest*>(context);
+    dSpaceCollide(test->space, test, Near);
+  }
+
+  ssStepperDef Def() {
+    ssStepperDef def = ssDefaultStepperDef();
+    def.world = world;
+    def.space = space;
+    def.tuned_step_s = 1.0 / 60;
+    def.stepping.solver = SS_SOLVER_QUICK;
+    def.collide = Collide;
+    def.collide_context = this;
+    def.contact_group = contacts;
+    return def;
+  }
+  ssStatus Make(ssStepperDef def) { return ssStepper_Create(&def, &stepper); }
+
+  dSpaceID space = nullptr;
+  dJointGroupID contacts = nullptr;
+  ssStepper* stepper = nullptr;
+};
+
+// ---- a. one check at the boundary, before every physics step ----
+
+TEST_F(PromiseTest, ANanTorqueAddedByAControllerInBeforeStepIsRefusedByNameNotAnAbort) {
+  dBodyID arm = Box(0, 0, 1);
+  ssStepperDef def = Def();
+  struct Pd {
+    dBodyID arm;
+    int calls = 0;
+  } pd{arm};
+  def.before_step = [](void* context, ssStepper*) {
+    auto* pd = static_cast<Pd*>(context);
+    double error = 0, rate = 0;  // a controller whose gain divides by a span that is zero this step
+    if (++pd->calls == 2) dBodyAddTorque(pd->arm, (0.0 - error) / rate, 0, 0);
+  };
+  def.before_step_context = &pd;
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  const dReal* p = dBodyGetPosition(arm);
+  const double before[3] = {p[0], p[1], p[2]};
+  ssFrameReport report;
+  EXPECT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_ERROR_NOT_FINITE);
+  EXPECT_TRUE(Names("torque (") && Names("nan, 0, 0) N*m")) << ssLastError();
+  EXPECT_TRUE(Names("not finite")) << ssLastError();
+  EXPECT_TRUE(Names("before step 2 of 3")) << ssLastError();
+  EXPECT_EQ(report.failed_body, arm);
+  EXPECT_EQ(report.steps, 1);
+  EXPECT_EQ(dBodyGetTorque(arm)[0], 0);  // as the first step left it: nothing of the refused step remains
+  EXPECT_EQ(std::memcmp(p, before, sizeof before), 0);
+  EXPECT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_ERROR_FAILED);  // latched until the program repairs
+  ssStepper_Reset(stepper);
+  EXPECT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_OK) << ssLastError();
+}
+
+TEST_F(PromiseTest, AStateSetBetweenFramesIsRefusedByNameBeforeODEOrTheSpaceSeesIt) {
+  dBodyID body = Box(0, 0, 1);
+  ssStepperDef def = Def();
+  def.stepping.max_speed = 0;  // the guard at its widest: SS_MAX_SAFE_SPEED
+  def.stepping.max_angular_speed = 0;
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  struct Case {
+    void (*set)(dBodyID);
+    ssStatus status;
+    const char* named;
+  } cases[] = {
+      {[](dBodyID b) { dBodySetAngularVel(b, 1e154, 0, 0); }, SS_ERROR_SPEED_LIMIT, "angular speed 1e+154 rad/s"},
+      {[](dBodyID b) { dBodySetAngularVel(b, 0, INFINITY, 0); }, SS_ERROR_BLOWUP, "angular velocity (0, inf, 0)"},
+      {[](dBodyID b) { dBodySetLinearVel(b, NAN, 0, 0); }, SS_ERROR_BLOWUP, "linear velocity (nan, 0, 0)"},
+      {[](dBodyID b) { dBodySetPosition(b, 1e9, 0, 1); }, SS_ERROR_POSITION_LIMIT, "position (1e+09, 0, 1) m"},
+      {[](dBodyID b) { dBodyAddForce(b, 0, 0, 1e31); }, SS_ERROR_OUT_OF_RANGE, "force (0, 0, 1e+31) N"},
+  };
+  for (const Case& c : cases) {
+    dBodySetPosition(body, 0, 0, 1);
+    dBodySetLinearVel(body, 0, 0, 0);
+    dBodySetAngularVel(body, 0, 0, 0);
+    dBodySetForce(body, 0, 0, 0);
+    c.set(body);
+    ssFrameReport report;
+    EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 60, &report), c.status) << c.named;
+    EXPECT_TRUE(Names(c.named)) << ssLastError();
+    EXPECT_TRUE(Names("before the frame")) << ssLastError();
+    EXPECT_EQ(report.failed_body, body);
+    EXPECT_EQ(report.steps, 0);
+    ssStepper_Reset(stepper);
+  }
+}
+
+TEST_F(PromiseTest, TheRunawayLeftByAResetWithoutRepairIsRefusedAgainNotStepped) {
+  dBodyID body = Box(0, 0, 1);
+  ssStepperDef def = Def();
+  def.stepping.max_speed = 100;
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  dBodySetLinearVel(body, 90, 0, 0);
+  dBodyAddForce(body, 6000, 0, 0);  // 100 m/s more over the frame
+  ssFrameReport report;
+  EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 60, &report), SS_ERROR_SPEED_LIMIT);
+  EXPECT_TRUE(Names("after step 1 of 1")) << ssLastError();
+  ssStepper_Reset(stepper);  // without the repair
+  const double x = dBodyGetPosition(body)[0];
+  EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 60, &report), SS_ERROR_SPEED_LIMIT);
+  EXPECT_TRUE(Names("before the frame")) << ssLastError();
+  EXPECT_EQ(report.steps, 0);
+  EXPECT_EQ(dBodyGetPosition(body)[0], x);
+}
+
+TEST_F(PromiseTest, ABodyFallingFarInAHashSpaceIsStoppedAtThePositionBoundBeforeTheSpaceAborts) {
+  dBodyID body = Box(0, 0, -0.99 * SS_MAX_POSITION_M);
+  ssStepperDef def = Def();
+  def.stepping.max_speed = 0;  // the widest guard: the speed alone would let it go on to ODE's abort
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  dBodySetLinearVel(body, 0, 0, -1e5);
+  ssStatus status = SS_OK;
+  int frames = 0;
+  for (; frames < 100 && status == SS_OK; ++frames) status = ssStepper_Step(stepper, 1.0 / 60, nullptr);
+  EXPECT_EQ(status, SS_ERROR_POSITION_LIMIT);
+  EXPECT_TRUE(Names("SS_MAX_POSITION_M")) << ssLastError();
+  EXPECT_LT(std::fabs(dBodyGetPosition(body)[2]), SS_MAX_POSITION_M + 1e5 / 60 + 1);
+}
+
+// ---- b. callbacks that destroy and re-enter ----
+
+struct Destroyer {
+  ssStepper** stepper;
+  dBodyID body;
+  int at_step;  // destroy before (or after) this step index
+  PromiseTest* test;
+  int done = 0;
+};
+
+void DestroyBodyOnce(void* context, ssStepper* stepper) {
+  auto* d = static_cast<Destroyer*>(context);
+  if (d->done || ssStepper_CurrentStep(stepper).index != d->at_step) return;
+  d->done = 1;
+  dGeomDestroy(dBodyGetFirstGeom(d->body));
+  EXPECT_EQ(ssStepper_DestroyBody(stepper, d->body), SS_OK);
+}
+
+TEST_F(PromiseTest, DestroyingAKnownBodyFromEachCallbackIsSafe) {
+  for (int where = 0; where < 3; ++where) {  // before_step, collide, step_done
+    SCOPED_TRACE(where);
+    ssStepper_Destroy(stepper);
+    stepper = nullptr;
+    dBodyID doomed = Box(0, 0, 0.05), other = Box(0.05, 0, 0.05);  // touching: contacts with the doomed one
+    dJointID hinge = dJointCreateHinge(world, 0);
+    dJointAttach(hinge, doomed, other);
+    ssStepperDef def = Def();
+    Destroyer d{&stepper, doomed, 1, this};
+    if (where == 0) {
+      def.before_step = DestroyBodyOnce;
+      def.before_step_context = &d;
+    } else if (where == 1) {
+      def.collide = [](void* context, ssStepper* s) {  // after the contacts with it were made
+        PromiseTest::Collide(static_cast<Destroyer*>(context)->test, s);
+        DestroyBodyOnce(context, s);
+      };
+      def.collide_context = &d;
+    } else {
+      def.step_done = [](void* context, double) {
+        auto* d = static_cast<Destroyer*>(context);
+        if (!d->done) DestroyBodyOnce(context, *d->stepper);
+      };
+      def.step_done_context = &d;
+      d.at_step = 0;
+    }
+    ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+    const int known = ssStepper_KnownBodyCount(stepper);
+    ssFrameReport report;
+    ASSERT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_OK) << ssLastError();
+    EXPECT_EQ(d.done, 1);
+    EXPECT_EQ(report.steps, 3);
+    EXPECT_EQ(ssStepper_KnownBodyCount(stepper), known - 1);
+    for (int frame = 0; frame < 5; ++frame) ASSERT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK) << ssLastError();
+    EXPECT_TRUE(std::isfinite(dBodyGetPosition(other)[0]));
+    ASSERT_EQ(ssStepper_DestroyBody(stepper, other), SS_OK);
+  }
+}
+
+TEST_F(PromiseTest, SteppingAgainFromItsOwnCallbackIsRefusedByName) {
+  Box(0, 0, 1);
+  struct Reentry {
+    ssStatus step = SS_OK, set = SS_OK;
+    std::string step_message, set_message, reset_message;
+    ssFrameReport inner;
+  } r;
+  ssStepperDef def = Def();
+  def.before_step = [](void* context, ssStepper* stepper) {
+    auto* r = static_cast<Reentry*>(context);
+    r->inner.steps = 99;
+    r->step = ssStepper_Step(stepper, 0.05, &r->inner);
+    r->step_message = ssLastError();
+    ssStepping stepping = ssStepper_Stepping(stepper);
+    r->set = ssStepper_SetStepping(stepper, &stepping);
+    r->set_message = ssLastError();
+    ssStepper_Reset(stepper);
+    r->reset_message = ssLastError();
+  };
+  def.before_step_context = &r;
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  ssFrameReport report;
+  ASSERT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_OK) << ssLastError();
+  EXPECT_EQ(report.steps, 3);  // only the frame's own steps
+  EXPECT_EQ(r.step, SS_ERROR_REENTERED);
+  EXPECT_NE(r.step_message.find("ssStepper_Step: called from a callback"), std::string::npos) << r.step_message;
+  EXPECT_EQ(r.inner.steps, 99);  // the refused call's report is left alone
+  EXPECT_EQ(r.set, SS_ERROR_REENTERED);
+  EXPECT_NE(r.set_message.find("ssStepper_SetStepping"), std::string::npos) << r.set_message;
+  EXPECT_NE(r.reset_message.find("ssStepper_Reset: called from a callback"), std::string::npos) << r.reset_message;
+  EXPECT_STREQ(ssStatusName(SS_ERROR_REENTERED), "reentered");
+}
+
+TEST_F(PromiseTest, DestroyingTheStepperFromItsOwnCallbackEndsTheFrameThenFreesIt) {
+  Box(0, 0, 1);
+  for (int from_step_done = 0; from_step_done < 2; ++from_step_done) {
+    ssStepperDef def = Def();
+    ssStepper* own = nullptr;
+    if (from_step_done) {
+      def.step_done = [](void* context, double) { ssStepper_Destroy(*static_cast<ssStepper**>(context)); };
+      def.step_done_context = &own;
+    } else {
+      def.before_step = [](void*, ssStepper* s) {
+        if (ssStepper_CurrentStep(s).index == 1) ssStepper_Destroy(s);
+      };
+    }
+    ASSERT_EQ(ssStepper_Create(&def, &own), SS_OK) << ssLastError();
+    ssFrameReport report;
+    EXPECT_EQ(ssStepper_Step(own, 0.05, &report), SS_OK) << ssLastError();
+    EXPECT_EQ(report.steps, 1);  // from step_done after the first step; from before_step the second is not taken
+    // `own` is freed now (a sanitizer build would report a leak or a use after free otherwise)
+  }
+}
+
+// ---- c. a frame of exactly 0 s ----
+
+TEST_F(PromiseTest, AFrameOfZeroSecondsReadsAndClearsTheFramesForces) {
+  dBodyID body = Box(0, 0, 1);
+  ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
+  for (double frame_s : {1.0 / 60, 0.0, 1.0 / 60}) {
+    dBodyAddForce(body, 1, 0, 0);  // 1 N on 1 kg, added every frame
+    ASSERT_EQ(ssStepper_Step(stepper, frame_s, nullptr), SS_OK) << ssLastError();
+  }
+  EXPECT_NEAR(dBodyGetLinearVel(body)[0], 2.0 / 60, 1e-9);  // F·(1/60 + 0 + 1/60) / m
+}
+
+// ---- d. the bodies the stepper knows ----
+
+TEST_F(PromiseTest, ABodySpawnedAfterAdoptionGetsItsWholeFrameForce) {
+  Box(5, 0, 0);
+  ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
+  const int adopted = ssStepper_Adopted(stepper).bodies;
+  ASSERT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK);
+  dBodyID spawned = Box(0, 0, 0);  // a box spawned on a key press
+  for (int frame = 0; frame < 20; ++frame) {  // 1 s of 1/20 s frames, each 3 substeps of 1/60 s
+    dBodyAddForce(spawned, 1, 0, 0);
+    ssFrameReport report;
+    ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 20, &report), SS_OK) << ssLastError();
+    ASSERT_EQ(report.steps, 3);
+  }
+  EXPECT_NEAR(dBodyGetLinearVel(spawned)[0], 1.0, 1e-9);  // F·t / m
+  EXPECT_EQ(ssStepper_Adopted(stepper).bodies, adopted + 1);
+}
+
+TEST_F(PromiseTest, ABodySpawnedInACallbackIsFoundBeforeTheNextStep) {
+  Box(5, 0, 0);
+  struct Spawner {
+    PromiseTest* test;
+    dBodyID body = nullptr;
+    int known_after = 0;
+  } spawner{this};
+  ssStepperDef def = Def();
+  def.before_step = [](void* context, ssStepper*) {
+    auto* s = static_cast<Spawner*>(context);
+    if (s->body == nullptr) s->body = s->test->Box(0, 0, 0);
+  };
+  def.before_step_context = &spawner;
+  def.step_done = [](void* context, double) {
+    auto* s = static_cast<Spawner*>(context);
+    if (s->known_after == 0) s->known_after = -1;
+  };
+  def.step_done_context = &spawner;
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  EXPECT_EQ(ssStepper_KnownBodyCount(stepper), 1);
+  ASSERT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK) << ssLastError();
+  EXPECT_EQ(ssStepper_KnownBodyCount(stepper), 2);
+  EXPECT_EQ(ssStepper_Adopted(stepper).bodies, 2);
+  // known: its state is checked before every step
+  dBodySetLinearVel(spawner.body, NAN, 0, 0);
+  ssFrameReport report;
+  EXPECT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_ERROR_BLOWUP);
+  EXPECT_EQ(report.failed_body, spawner.body);
+}
+
+TEST_F(PromiseTest, ABobHungFromAKnownBodyIsKnownThroughItsJointAndOneHungFromTheWorldIsWatched) {
+  dBodyID box = Box(0, 0, 0);
+  ssStepperDef def = Def();
+  def.stepping.max_step_s = 1.0 / 60;
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  ASSERT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK);
+  // Made after the stepper, without a geom: a slider from the known box (found through the box's joints), and a
+  // slider from the static world (nothing the stepper sees reaches it: the program watches it).
+  dBodyID bob = MakeBody(1.0, 0, 0, -1), hung = MakeBody(1.0, 3, 0, -1);
+  dJointID slider = dJointCreateSlider(world, 0);
+  dJointAttach(slider, bob, box);
+  dJointSetSliderAxis(slider, 1, 0, 0);
+  dJointID rail = dJointCreateSlider(world, 0);
+  dJointAttach(rail, hung, 0);
+  dJointSetSliderAxis(rail, 1, 0, 0);
+  EXPECT_EQ(ssStepper_KnownBodyCount(stepper), 1);  // the bob is found at the next frame, the hung body never
+  ASSERT_EQ(ssStepper_WatchBody(stepper, hung), SS_OK);
+  const double v_box = dBodyGetLinearVel(box)[0];
+  for (int frame = 0; frame < 20; ++frame) {
+    dBodyAddForce(bob, 1, 0, 0);
+    dBodyAddForce(hung, 1, 0, 0);
+    ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 20, nullptr), SS_OK) << ssLastError();
+  }
+  EXPECT_EQ(ssStepper_KnownBodyCount(stepper), 3);
+  EXPECT_NEAR(dBodyGetLinearVel(hung)[0], 1.0, 1e-9);  // F·t / m on its rail
+  // the bob and the box share the momentum along the slider: (m_bob + m_box) v = F t
+  EXPECT_NEAR(dBodyGetLinearVel(bob)[0] + dBodyGetLinearVel(box)[0] - v_box, 1.0, 1e-6);
+}
+
+// ---- e. a frame of one step leaves the program's forces as it added them ----
+
+TEST_F(PromiseTest, AOneStepFrameStepsTheProgramsForcesBitForBit) {
+  // A force where F·h/h is not F: the rewrite would show in the last bit.
+  const double h = 1.0 / 60;
+  double force = 0;
+  for (int milli = 1; milli <= 3000 && force == 0; ++milli)
+    if (milli / 1000.0 * h / h != milli / 1000.0) force = milli / 1000.0;
+  ASSERT_GT(force, 0);
+  dWorldID own = dWorldCreate();  // the program's own stepping, beside the one through the stepper
+  dWorldSetGravity(own, 0, 0, 0);
+  dBodyID mine = dBodyCreate(own);
+  dBodyID body = Box(0, 0, 0);
+  dMass mass;
+  dBodyGetMass(body, &mass);
+  dBodySetMass(mine, &mass);
+  ssStepperDef def = Def();
+  def.collide = nullptr;
+  struct Seen {
+    dBodyID body;
+    std::vector<double> forces;  // the x force in ODE's accumulator just before each step
+  } seen{body, {}};
+  def.before_step = [](void* context, ssStepper*) {
+    auto* seen = static_cast<Seen*>(context);
+    seen->forces.push_back(dBodyGetForce(seen->body)[0]);
+  };
+  def.before_step_context = &seen;
+  ssSteppingForPolicy("naive", h, &def.stepping);
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  for (int frame = 0; frame < 30; ++frame) {
+    dBodyAddForce(mine, force, 0.3 * force, 0);
+    dBodyAddTorque(mine, 0, 0, force);
+    dWorldQuickStep(own, h);
+    dBodyAddForce(body, force, 0.3 * force, 0);
+    dBodyAddTorque(body, 0, 0, force);
+    ASSERT_EQ(ssStepper_Step(stepper, h, nullptr), SS_OK) << ssLastError();
+  }
+  ASSERT_EQ(seen.forces.size(), 30u);
+  for (double seen_force : seen.forces) EXPECT_EQ(seen_force, force);  // as added, not F·h/h
+  EXPECT_EQ(std::memcmp(dBodyGetLinearVel(mine), dBodyGetLinearVel(body), 3 * sizeof(dReal)), 0);
+  EXPECT_EQ(std::memcmp(dBodyGetAngularVel(mine), dBodyGetAngularVel(body), 3 * sizeof(dReal)), 0);
+  EXPECT_EQ(std::memcmp(dBodyGetPosition(mine), dBodyGetPosition(body), 3 * sizeof(dReal)), 0);
+  dWorldDestroy(own);
+}
+
+TEST_F(PromiseTest, TheStepperWritesNoSolverSettingTheProgramDidNotAskFor) {
+  Box(0, 0, 0);
+  dWorldSetQuickStepNumIterations(world, 37);
+  dWorldSetQuickStepW(world, 1.1);
+  ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
+  for (int frame = 0; frame < 5; ++frame) ASSERT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK);
+  EXPECT_EQ(dWorldGetQuickStepNumIterations(world), 37);
+  EXPECT_EQ(dWorldGetQuickStepW(world), 1.1);
+}
+
+}  // namespace
