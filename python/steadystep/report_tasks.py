@@ -130,7 +130,8 @@ def _figure_tasks(report, scene: str, done: dict) -> list[dict]:
             for figure in [*runs.motion_quantities(scene)[:2], "deviation"]]
 
 
-FIGURES_PER_SCENE = lambda scene: len(runs.motion_quantities(scene)[:2]) + 1  # noqa: E731
+def _figure_count(scene: str) -> int:
+    return len(runs.motion_quantities(scene)[:2]) + 1
 
 
 def _figures_needed(report, scene: str) -> set[tuple]:
@@ -144,7 +145,7 @@ def run_phases(report, units: dict[tuple, dict], executor, progress: bool | None
     into figure_dir (report.figures). The phases' wall times go into report.phases_s."""
     started = time.perf_counter()
     waiting = {scene: _figures_needed(report, scene) for scene in report.scenes} if figure_dir is not None else {}
-    total = len(units) + sum(FIGURES_PER_SCENE(scene) for scene in waiting)
+    total = len(units) + sum(_figure_count(scene) for scene in waiting)
     done: dict[tuple, object] = {}
     with study.progress_bar(total, progress, "steadystep compare [runs]", "unit") as bar:
         def finished(key, task, result):
