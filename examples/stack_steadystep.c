@@ -130,17 +130,16 @@ int main(int argc, char** argv) {
   }
   dInitODE2(0);
   build();
-  /* steadystep: adopt what the program tuned at 60 fps (world, joints, bodies), and make the stepper. */
-  ssRegistry* registry = ssRegistry_Create(world);
+  /* steadystep: the stepper adopts the world and all the space reaches, as the program tuned them at 60 fps */
   ssStepperDef def = ssDefaultStepperDef();
   def.world = world;
-  def.registry = registry;
+  def.space = space;
+  def.tuned_step_s = 1.0 / 60;
   def.stepping = stepping;
   def.collide = collide;
   def.contact_group = contacts;
   ssStepper* stepper = NULL;
-  if (registry == NULL || ssRegistry_Adopt(registry, 1.0 / 60, space, NULL) != SS_OK ||
-      ssStepper_Create(&def, &stepper) != SS_OK) {
+  if (ssStepper_Create(&def, &stepper) != SS_OK) {
     fprintf(stderr, PROGRAM ": %s\n", ssLastError());
     return 1;
   }
@@ -168,7 +167,6 @@ int main(int argc, char** argv) {
   exampleFinish(&flags, started);
 
   ssStepper_Destroy(stepper);
-  ssRegistry_Destroy(registry);
   dJointGroupDestroy(contacts);
   dSpaceDestroy(space);
   dWorldDestroy(world);

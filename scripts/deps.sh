@@ -39,7 +39,8 @@ if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
   "$venv/bin/pip" install --quiet --upgrade pip
 fi
-"$venv/bin/pip" install --quiet scikit-build-core
+# The build needs cffi itself: it parses the headers into the binding (python/steadystep/_cdef_build.py).
+"$venv/bin/pip" install --quiet scikit-build-core cffi
 # test: pytest and ode-python (the tests' own ODE worlds); report: matplotlib and tqdm (figures, the report);
 # dask: Dask distributed, so that the tests run studies on a real (local) cluster.
 "$venv/bin/pip" install --quiet --no-build-isolation "$repo[test,report,dask]"

@@ -1,8 +1,8 @@
 /* Adoption: a program's tuned numbers read back from ODE and bound as what they stand for (adopt.h).
  *
  * ODE 0.16 cannot list a world's bodies or joints, so adoption walks what it can reach: spaces -> geoms -> bodies
- * -> joints -> bodies. It plans every binding first and commits only when the whole plan is valid, so an error
- * leaves the registry as it was. */
+ * -> joints -> bodies. It plans every binding first, the world's included, and commits only when the whole plan is
+ * valid, so an error leaves the registry as it was. */
 #include "steadystep/adopt.h"
 
 #include <math.h>
@@ -25,11 +25,11 @@ typedef struct PlannedRow {
   ssRowLaw law;
 } PlannedRow;
 
+/* A body's binding as it will be made (body 0: the world's defaults), and the sample count the body holds, which is
+ * not written again where it is already the one to write (ODE restarts the average when it is set). */
 typedef struct PlannedBody {
-  dBodyID body;
-  double linear_rate_per_s, angular_rate_per_s;
-  int has_auto_disable;
-  double idle_time_s, average_window_s;
+  ssBodyBinding binding;
+  int samples_held;
 } PlannedBody;
 
 /* Pointers seen by the walk: open addressing, grown at half full. */
@@ -42,6 +42,10 @@ typedef struct Plan {
   ssRegistry* registry;
   dWorldID world;
   double tuned_step_s;
+  /* the world's ERP/CFM and defaults, when this adoption binds them */
+  int world_planned;
+  ssRowLaw world_law;
+  PlannedBody world_defaults;
   PlannedRow* rows;
   int row_count, row_capacity;
   PlannedBody* bodies;
@@ -112,17 +116,62 @@ static ssStatus dampingRate(const char* what, double scale, double tuned_step_s,
 }
 
 /* Auto-disable after `steps` idle steps of h0 and `seconds` idle seconds (ODE waits for both) as an idle time, and
- * an average over `samples` steps as a window. */
+ * an average over `samples` steps as a window; the numbers themselves are kept for the tuned step. */
 static ssStatus autoDisableTimes(const char* what, int steps, double seconds, int samples, double tuned_step_s,
-                                 PlannedBody* out) {
+                                 ssBodyBinding* out) {
   if (!isfinite(seconds) || seconds < 0)
     return ssFail(isfinite(seconds) ? SS_ERROR_OUT_OF_RANGE : SS_ERROR_NOT_FINITE,
                   "%s auto-disable time = %g s: must be finite and not negative", what, seconds);
   double idle_s = fmax(fmax(steps, 0) * tuned_step_s, seconds);
-  out->has_auto_disable = idle_s > 0; /* 0 idle steps and 0 s: disabled at once, at every step length alike */
+  /* 0 idle steps and 0 s: disabled at once; 0 samples: ODE never samples, so the body never sleeps. Both are so at
+   * every step length alike: left as the program set them. */
+  out->has_auto_disable = idle_s > 0 && samples > 0;
   out->idle_time_s = idle_s;
   out->average_window_s = samples > 1 ? samples * tuned_step_s : 0;
+  out->tuned.auto_disable_step_s = tuned_step_s;
+  out->tuned.idle_steps = steps;
+  out->tuned.idle_time_s = seconds;
+  out->tuned.average_samples = samples;
   return SS_OK;
+}
+
+/* The damping scales of a body (or the world) as rates, the scales themselves kept for the tuned step. */
+static ssStatus dampingRates(const char* what, double linear, double angular, double tuned_step_s,
+                             ssBodyBinding* out) {
+  ssStatus status = dampingRate(what, linear, tuned_step_s, &out->linear_rate_per_s);
+  if (status == SS_OK) status = dampingRate(what, angular, tuned_step_s, &out->angular_rate_per_s);
+  if (status != SS_OK) return status;
+  out->has_damping = 1;
+  out->tuned.damping_step_s = tuned_step_s;
+  out->tuned.linear_scale = linear;
+  out->tuned.angular_scale = angular;
+  return SS_OK;
+}
+
+/* The world's defaults as this adoption binds them, or as bound before; NULL when neither. */
+static const ssBodyBinding* worldDefaults(Plan* plan) {
+  if (plan->world_planned) return &plan->world_defaults.binding;
+  return ssRegistryFindBody(plan->registry, 0);
+}
+
+/* The world's law as this adoption binds it, or as bound before; 0 when neither. */
+static int worldLaw(const Plan* plan, ssRowLaw* law) {
+  if (plan->world_planned) {
+    *law = plan->world_law;
+    return 1;
+  }
+  return ssRegistryWorldBound(plan->registry, law);
+}
+
+/* Refuses a body of another world than the registry's: ODE would step it with another world, and the registry would
+ * rewrite numbers the registry's world never reads. joint: the joint it was reached through, or 0. */
+static ssStatus requireSameWorld(const Plan* plan, dJointID joint, dBodyID body) {
+  dWorldID world = dBodyGetWorld(body);
+  if (world == plan->world) return SS_OK;
+  char through[64] = "";
+  if (joint != 0) snprintf(through, sizeof through, "%s joint %p: ", ssJointTypeName(joint), (void*)joint);
+  return ssFail(SS_ERROR_OUT_OF_RANGE, "%sbody %p is of world %p, not of the registry's world %p", through,
+                (void*)body, (void*)world, (void*)plan->world);
 }
 
 static int pushPending(Plan* plan, dBodyID body) {
@@ -135,35 +184,48 @@ static ssStatus planBody(Plan* plan, dBodyID body) {
   int added = addSeen(&plan->seen, body);
   if (added < 0) return outOfMemory();
   if (added == 0) return SS_OK;
+  ssStatus status = requireSameWorld(plan, 0, body);
+  if (status != SS_OK) return status;
   if (!pushPending(plan, body)) return outOfMemory();
   if (ssRegistryHasBody(plan->registry, body)) return SS_OK;
-  char what[64];
-  snprintf(what, sizeof what, "body %p", (void*)body);
-  PlannedBody planned = {.body = body};
+  /* the message names the body; it is written only on a refusal (one snprintf a body was 4.5 % of adopting) */
+  char what[64] = "body";
+  PlannedBody planned;
+  memset(&planned, 0, sizeof planned);
+  planned.binding.body = body;
+  ssBodyBinding* binding = &planned.binding;
   /* ODE copied the world's current defaults into a body made after an earlier adoption: those stand for the
    * world's rates, not for values tuned at h0 */
-  const ssBodyBinding* world = ssRegistryFindBody(plan->registry, 0);
+  const ssBodyBinding* world = worldDefaults(plan);
   double linear = dBodyGetLinearDamping(body), angular = dBodyGetAngularDamping(body);
   if (world != NULL && world->has_damping && linear == dWorldGetLinearDamping(plan->world) &&
       angular == dWorldGetAngularDamping(plan->world)) {
-    planned.linear_rate_per_s = world->linear_rate_per_s;
-    planned.angular_rate_per_s = world->angular_rate_per_s;
-  } else {
-    ssStatus status = dampingRate(what, linear, plan->tuned_step_s, &planned.linear_rate_per_s);
-    if (status == SS_OK) status = dampingRate(what, angular, plan->tuned_step_s, &planned.angular_rate_per_s);
-    if (status != SS_OK) return status;
+    binding->has_damping = 1;
+    binding->linear_rate_per_s = world->linear_rate_per_s;
+    binding->angular_rate_per_s = world->angular_rate_per_s;
+    binding->tuned.damping_step_s = world->tuned.damping_step_s;
+    binding->tuned.linear_scale = world->tuned.linear_scale;
+    binding->tuned.angular_scale = world->tuned.angular_scale;
+  } else if ((status = dampingRates(what, linear, angular, plan->tuned_step_s, binding)) != SS_OK) {
+    snprintf(what, sizeof what, "body %p", (void*)body);
+    return dampingRates(what, linear, angular, plan->tuned_step_s, binding);
   }
   int steps = dBodyGetAutoDisableSteps(body), samples = dBodyGetAutoDisableAverageSamplesCount(body);
   double seconds = dBodyGetAutoDisableTime(body);
+  planned.samples_held = samples;
   if (world != NULL && world->has_auto_disable && steps == dWorldGetAutoDisableSteps(plan->world) &&
       seconds == dWorldGetAutoDisableTime(plan->world) &&
       samples == dWorldGetAutoDisableAverageSamplesCount(plan->world)) {
-    planned.has_auto_disable = 1;
-    planned.idle_time_s = world->idle_time_s;
-    planned.average_window_s = world->average_window_s;
-  } else {
-    ssStatus status = autoDisableTimes(what, steps, seconds, samples, plan->tuned_step_s, &planned);
-    if (status != SS_OK) return status;
+    binding->has_auto_disable = 1;
+    binding->idle_time_s = world->idle_time_s;
+    binding->average_window_s = world->average_window_s;
+    binding->tuned.auto_disable_step_s = world->tuned.auto_disable_step_s;
+    binding->tuned.idle_steps = world->tuned.idle_steps;
+    binding->tuned.idle_time_s = world->tuned.idle_time_s;
+    binding->tuned.average_samples = world->tuned.average_samples;
+  } else if ((status = autoDisableTimes(what, steps, seconds, samples, plan->tuned_step_s, binding)) != SS_OK) {
+    snprintf(what, sizeof what, "body %p", (void*)body);
+    return autoDisableTimes(what, steps, seconds, samples, plan->tuned_step_s, binding);
   }
   if (!ssReserveOne((void**)&plan->bodies, plan->body_count, &plan->body_capacity, sizeof planned))
     return outOfMemory();
@@ -171,25 +233,29 @@ static ssStatus planBody(Plan* plan, dBodyID body) {
   return SS_OK;
 }
 
+/* A row's law from its tuned ERP/CFM, writable at every step length. */
+static ssStatus planRowLaw(const char* what, double erp, double cfm, double tuned_step_s, ssRowLaw* law) {
+  ssStatus status = ssRowLawFromTuned(what, erp, cfm, tuned_step_s, law);
+  return status == SS_OK ? ssCheckLawForEveryStep(what, law) : status;
+}
+
 static ssStatus planRow(Plan* plan, dJointID joint, ssJointParam param, int axis) {
   if (ssRegistryHasJointRow(plan->registry, joint, param, axis)) return SS_OK;
   double erp, cfm;
   ssJointReadSoftness(joint, param, axis, &erp, &cfm);
-  PlannedRow row = {joint, param, axis, {{0, 0}, 0, 0}};
+  PlannedRow row = {.joint = joint, .param = param, .axis = axis};
   ssRowLaw world_law;
   ssSoftness world_now = {dWorldGetERP(plan->world), dWorldGetCFM(plan->world)};
   /* a row still holding the world's current ERP/CFM (ODE copies them at creation; the registry rewrites them for
    * each step) stands for the world's tuned spring. Motor rows are dampers, whose cfm is adopted as it is. */
-  if (param != SS_PARAM_MOTOR && erp == world_now.erp && cfm == world_now.cfm &&
-      ssRegistryWorldBound(plan->registry, &world_law)) {
+  if (param != SS_PARAM_MOTOR && erp == world_now.erp && cfm == world_now.cfm && worldLaw(plan, &world_law)) {
     row.law = world_law;
-  } else {
+  } else if (planRowLaw("row", erp, cfm, plan->tuned_step_s, &row.law) != SS_OK) {
+    /* refused: again, with the message naming the row (written only on a refusal, as for bodies) */
     char what[96];
     snprintf(what, sizeof what, "%s joint %p, %s axis %d", ssJointTypeName(joint), (void*)joint,
              ssJointParamName(param), axis);
-    ssStatus status = ssRowLawFromTuned(what, erp, cfm, plan->tuned_step_s, &row.law);
-    if (status == SS_OK) status = ssCheckLawForEveryStep(what, &row.law);
-    if (status != SS_OK) return status;
+    return planRowLaw(what, erp, cfm, plan->tuned_step_s, &row.law);
   }
   if (!ssReserveOne((void**)&plan->rows, plan->row_count, &plan->row_capacity, sizeof row)) return outOfMemory();
   plan->rows[plan->row_count++] = row;
@@ -211,6 +277,12 @@ static ssStatus planJoint(Plan* plan, dJointID joint) {
   int type = dJointGetType(joint);
   if (type <= dJointTypeNone || type > dJointTypeTransmission)
     return ssFail(SS_ERROR_UNSUPPORTED, "joint %p: type %d is not one ODE 0.16 knows", (void*)joint, type);
+  /* ODE 0.16 has no getter for a joint's world: its bodies tell (a joint attached to none acts on nothing) */
+  for (int side = 0; side < 2; ++side) {
+    dBodyID body = dJointGetBody(joint, side);
+    ssStatus status = body != 0 ? requireSameWorld(plan, joint, body) : SS_OK;
+    if (status != SS_OK) return status;
+  }
   if (type == dJointTypeContact || type == dJointTypeNull || type == dJointTypePlane2D) {
     plan->counts.skipped_joints += 1;
     return SS_OK; /* contacts are transient: the bodies they touch are reached through the space */
@@ -261,20 +333,40 @@ static ssStatus planSpace(Plan* plan, dSpaceID space) {
   return SS_OK;
 }
 
+/* Binds one planned body (or the world's defaults), with what the program had for the tuned step. */
+static void bindBody(ssRegistry* registry, const PlannedBody* planned) {
+  const ssBodyBinding* binding = &planned->binding;
+  ssRegistry_BindDamping(registry, binding->body, binding->linear_rate_per_s, binding->angular_rate_per_s);
+  if (binding->has_auto_disable)
+    ssRegistry_BindAutoDisable(registry, binding->body, binding->idle_time_s, binding->average_window_s);
+  ssBodyBinding* bound = ssRegistryFindBody(registry, binding->body);
+  bound->tuned.damping_step_s = binding->tuned.damping_step_s;
+  bound->tuned.linear_scale = binding->tuned.linear_scale;
+  bound->tuned.angular_scale = binding->tuned.angular_scale;
+  if (!binding->has_auto_disable) return;
+  bound->tuned.auto_disable_step_s = binding->tuned.auto_disable_step_s;
+  bound->tuned.idle_steps = binding->tuned.idle_steps;
+  bound->tuned.idle_time_s = binding->tuned.idle_time_s;
+  bound->tuned.average_samples = binding->tuned.average_samples;
+  bound->average_samples_written = planned->samples_held;
+}
+
 /* Binds the whole plan; nothing can fail after the reservation. */
 static ssStatus commit(Plan* plan, ssAdoptReport* report) {
-  ssStatus status = ssRegistryReserve(plan->registry, plan->row_count, plan->body_count);
+  ssStatus status = ssRegistryReserve(plan->registry, plan->row_count, plan->body_count + plan->world_planned);
   if (status != SS_OK) return status;
+  if (plan->world_planned) {
+    ssRegistryBindWorldLaw(plan->registry, plan->world_law, 0);
+    ssRegistrySetTuned(plan->registry, plan->tuned_step_s, plan->world_law.tuned);
+    bindBody(plan->registry, &plan->world_defaults);
+    plan->counts.world = 1;
+    plan->counts.hard_rows += plan->world_law.hard;
+  }
   for (int i = 0; i < plan->row_count; ++i) {
     const PlannedRow* row = &plan->rows[i];
     ssRegistryBindJointLaw(plan->registry, row->joint, row->param, row->axis, row->law, 0);
   }
-  for (int i = 0; i < plan->body_count; ++i) {
-    const PlannedBody* body = &plan->bodies[i];
-    ssRegistry_BindDamping(plan->registry, body->body, body->linear_rate_per_s, body->angular_rate_per_s);
-    if (body->has_auto_disable)
-      ssRegistry_BindAutoDisable(plan->registry, body->body, body->idle_time_s, body->average_window_s);
-  }
+  for (int i = 0; i < plan->body_count; ++i) bindBody(plan->registry, &plan->bodies[i]);
   plan->counts.bodies += plan->body_count;
   if (report != NULL) {
     report->world += plan->counts.world;
@@ -299,41 +391,39 @@ static Plan startPlan(ssRegistry* registry) {
   return plan;
 }
 
-ssStatus ssRegistry_AdoptWorld(ssRegistry* registry, double tuned_step_s, ssAdoptReport* report) {
-  if (registry == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "registry = NULL: a registry is required");
+/* Plans the world's ERP/CFM and defaults as tuned at tuned_step_s, unless adopted already at that step. */
+static ssStatus planWorld(Plan* plan, double tuned_step_s) {
   ssStatus status = ssCheckStepLength("tuned_step_s", tuned_step_s);
   if (status != SS_OK) return status;
-  double adopted_s = ssRegistry_TunedStep(registry);
+  double adopted_s = ssRegistry_TunedStep(plan->registry);
   if (adopted_s != 0 && adopted_s != tuned_step_s)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "tuned_step_s = %g s: this registry adopted values tuned at %g s",
-                  tuned_step_s,
-                  adopted_s);
+                  tuned_step_s, adopted_s);
   if (adopted_s != 0) return SS_OK; /* adopted already: idempotent */
-  dWorldID world = ssRegistryWorld(registry);
-  ssSoftness tuned = {dWorldGetERP(world), dWorldGetCFM(world)};
-  ssRowLaw law;
-  status = ssRowLawFromTuned("world", tuned.erp, tuned.cfm, tuned_step_s, &law);
-  if (status == SS_OK) status = ssCheckLawForEveryStep("world", &law);
-  PlannedBody defaults = {0};
+  plan->tuned_step_s = tuned_step_s;
+  dWorldID world = plan->world;
+  status = ssRowLawFromTuned("world", dWorldGetERP(world), dWorldGetCFM(world), tuned_step_s, &plan->world_law);
+  if (status == SS_OK) status = ssCheckLawForEveryStep("world", &plan->world_law);
+  ssBodyBinding* defaults = &plan->world_defaults.binding;
   if (status == SS_OK)
-    status = dampingRate("world", dWorldGetLinearDamping(world), tuned_step_s, &defaults.linear_rate_per_s);
-  if (status == SS_OK)
-    status = dampingRate("world", dWorldGetAngularDamping(world), tuned_step_s, &defaults.angular_rate_per_s);
+    status = dampingRates("world", dWorldGetLinearDamping(world), dWorldGetAngularDamping(world), tuned_step_s,
+                          defaults);
   if (status == SS_OK)
     status = autoDisableTimes("world", dWorldGetAutoDisableSteps(world), dWorldGetAutoDisableTime(world),
-                              dWorldGetAutoDisableAverageSamplesCount(world), tuned_step_s, &defaults);
-  if (status == SS_OK) status = ssRegistryReserve(registry, 0, 1);
+                              dWorldGetAutoDisableAverageSamplesCount(world), tuned_step_s, defaults);
   if (status != SS_OK) return status;
-  ssRegistryBindWorldLaw(registry, law, 0);
-  ssRegistrySetTuned(registry, tuned_step_s, tuned);
-  ssRegistry_BindDamping(registry, 0, defaults.linear_rate_per_s, defaults.angular_rate_per_s);
-  if (defaults.has_auto_disable)
-    ssRegistry_BindAutoDisable(registry, 0, defaults.idle_time_s, defaults.average_window_s);
-  if (report != NULL) {
-    report->world += 1;
-    report->hard_rows += law.hard;
-  }
+  plan->world_defaults.samples_held = dWorldGetAutoDisableAverageSamplesCount(world);
+  plan->world_planned = 1;
   return SS_OK;
+}
+
+ssStatus ssRegistry_AdoptWorld(ssRegistry* registry, double tuned_step_s, ssAdoptReport* report) {
+  if (registry == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "registry = NULL: a registry is required");
+  Plan plan = startPlan(registry);
+  ssStatus status = planWorld(&plan, tuned_step_s);
+  if (status == SS_OK) status = commit(&plan, report);
+  freePlan(&plan);
+  return status;
 }
 
 ssStatus ssRegistry_AdoptSpace(ssRegistry* registry, dSpaceID space, ssAdoptReport* report) {
@@ -348,12 +438,13 @@ ssStatus ssRegistry_AdoptSpace(ssRegistry* registry, dSpaceID space, ssAdoptRepo
 }
 
 ssStatus ssRegistry_Adopt(ssRegistry* registry, double tuned_step_s, dSpaceID space, ssAdoptReport* report) {
+  if (registry == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "registry = NULL: a registry is required");
   if (space == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "space = NULL: a space is required");
-  int world_was_adopted = ssRegistry_TunedStep(registry) != 0;
-  ssStatus status = ssRegistry_AdoptWorld(registry, tuned_step_s, report);
-  if (status != SS_OK) return status;
-  status = ssRegistry_AdoptSpace(registry, space, report);
-  if (status != SS_OK && !world_was_adopted) ssRegistryForgetWorldAdoption(registry);
+  Plan plan = startPlan(registry);
+  ssStatus status = planWorld(&plan, tuned_step_s);
+  if (status == SS_OK) status = planSpace(&plan, space);
+  if (status == SS_OK) status = commit(&plan, report);
+  freePlan(&plan);
   return status;
 }
 

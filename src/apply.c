@@ -95,7 +95,8 @@ typedef struct SharedSoftness {
 
 static int sameLaw(const ssRowLaw* a, const ssRowLaw* b) {
   return a->hard == b->hard && a->spring.stiffness == b->spring.stiffness && a->spring.damping == b->spring.damping &&
-         a->hard_rate_per_s == b->hard_rate_per_s;
+         a->hard_rate_per_s == b->hard_rate_per_s && a->tuned_step_s == b->tuned_step_s &&
+         a->tuned.erp == b->tuned.erp && a->tuned.cfm == b->tuned.cfm;
 }
 
 /* Whether the row's law is the shared one's: by slot where both are in the law table (distinct there). */
@@ -236,9 +237,10 @@ static int sharesRow(const JointBinding* a, const JointBinding* b) {
          !a->law.hard && !b->law.hard;
 }
 
-/* Whether writing b over a would change nothing in ODE: a row without an erp (a motor) holds only its cfm. */
+/* Whether writing b over a would change nothing in ODE (as it stores them: in float, doubles that round alike are
+ * one value): a row without an erp (a motor) holds only its cfm. */
 static int sameWrite(int erp_number, const ssSoftness* a, const ssSoftness* b) {
-  return a->cfm == b->cfm && (erp_number < 0 || a->erp == b->erp);
+  return ssSameInOde(a->cfm, b->cfm) && (erp_number < 0 || ssSameInOde(a->erp, b->erp));
 }
 
 /* Apply's first pass in general: each row's mass and softness into pending, and the load corrections, all checked
@@ -360,7 +362,7 @@ static int writeRows(ssRegistry* registry, ssMapping mapping) {
 static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* softness) {
   for (int j = 0; j < registry->law_count; ++j) {
     const ssRowLaw* law = &registry->laws[j];
-    if (!law->hard) {
+    if (!law->hard && step_s != law->tuned_step_s) { /* at its tuned step, a law gives its tuned numbers back */
       /* ssSoftnessFromSpring's arithmetic without its checks, which every bound law passed for every step length
        * (ssCheckLawForEveryStep at bind time): cfm within ODE's range is all that is left to see */
       double hk_plus_c = step_s * law->spring.stiffness + law->spring.damping;
@@ -385,8 +387,8 @@ static int writeRowsByLaw(ssRegistry* registry, const ssSoftness* softness) {
   int by_law = registry->written_by_law;
   int erp_changed[kLawTableSize], cfm_changed[kLawTableSize];
   for (int j = 0; j < registry->law_count; ++j) {
-    erp_changed[j] = softness[j].erp != registry->law_written[j].erp;
-    cfm_changed[j] = softness[j].cfm != registry->law_written[j].cfm;
+    erp_changed[j] = !ssSameInOde(softness[j].erp, registry->law_written[j].erp);
+    cfm_changed[j] = !ssSameInOde(softness[j].cfm, registry->law_written[j].cfm);
   }
   HotRow* hot = registry->hot_rows;
   for (int i = 0; i < registry->joint_count; ++i) {
@@ -452,8 +454,8 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   if (status != SS_OK) return status;
 
   /* Nothing below can fail. */
-  if (registry->world_bound && (dWorldGetERP(registry->world) != registry->world_pending.erp ||
-                                dWorldGetCFM(registry->world) != registry->world_pending.cfm)) {
+  if (registry->world_bound && (!ssSameInOde(dWorldGetERP(registry->world), registry->world_pending.erp) ||
+                                !ssSameInOde(dWorldGetCFM(registry->world), registry->world_pending.cfm))) {
     dWorldSetERP(registry->world, registry->world_pending.erp);
     dWorldSetCFM(registry->world, registry->world_pending.cfm);
     counts.row_writes += 1;

@@ -67,12 +67,16 @@ static ssStatus computeRow(const ssJointRowBinding* row, ssMapping mapping, doub
 
 static double stepsIn(double seconds, double step_s) { return ceil(seconds / step_s - 1e-9); }
 
-/* A body binding's values for the step, each written where ODE holds another. */
+/* A body binding's values for the step, each written where ODE holds another: at the step adoption read them for,
+ * the program's own numbers; at any other, what the rates and seconds stand for, with at most
+ * SS_MAX_AVERAGE_SAMPLES samples. */
 static void writeBody(const ssBodyBinding* binding, dWorldID world, double step_s) {
   dBodyID body = binding->body;
+  const ssBodyTuned* tuned = &binding->tuned;
   if (binding->has_damping) {
-    double linear = -expm1(-binding->linear_rate_per_s * step_s);
-    double angular = -expm1(-binding->angular_rate_per_s * step_s);
+    int as_tuned = step_s == tuned->damping_step_s;
+    double linear = as_tuned ? tuned->linear_scale : -expm1(-binding->linear_rate_per_s * step_s);
+    double angular = as_tuned ? tuned->angular_scale : -expm1(-binding->angular_rate_per_s * step_s);
     if (body) {
       if (dBodyGetLinearDamping(body) != linear) dBodySetLinearDamping(body, linear);
       if (dBodyGetAngularDamping(body) != angular) dBodySetAngularDamping(body, angular);
@@ -82,20 +86,20 @@ static void writeBody(const ssBodyBinding* binding, dWorldID world, double step_
     }
   }
   if (binding->has_auto_disable) {
+    int as_tuned = step_s == tuned->auto_disable_step_s;
     double steps = stepsIn(binding->idle_time_s, step_s);
-    int idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
-    double samples = fmax(1.0, stepsIn(binding->average_window_s, step_s));
-    unsigned average = samples < 1e6 ? (unsigned)samples : 1000000u;
+    int idle_steps = as_tuned ? tuned->idle_steps : steps < INT32_MAX ? (int)steps : INT32_MAX;
+    double idle_time_s = as_tuned ? tuned->idle_time_s : binding->idle_time_s;
+    double samples = fmin(fmax(1.0, stepsIn(binding->average_window_s, step_s)), SS_MAX_AVERAGE_SAMPLES);
+    unsigned average = as_tuned ? (unsigned)tuned->average_samples : (unsigned)samples;
     if (body) {
       if (dBodyGetAutoDisableSteps(body) != idle_steps) dBodySetAutoDisableSteps(body, idle_steps);
-      if (dBodyGetAutoDisableTime(body) != binding->idle_time_s)
-        dBodySetAutoDisableTime(body, binding->idle_time_s);
+      if (dBodyGetAutoDisableTime(body) != idle_time_s) dBodySetAutoDisableTime(body, idle_time_s);
       if ((unsigned)dBodyGetAutoDisableAverageSamplesCount(body) != average)
         dBodySetAutoDisableAverageSamplesCount(body, average);
     } else {
       if (dWorldGetAutoDisableSteps(world) != idle_steps) dWorldSetAutoDisableSteps(world, idle_steps);
-      if (dWorldGetAutoDisableTime(world) != binding->idle_time_s)
-        dWorldSetAutoDisableTime(world, binding->idle_time_s);
+      if (dWorldGetAutoDisableTime(world) != idle_time_s) dWorldSetAutoDisableTime(world, idle_time_s);
       if ((unsigned)dWorldGetAutoDisableAverageSamplesCount(world) != average)
         dWorldSetAutoDisableAverageSamplesCount(world, average);
     }
@@ -134,7 +138,8 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
     return status;
   }
   dWorldID world_id = ssRegistryWorld(registry);
-  if (world_bound && (dWorldGetERP(world_id) != world.erp || dWorldGetCFM(world_id) != world.cfm)) {
+  if (world_bound &&
+      (!ssSameInOde(dWorldGetERP(world_id), world.erp) || !ssSameInOde(dWorldGetCFM(world_id), world.cfm))) {
     dWorldSetERP(world_id, world.erp);
     dWorldSetCFM(world_id, world.cfm);
     counts.row_writes += 1;
@@ -146,9 +151,9 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
     ssRowWriter writer;
     ssJointRowWriterOf(row.joint, row.param, row.axis, &writer);
     /* a motor row has no erp: ODE holds only its cfm */
-    int erp_differs = writer.erp_number >= 0 && erp != computed[i].softness.erp;
+    int erp_differs = writer.erp_number >= 0 && !ssSameInOde(erp, computed[i].softness.erp);
     /* a row bound since the last Apply is written whatever ODE holds (registry.h: binding again rewrites it) */
-    if (row.unwritten || erp_differs || cfm != computed[i].softness.cfm) {
+    if (row.unwritten || erp_differs || !ssSameInOde(cfm, computed[i].softness.cfm)) {
       ssRowWrite(&writer, row.joint, computed[i].softness.erp, computed[i].softness.cfm);
       ssRegistrySetRowWritten(registry, i, computed[i].softness);
       counts.row_writes += 1;

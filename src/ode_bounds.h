@@ -6,6 +6,8 @@
 #ifndef STEADYSTEP_ODE_BOUNDS_H
 #define STEADYSTEP_ODE_BOUNDS_H
 
+#include <ode/common.h>
+
 #include "steadystep/limits.h"
 #include "steadystep/spring.h"
 #include "steadystep/status.h"
@@ -21,6 +23,11 @@ ssStatus ssCheckSoftnessForOde(const char* name, double erp, double cfm);
 /* The same for a softness the library computed from a spring: as ssCheckSoftnessForOde, and cfm at least
  * SS_MIN_POSITIVE_CFM (it reaches ODE's dReal as a positive normal number, not as 0). */
 ssStatus ssCheckComputedSoftness(const char* name, ssSoftness softness);
+
+/* Whether writing a where ODE was given b leaves ODE holding the same value: the two compared as ODE stores them,
+ * so that every path decides alike whether a value needs writing, whether it remembers b in double or reads it back
+ * from ODE. NAN (nothing written yet) is never the same. */
+static inline int ssSameInOde(double a, double b) { return (dReal)a == (dReal)b; }
 
 /* A body mass (kg) for dBodySetMass: finite and in [SS_MIN_MASS_KG, SS_MAX_MASS_KG]. */
 ssStatus ssCheckMass(const char* name, double mass_kg);

@@ -11,6 +11,14 @@
 #include "steadystep/adopt.h"
 #include "steadystep/registry.h"
 
+/* Refuses a body of another world than the registry's (0, the static world, is everyone's): the registry's writes
+ * for it would be read by a world the registry never steps. */
+static ssStatus requireRegistryWorld(const ssRegistry* registry, const char* what, dBodyID body) {
+  if (body == 0 || dBodyGetWorld(body) == registry->world) return SS_OK;
+  return ssFail(SS_ERROR_OUT_OF_RANGE, "%s: body %p is of world %p, not of the registry's world %p", what,
+                (void*)body, (void*)dBodyGetWorld(body), (void*)registry->world);
+}
+
 ssRegistry* ssRegistry_Create(dWorldID world) {
   if (world == 0) {
     ssFail(SS_ERROR_OUT_OF_RANGE, "world = NULL: a world is required");
@@ -158,6 +166,9 @@ ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam
   ssStatus status = ssValidateSpring(spring);
   if (status == SS_OK) status = ssCheckLawForEveryStep("joint", &law);
   if (status == SS_OK) status = ssCheckNonNegative("effective_mass", "kg", effective_mass);
+  /* ODE 0.16 has no getter for a joint's world: its bodies tell */
+  for (int side = 0; side < 2 && status == SS_OK; ++side)
+    status = requireRegistryWorld(registry, "joint", dJointGetBody(joint, side));
   if (status != SS_OK) return status;
   return ssRegistryBindJointLaw(registry, joint, param, axis, law, effective_mass);
 }
@@ -228,12 +239,14 @@ ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linea
   REQUIRE_REGISTRY(registry);
   ssStatus status = ssCheckNonNegative("linear_rate_per_s", "1/s", linear_rate_per_s);
   if (status == SS_OK) status = ssCheckNonNegative("angular_rate_per_s", "1/s", angular_rate_per_s);
+  if (status == SS_OK) status = requireRegistryWorld(registry, "damping", body);
   if (status != SS_OK) return status;
   ssBodyBinding* binding = bodyBinding(registry, body);
   if (binding == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding damping");
   binding->has_damping = 1;
   binding->linear_rate_per_s = linear_rate_per_s;
   binding->angular_rate_per_s = angular_rate_per_s;
+  binding->tuned.damping_step_s = 0;
   binding->written_step_s = NAN;
   registry->revision += 1;
   return SS_OK;
@@ -243,12 +256,14 @@ ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double i
   REQUIRE_REGISTRY(registry);
   ssStatus status = ssCheckPositive("idle_time_s", "s", idle_time_s);
   if (status == SS_OK) status = ssCheckNonNegative("average_window_s", "s", average_window_s);
+  if (status == SS_OK) status = requireRegistryWorld(registry, "auto-disable", body);
   if (status != SS_OK) return status;
   ssBodyBinding* binding = bodyBinding(registry, body);
   if (binding == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding auto-disable");
   binding->has_auto_disable = 1;
   binding->idle_time_s = idle_time_s;
   binding->average_window_s = average_window_s;
+  binding->tuned.auto_disable_step_s = 0;
   binding->average_samples_written = 0;
   binding->written_step_s = NAN;
   registry->revision += 1;
@@ -271,12 +286,16 @@ ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body) {
  * (10·(1/60)/(1/60) = 10.000000000000002) must not become one more. */
 static double stepsIn(double seconds, double step_s) { return ceil(seconds / step_s - 1e-9); }
 
+/* The body's numbers for a step of step_s: at the step adoption read them for, the program's own; otherwise what the
+ * rates and seconds stand for at this step. */
 static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
   dBodyID body = binding->body;
+  const ssBodyTuned* tuned = &binding->tuned;
   if (binding->has_damping) {
     /* ODE scales velocity by (1 - scale) once per step: this scale removes the same fraction per second */
-    double linear = -expm1(-binding->linear_rate_per_s * step_s);
-    double angular = -expm1(-binding->angular_rate_per_s * step_s);
+    int as_tuned = step_s == tuned->damping_step_s;
+    double linear = as_tuned ? tuned->linear_scale : -expm1(-binding->linear_rate_per_s * step_s);
+    double angular = as_tuned ? tuned->angular_scale : -expm1(-binding->angular_rate_per_s * step_s);
     if (body) {
       dBodySetLinearDamping(body, linear);
       dBodySetAngularDamping(body, angular);
@@ -286,18 +305,28 @@ static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
     }
   }
   if (binding->has_auto_disable) {
-    double steps = stepsIn(binding->idle_time_s, step_s);
-    int idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
-    double samples = fmax(1.0, stepsIn(binding->average_window_s, step_s));
-    int average_samples = samples < 1e6 ? (int)samples : 1000000;
+    int idle_steps, average_samples;
+    double idle_time_s;
+    if (step_s == tuned->auto_disable_step_s) {
+      idle_steps = tuned->idle_steps;
+      idle_time_s = tuned->idle_time_s;
+      average_samples = tuned->average_samples;
+    } else {
+      double steps = stepsIn(binding->idle_time_s, step_s);
+      idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
+      idle_time_s = binding->idle_time_s;
+      /* ODE allocates two vectors a sample for every body: bounded, see SS_MAX_AVERAGE_SAMPLES */
+      double samples = fmax(1.0, stepsIn(binding->average_window_s, step_s));
+      average_samples = samples < SS_MAX_AVERAGE_SAMPLES ? (int)samples : SS_MAX_AVERAGE_SAMPLES;
+    }
     if (body) {
       dBodySetAutoDisableSteps(body, idle_steps);
-      dBodySetAutoDisableTime(body, binding->idle_time_s);
+      dBodySetAutoDisableTime(body, idle_time_s);
       if (average_samples != binding->average_samples_written)
         dBodySetAutoDisableAverageSamplesCount(body, (unsigned)average_samples);
     } else {
       dWorldSetAutoDisableSteps(world, idle_steps);
-      dWorldSetAutoDisableTime(world, binding->idle_time_s);
+      dWorldSetAutoDisableTime(world, idle_time_s);
       if (average_samples != binding->average_samples_written)
         dWorldSetAutoDisableAverageSamplesCount(world, (unsigned)average_samples);
     }
@@ -341,12 +370,6 @@ void ssRegistrySetTuned(ssRegistry* registry, double tuned_step_s, ssSoftness tu
   registry->tuned_world = tuned_world;
 }
 
-void ssRegistryForgetWorldAdoption(ssRegistry* registry) {
-  registry->revision += 1;
-  registry->world_bound = 0;
-  registry->tuned_step_s = 0;
-  if (ssRegistryHasBody(registry, 0)) ssRegistry_UnbindBody(registry, 0);
-}
 
 ssSoftness ssRegistryTunedWorld(const ssRegistry* registry) { return registry->tuned_world; }
 

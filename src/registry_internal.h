@@ -5,6 +5,18 @@
 #include "row_law.h"
 #include "steadystep/registry.h"
 
+/* What a program had set on a body (or as the world's defaults), read back by adoption: at the step they were tuned
+ * for the registry writes these numbers as they were, since the rates and seconds that stand for them at every other
+ * step give them back only to a rounding (and an idle time the program never set). */
+typedef struct ssBodyTuned {
+  double damping_step_s; /* > 0: the damping scales were read for steps of this length (s); 0: bound by hand */
+  double linear_scale, angular_scale;
+  double auto_disable_step_s; /* > 0: the auto-disable numbers were read for steps of this length (s) */
+  int idle_steps;
+  double idle_time_s;
+  int average_samples;
+} ssBodyTuned;
+
 /* A body's damping and auto-disable, given in seconds. body 0 holds the world's defaults. */
 typedef struct ssBodyBinding {
   dBodyID body;
@@ -12,6 +24,7 @@ typedef struct ssBodyBinding {
   double linear_rate_per_s, angular_rate_per_s;
   int has_auto_disable;
   double idle_time_s, average_window_s;
+  ssBodyTuned tuned;           /* cleared by ssRegistry_BindDamping and ssRegistry_BindAutoDisable */
   int average_samples_written; /* ODE restarts its average whenever the count is set: write it only on change */
   double written_step_s;       /* the step the values were last written for; NAN after a (re)binding */
 } ssBodyBinding;
@@ -45,8 +58,6 @@ ssStatus ssRegistryReserve(ssRegistry* registry, int more_joints, int more_bodie
 /* Adoption's tuned step and the world's ERP/CFM as adopted. */
 void ssRegistrySetTuned(ssRegistry* registry, double tuned_step_s, ssSoftness tuned_world);
 ssSoftness ssRegistryTunedWorld(const ssRegistry* registry);
-/* Undoes ssRegistry_AdoptWorld, when the rest of an adoption failed. */
-void ssRegistryForgetWorldAdoption(ssRegistry* registry);
 
 /* One bound joint row as bound, for the reference Apply (apply_reference.h): no cache, no derived state. */
 typedef struct ssJointRowBinding {

@@ -9,7 +9,9 @@
 #include "steadystep/limits.h"
 #include "matched_internal.h"
 
-ssRowLaw ssRowLawOfSpring(ssSpring spring) { return (ssRowLaw){.spring = spring, .hard = 0, .hard_rate_per_s = 0}; }
+ssRowLaw ssRowLawOfSpring(ssSpring spring) {
+  return (ssRowLaw){.spring = spring, .hard = 0, .hard_rate_per_s = 0, .tuned_step_s = 0, .tuned = {0, 0}};
+}
 
 ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tuned_step_s, ssRowLaw* out) {
   if (!isfinite(erp) || !isfinite(cfm))
@@ -26,11 +28,14 @@ ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tune
       return ssFail(SS_ERROR_OUT_OF_RANGE, "%s: erp = %g, cfm = %g at %g s: too soft to stand for a spring", what,
                     erp, cfm, tuned_step_s);
     *out = ssRowLawOfSpring((ssSpring){stiffness, damping});
+    out->tuned_step_s = tuned_step_s;
+    out->tuned = (ssSoftness){erp, cfm};
     return SS_OK;
   }
   /* hard: the error is corrected at r = k/c = erp/(h0·(1 - erp)) per second, which stays finite as cfm -> 0 */
   double rate = erp == 1 ? INFINITY : erp / (tuned_step_s * (1.0 - erp));
-  *out = (ssRowLaw){.spring = {0, 0}, .hard = 1, .hard_rate_per_s = rate};
+  *out = (ssRowLaw){
+      .spring = {0, 0}, .hard = 1, .hard_rate_per_s = rate, .tuned_step_s = tuned_step_s, .tuned = {erp, cfm}};
   return SS_OK;
 }
 
@@ -46,16 +51,26 @@ ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law) {
   return SS_OK;
 }
 
-ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
-                       ssRowFallback* fallback, ssSoftness* out) {
-  ssRowFallback local;
-  if (fallback == NULL) fallback = &local;
-  *fallback = (ssRowFallback){0, 0};
+/* The implicit-Euler mapping of a law (a hard law's one rule): at the law's tuned step, its tuned numbers. */
+static ssStatus implicitEuler(const ssRowLaw* law, double step_s, ssSoftness* out) {
+  if (step_s == law->tuned_step_s) {
+    *out = law->tuned;
+    return SS_OK;
+  }
   if (law->hard) {
     double rate_h = law->hard_rate_per_s * step_s;
     *out = (ssSoftness){.erp = isinf(rate_h) ? 1.0 : rate_h / (rate_h + 1.0), .cfm = 0};
     return SS_OK;
   }
+  return ssSoftnessFromSpring(law->spring, step_s, out);
+}
+
+ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
+                       ssRowFallback* fallback, ssSoftness* out) {
+  ssRowFallback local;
+  if (fallback == NULL) fallback = &local;
+  *fallback = (ssRowFallback){0, 0};
+  if (law->hard) return implicitEuler(law, step_s, out);
   if (mapping == SS_MAPPING_MATCHED || mapping == SS_MAPPING_EXACT) {
     /* The accurate mappings need a mass, damping (c = 0 puts the poles on the unit circle) and a frequency the
      * step can sample: a near-rigid row above Nyquist has poles that no (erp, cfm) of this step reproduces. */
@@ -77,5 +92,5 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
     fallback->exact_to_matched = 0;
     fallback->to_implicit_euler = 1;
   }
-  return ssSoftnessFromSpring(law->spring, step_s, out);
+  return implicitEuler(law, step_s, out);
 }

@@ -10,6 +10,12 @@ typedef struct ssRowLaw {
   ssSpring spring;        /* when !hard */
   int hard;               /* tuned with cfm = 0: kept at cfm = 0 at every step */
   double hard_rate_per_s; /* hard rows: erp(h) = h·r/(h·r + 1); INFINITY keeps erp = 1 */
+  /* > 0: the law was read from `tuned`, the erp/cfm a program set for steps of this length (s). The implicit-Euler
+   * mapping at that very step gives them back as they were: in exact arithmetic it is the same numbers, but the
+   * round trip through k and c moves them by a rounding, and a program adopted under naive must step bit for bit
+   * as its own stepping. 0: a spring bound as such. */
+  double tuned_step_s;
+  ssSoftness tuned;
 } ssRowLaw;
 
 /* How a row's softness for one step was obtained, beyond the mapping asked for. */
@@ -23,7 +29,8 @@ typedef struct ssRowFallback {
 ssRowLaw ssRowLawOfSpring(ssSpring spring);
 
 /* What erp and cfm tuned at a fixed step tuned_step_s stand for: a spring (cfm > 0, erp in [0, 1]; erp = 0 is a
- * pure damper) or a hard row (cfm = 0). what names the row in messages ("world", "hinge joint 0x.. stop axis 1").
+ * pure damper) or a hard row (cfm = 0), remembering erp and cfm themselves for that step. what names the row in
+ * messages ("world", "hinge joint 0x.. stop axis 1").
  * Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (erp outside [0, 1], cfm < 0). */
 ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tuned_step_s, ssRowLaw* out);
 
@@ -34,8 +41,9 @@ ssStatus ssRowLawFromTuned(const char* what, double erp, double cfm, double tune
  * message. Errors: SS_ERROR_NO_FINITE_MAPPING. */
 ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law);
 
-/* The softness of the row for a step of step_s under mapping. mass (kg or kg·m²) is read by the accurate mappings
- * only; pass NAN when the row has none. Where MATCHED or EXACT cannot serve the row (no mass, c = 0, natural
+/* The softness of the row for a step of step_s under mapping: for a tuned law at its tuned step under implicit Euler
+ * (or a hard law, whose rule is the same under every mapping), the tuned erp/cfm themselves. mass (kg or kg·m²) is
+ * read by the accurate mappings only; pass NAN when the row has none. Where MATCHED or EXACT cannot serve the row (no mass, c = 0, natural
  * frequency above the step's Nyquist frequency, no finite softness) the implicit-Euler mapping serves it and
  * fallback->to_implicit_euler says so. fallback may be NULL. Errors: those of ssSoftnessFromSpring. */
 ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,

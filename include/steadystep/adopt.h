@@ -8,7 +8,14 @@
  *    is still corrected at the same rate per second (erp = 1 stays 1, erp = 0 stays 0);
  *  - a damping scale s (ODE removes the fraction s of a body's velocity every step) is the rate -ln(1 - s)/h0 per s;
  *  - auto-disable after N idle steps and T idle seconds is idle time max(N·h0, T); an average over S > 1 samples is
- *    a window of S·h0 seconds.
+ *    a window of S·h0 seconds (at most SS_MAX_AVERAGE_SAMPLES samples are written, limits.h). A body that never
+ *    samples (S = 0, which ODE never puts to sleep) or that sleeps at once (N = 0, T = 0) is so at every step: its
+ *    auto-disable is left as it is.
+ * At h0 itself (the implicit-Euler mapping at h0, as the naive policy frozen at the tuned step writes at every step;
+ * hard rows and bodies under every mapping), the registry writes back the program's own numbers bit for bit: the
+ * tuned erp/cfm, damping scales, idle steps, idle time (0 stays 0) and sample count, and ssStepper_SoftenContact
+ * gives a contact the program's own soft_erp/soft_cfm (or the world's ERP). Adopted under naive, a program steps as
+ * its own stepping does, to the last bit, at every frame rate.
  * What is adopted: the world's ERP/CFM (hinge, slider, universal, PR, PU and piston read them at every step, and
  * contacts without soft modes use them), the world's damping and auto-disable defaults, and for every joint
  * reachable from the space's geoms through bodies and joints: ball, fixed, double-ball, double-hinge and
@@ -51,10 +58,12 @@ typedef struct ssAdoptReport {
 /** Adopts the world's ERP/CFM and its damping and auto-disable defaults, as tuned at tuned_step_s (s, in
  *  [SS_MIN_STEP_S, SS_MAX_STEP_S]), and everything reachable from space (nested spaces included): the one call a
  *  program makes after building its world. Sets the registry's tuned step, which later adoption calls and
- *  ssStepper_SoftenContact use. report may be NULL. Either everything is bound or, on an error, nothing is.
+ *  ssStepper_SoftenContact use. report may be NULL. Either everything is bound or, on an error, nothing is: every
+ *  binding made before (by hand or by an earlier adoption, the world's included) is left as it was.
  *  Errors: SS_ERROR_OUT_OF_RANGE (registry or space NULL, tuned_step_s out of range, a tuned value outside its range,
- *  named with its joint or body, e.g. erp > 1, cfm < 0 or a cfm too large to stand for a spring, or a tuned step
- *  different from an earlier adoption's); SS_ERROR_NO_FINITE_MAPPING (a tuned row that implicit Euler cannot
+ *  named with its joint or body, e.g. erp > 1, cfm < 0 or a cfm too large to stand for a spring, a tuned step
+ *  different from an earlier adoption's, or a body reached, or a joint's body, of another world than the
+ *  registry's); SS_ERROR_NO_FINITE_MAPPING (a tuned row that implicit Euler cannot
  *  write at every step length, see ssRegistry_BindWorld);
  *  SS_ERROR_NOT_FINITE; SS_ERROR_UNSUPPORTED (a joint of a type ODE 0.16 does not know); SS_ERROR_OUT_OF_MEMORY. */
 SS_API ssStatus ssRegistry_Adopt(ssRegistry* registry, double tuned_step_s, dSpaceID space, ssAdoptReport* report);

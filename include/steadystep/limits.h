@@ -142,6 +142,15 @@
  *  (SS_ERROR_POSITION_LIMIT) before its next step, and a step at max_speed below 1e4 m/s moves at most 3.6e7 m. */
 #define SS_MAX_POSITION_M 1e6
 
+/** The most auto-disable samples the registry writes into a body or the world's defaults: 1000. A window of S
+ *  samples tuned at h0 lasts S·h0 seconds, which takes ceil(S·h0/h) samples at a step h, and ODE allocates two
+ *  vectors a sample for every body (64 bytes in double, 32 in float): 5 samples tuned at 1/60 s stepped at
+ *  SS_MIN_STEP_S would be 8·10^7 samples, 5 GB a body. 1000 samples are 64 kB a body. Beyond the bound (steps
+ *  shorter than the window / 1000, e.g. under 83 µs for 5 samples at 1/60 s), the velocities are averaged over the
+ *  last 1000 steps, a window shorter than the tuned one; the idle time still holds. A program's own count is written
+ *  back as it was at the step it was tuned for (adopt.h), whatever its size. */
+#define SS_MAX_AVERAGE_SAMPLES 1000
+
 /** The shortest and longest frame (s) a lab profile hands out (profile.h): 1e-12 s to SS_MAX_STEP_S. Frames
  *  shorter than SS_MIN_STEP_S are allowed on purpose, to exercise carrying a frame over. */
 #define SS_MIN_PROFILE_FRAME_S 1e-12

@@ -75,8 +75,8 @@ SS_API ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, doub
  *  computed at each Apply from the joint's bodies (ssJointEffectiveMass).
  *  Errors: SS_ERROR_UNSUPPORTED when the joint's type has no such parameter on that axis (ODE itself would ignore
  *  it silently), or for an unknown param; those of ssValidateSpring; SS_ERROR_NO_FINITE_MAPPING as
- *  ssRegistry_BindWorld; SS_ERROR_OUT_OF_RANGE for effective_mass < 0 or a NULL registry or joint;
- *  SS_ERROR_OUT_OF_MEMORY. */
+ *  ssRegistry_BindWorld; SS_ERROR_OUT_OF_RANGE for effective_mass < 0, a NULL registry or joint, or a joint
+ *  attached to a body of another world than the registry's; SS_ERROR_OUT_OF_MEMORY. */
 SS_API ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis,
                                      ssSpring spring, double effective_mass);
 
@@ -103,17 +103,20 @@ SS_API ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint);
  *  registry writes scale = 1 - exp(-rate·h), which removes the same fraction of velocity per second at every step
  *  length. body = NULL binds the world's default damping (dWorldSetLinearDamping/AngularDamping), which ODE copies
  *  into a body when the body is created: bind existing bodies one by one.
- *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE, SS_ERROR_OUT_OF_MEMORY. */
+ *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (also a body of another world than the registry's),
+ *  SS_ERROR_OUT_OF_MEMORY. */
 SS_API ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linear_rate_per_s,
                                        double angular_rate_per_s);
 
 /** Binds auto-disable in seconds: a body at rest for idle_time_s (> 0) is disabled, with its velocity averaged over
  *  average_window_s (>= 0; 0 = the current step only). ODE counts steps, so the registry writes
- *  AutoDisableSteps = ceil(idle/h), AutoDisableTime = idle and AverageSamplesCount = max(1, ceil(window/h)).
+ *  AutoDisableSteps = ceil(idle/h), AutoDisableTime = idle and AverageSamplesCount = max(1, ceil(window/h)), at most
+ *  SS_MAX_AVERAGE_SAMPLES (limits.h: ODE allocates the samples for every body).
  *  body = NULL binds the world's defaults (copied into bodies when they are created). The sample count is written
  *  only when it changes, because ODE restarts a body's velocity average whenever it is set. Enabling auto-disable
  *  and its thresholds stay the program's own choice.
- *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE, SS_ERROR_OUT_OF_MEMORY. */
+ *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (also a body of another world than the registry's),
+ *  SS_ERROR_OUT_OF_MEMORY. */
 SS_API ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double idle_time_s,
                                            double average_window_s);
 

@@ -6,11 +6,14 @@ reset), ``Stepper.soften_contact`` in the near callback, and ``Stepping`` for ho
 conversions (``softness_from_spring`` ..., scalars or numpy arrays), the lab's profiles and runs on built-in scenes
 (``steadystep.runs``, ``steadystep.profiles``), the article's model (``steadystep.article``), metrics, ``sweep`` of
 independent runs over any ``concurrent.futures.Executor`` (``make_executor``: a process pool, Dask); figures and
-the HTML report need the ``report`` extra (``pip install steadystep[report]``). Every failure of the C library
-raises ``SteadystepError`` (a ValueError) naming the value at fault. Importing the package changes no global state.
+the HTML report need the ``report`` extra (``pip install steadystep[report]``). Every failure raises
+``SteadystepError`` naming the value at fault, with ``code`` the C status (``Status``) and ``status`` its name:
+``InvalidValue`` (also a ValueError) for a refused value, ``SimulationFailure`` for a simulation that failed (a
+blow-up, a speed or position limit, a frame after a failure). Importing the package changes no global state and
+parses nothing (the cffi declarations were prepared from the headers when the package was built).
 """
 
-from steadystep._native import SteadystepError
+from steadystep._native import InvalidValue, SimulationFailure, SteadystepError
 from steadystep.convert import (Softness, Spring, exact_softness, frequency_from_spring, matched_softness,
                                 softness_for, softness_from_spring, spring_from_frequency, spring_from_softness)
 from steadystep.enums import FrameCut, JointParam, Mapping, Solver, Status
@@ -22,16 +25,22 @@ from steadystep.stepping import Stepping, policy_names
 from steadystep.study import grid, make_executor, sweep
 
 __all__ = [
-    "AdoptReport", "ApplyReport", "FrameCut", "FrameReport", "JointParam", "Mapping", "Profile", "Registry",
-    "ServedCounts", "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper", "SteadystepError", "Stepping",
-    "contact_soften",
+    "AdoptReport", "ApplyReport", "FrameCut", "FrameReport", "InvalidValue", "JointParam", "Mapping", "Profile",
+    "Registry", "ServedCounts", "SimulationFailure", "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper",
+    "SteadystepError", "Stepping", "contact_soften",
     "exact_softness", "frame_times", "frequency_from_spring", "grid", "joint_effective_mass", "joint_supports",
     "make_executor", "matched_softness", "policy_names", "softness_for", "softness_from_spring",
     "spring_from_frequency", "spring_from_softness", "sweep",
 ]
-try:  # the installed package's version, which the build read from CMakeLists.txt's project()
-    from importlib.metadata import version as _version
 
-    __version__ = _version("steadystep")
-except Exception:  # a source tree without installed metadata
-    __version__ = "unknown"
+
+def __getattr__(name: str):
+    # __version__ on demand: importlib.metadata costs about as much as the rest of the binding's import.
+    if name == "__version__":
+        try:  # the installed package's version, which the build read from CMakeLists.txt's project()
+            from importlib.metadata import version
+
+            return version("steadystep")
+        except Exception:  # a source tree without installed metadata
+            return "unknown"
+    raise AttributeError(f"module 'steadystep' has no attribute {name!r}")

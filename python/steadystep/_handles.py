@@ -12,6 +12,7 @@ from __future__ import annotations
 import ctypes
 
 from steadystep._native import SteadystepError, ffi, shown
+from steadystep.enums import Status
 
 # The kind of handle, as the library's parameter names say it -> (ODE's struct name, the C type of the parameter).
 KINDS = {
@@ -25,7 +26,7 @@ _ADDRESS_LIMIT = 2**64
 
 
 def _wrong(name: str, kind: str, value, what: str) -> SteadystepError:
-    return SteadystepError("out of range", f"{name} = {shown(value)}: {what}; must be an ODE {kind} (an odepy "
+    return SteadystepError(Status.OUT_OF_RANGE, f"{name} = {shown(value)}: {what}; must be an ODE {kind} (an odepy "
                            f"{KINDS[kind][1] if kind in KINDS else 'dContact'} or an integer address)")
 
 

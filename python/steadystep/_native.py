@@ -1,105 +1,70 @@
-"""The binding to libsteadystep: cffi in ABI mode over the packaged headers.
+"""The binding to libsteadystep: cffi in ABI mode, its declarations prepared from the headers when the package is
+built.
 
-The headers are the one source of truth for every struct and function: they are read from the wheel's
-``_native/include`` directory at import time, stripped of what cffi's parser does not take (preprocessor lines,
-``extern "C"`` braces) and handed to ``ffi.cdef``. Nothing is re-typed here, so a field added in C reaches Python
-with the next build. The headers read here (up to ``scene.h``) use no ODE types; ``stepping.h`` holds the stepper's
-settings, so the lab and Python share the one struct and its validator.
+The headers are the one source of truth for every struct and function: the build (CMakeLists.txt, STEADYSTEP_PYTHON)
+runs ``_cdef_build.py`` over them and installs the result as ``steadystep/_native_ffi.py``, cffi's out-of-line ABI
+module, which ``_cffi_backend`` loads without parsing anything. Nothing is typed again here, so a field added in C
+reaches Python with the next build.
 """
 
 from __future__ import annotations
 
-import re
-from pathlib import Path
+import os
 
-import cffi
+from steadystep._native_ffi import ffi
 
-_HERE = Path(__file__).resolve().parent / "_native"
-INCLUDE_DIR = _HERE / "include" / "steadystep"
 # The lab library: the core and the lab in one shared object (the core alone, libsteadystep, is for C programs).
-LIBRARY_PATH = _HERE / "libsteadystep_lab.so"
+LIBRARY_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_native", "libsteadystep_lab.so")
 
-# The headers cffi reads whole, in dependency order.
-_WHOLE_HEADERS = ("status.h", "spring.h", "stepping.h", "lab/profile.h", "lab/scene.h")
-
-_INTEGER_DEFINE = re.compile(r"^\s*#\s*define\s+(\w+)\s+(\d+)\s*$")
-# The export marks (steadystep/export.h, steadystep/lab/export.h) expand to attributes cffi does not parse.
-_EXPORT_MARK = re.compile(r"\bSS_(?:LAB_)?API\b")
+lib = ffi.dlopen(LIBRARY_PATH)
 
 
-def _strip_comments(text: str) -> str:
-    return re.sub(r"/\*.*?\*/|//[^\n]*", " ", text, flags=re.S)
+class SteadystepError(Exception):
+    """A failure of libsteadystep, or a value the binding refused before calling it: ``code`` is the C status
+    (ssStatus, a steadystep.Status value), ``status`` the library's name for it (ssStatusName: "out of range", ...),
+    ``message`` the one line naming the value at fault.
 
+    SteadystepError(code, message) makes the subclass the status belongs to: SimulationFailure for a simulation that
+    failed (a blow-up, a speed or position limit, a frame refused after a failure), InvalidValue (also a ValueError)
+    for a value refused by name, SteadystepError itself for the rest (i/o, memory, re-entry)."""
 
-def _declarations(text: str) -> str:
-    """The header's C declarations: integer #defines kept (cffi understands them), other preprocessor lines and
-    the extern "C" wrapper and the export marks dropped."""
-    kept = []
-    for line in _EXPORT_MARK.sub("", _strip_comments(text)).splitlines():
-        define = _INTEGER_DEFINE.match(line)
-        if define:
-            kept.append(f"#define {define.group(1)} {define.group(2)}")
-        elif line.lstrip().startswith("#"):
-            continue
-        elif line.strip() in ('extern "C" {', "}"):
-            # A lone "}" only closes the extern "C" block: struct and enum bodies close with "} name;".
-            continue
-        else:
-            kept.append(line)
-    return "\n".join(kept)
+    def __new__(cls, *args, **kwargs):
+        if cls is SteadystepError:
+            cls = _ERROR_CLASSES.get(int(args[0] if args else kwargs["code"]), SteadystepError)
+        return super().__new__(cls)
 
-
-def _cdef_source() -> str:
-    return "\n".join(_declarations((INCLUDE_DIR / header).read_text()) for header in _WHOLE_HEADERS)
-
-
-ffi = cffi.FFI()
-ffi.cdef(_cdef_source())
-
-# ---- the core for a program's own ODE world (registry, adoption, stepper) ------------------------------------------
-# These headers take ODE's handles. ODE's own headers are not read: cffi needs only the handles' names, as opaque
-# pointers (the Python side passes addresses, e.g. of an odepy world), dReal (a double build, as Debian's) and
-# dContact, which the library reads and writes through a pointer only. limits.h brings the integer bounds
-# (SS_MAX_RUN_STEPS ...); its floating-point #defines are not kept (cffi's ABI mode takes integer constants only).
-_ODE_HANDLES = """
-typedef struct dxWorld* dWorldID;
-typedef struct dxBody* dBodyID;
-typedef struct dxJoint* dJointID;
-typedef struct dxSpace* dSpaceID;
-typedef struct dxJointGroup* dJointGroupID;
-typedef double dReal;
-typedef struct dContact dContact;
-"""
-_CORE_HEADERS = ("limits.h", "registry.h", "adopt.h", "stepper.h", "interpolation.h")
-
-
-def _core_cdef_source() -> str:
-    return _ODE_HANDLES + "\n".join(_declarations((INCLUDE_DIR / header).read_text()) for header in _CORE_HEADERS)
-
-
-ffi.cdef(_core_cdef_source())
-# ---- end of the core for a program's own world ----------------------------------------------------------------------
-
-lib = ffi.dlopen(str(LIBRARY_PATH))
-
-
-class SteadystepError(ValueError):
-    """A failure reported by libsteadystep: ``status`` is the ssStatus name ("out of range", ...), ``code`` its
-    value, and the message is the library's one line naming the value at fault."""
-
-    def __init__(self, status: str, message: str, code: int = 0):
+    def __init__(self, code: int, message: str = ""):
         super().__init__(message)
-        self.status = status
-        self.code = code
+        self.code = int(code)
+        self.status = status_name(self.code)
         self.message = message
 
     def __str__(self) -> str:
         return f"{self.message} ({self.status})" if self.message else self.status
 
     def __reduce__(self):
-        # Pickled by its three fields (the default would call it with the message alone): a study's worker process
+        # Pickled by code and message (the default would call it with the message alone): a study's worker process
         # hands its refusal back to the caller this way.
-        return type(self), (self.status, self.message, self.code)
+        return type(self), (self.code, self.message)
+
+
+class InvalidValue(SteadystepError, ValueError):
+    """A value refused by name (not finite, out of range, no spring, no finite mapping, unsupported, not found,
+    malformed); nothing was changed."""
+
+
+class SimulationFailure(SteadystepError):
+    """The simulation failed, not an argument: a body blew up (not finite), ran faster than the speed limit or
+    beyond the position limit, or a frame was refused because an earlier one failed (reset the stepper)."""
+
+
+_ERROR_CLASSES = {
+    **dict.fromkeys((lib.SS_ERROR_NOT_FINITE, lib.SS_ERROR_OUT_OF_RANGE, lib.SS_ERROR_NO_SPRING,
+                     lib.SS_ERROR_NO_FINITE_MAPPING, lib.SS_ERROR_UNSUPPORTED, lib.SS_ERROR_NOT_FOUND,
+                     lib.SS_ERROR_PARSE), InvalidValue),
+    **dict.fromkeys((lib.SS_ERROR_BLOWUP, lib.SS_ERROR_SPEED_LIMIT, lib.SS_ERROR_POSITION_LIMIT, lib.SS_ERROR_FAILED),
+                    SimulationFailure),
+}  # the rest (i/o, out of memory, re-entered): SteadystepError itself
 
 
 def _decode(raw: bytes) -> str:
@@ -108,13 +73,14 @@ def _decode(raw: bytes) -> str:
     return raw.decode("utf-8", errors="replace")
 
 
-_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
+# Control characters (C0, DEL, C1) as \\xNN escapes; a table, so that the binding needs no regular expressions.
+_CONTROL_ESCAPES = {code: f"\\x{code:02x}" for code in (*range(0x20), *range(0x7f, 0xa0))}
 
 
 def one_line(message: str) -> str:
     """message as one printable line: control characters (a newline, an escape sequence quoted from a binary
     file) as \\xNN escapes, so that a message can neither span lines nor drive the terminal."""
-    return _CONTROL.sub(lambda match: f"\\x{ord(match.group()):02x}", message)
+    return message.translate(_CONTROL_ESCAPES)
 
 
 def status_name(code: int) -> str:
@@ -128,7 +94,7 @@ def last_error() -> str:
 def check(code: int) -> None:
     """Raises SteadystepError for any status but SS_OK, with the thread's last message."""
     if code != lib.SS_OK:
-        raise SteadystepError(status_name(code), last_error(), int(code))
+        raise SteadystepError(code, last_error())
 
 
 def text(pointer) -> str | None:
@@ -156,35 +122,36 @@ def c_string(name: str, value) -> bytes:
         try:
             raw = value.encode("utf-8", "surrogateescape")
         except UnicodeEncodeError:
-            raise SteadystepError("out of range", f"{name} = {shown(value)}: has characters that are not text "
+            raise SteadystepError(lib.SS_ERROR_OUT_OF_RANGE,
+                                  f"{name} = {shown(value)}: has characters that are not text "
                                   "(lone surrogates)") from None
     elif isinstance(value, (bytes, bytearray)):
         raw = bytes(value)
     else:
-        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be a string")
+        raise SteadystepError(lib.SS_ERROR_OUT_OF_RANGE, f"{name} = {shown(value)}: must be a string")
     if b"\0" in raw:
-        raise SteadystepError("out of range", f"{name} = {shown(value)}: contains a NUL character")
+        raise SteadystepError(lib.SS_ERROR_OUT_OF_RANGE, f"{name} = {shown(value)}: contains a NUL character")
     return raw
 
 
 def number(name: str, value, unit: str = "") -> float:
     """value as a float for the parameter called name; SteadystepError naming it when it is not a number."""
     if isinstance(value, (str, bytes, bytearray)):
-        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be a number{_unit(unit)}")
+        raise SteadystepError(lib.SS_ERROR_OUT_OF_RANGE, f"{name} = {shown(value)}: must be a number{_unit(unit)}")
     try:
         return float(value)
     except (TypeError, ValueError, OverflowError):
-        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be a number{_unit(unit)}"
+        raise SteadystepError(lib.SS_ERROR_OUT_OF_RANGE, f"{name} = {shown(value)}: must be a number{_unit(unit)}"
                               ) from None
 
 
 def integer(name: str, value, low: int, high: int) -> int:
     """value as an int in [low, high] for the parameter called name; SteadystepError naming it otherwise."""
     if isinstance(value, bool) or not hasattr(value, "__index__"):
-        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be an integer")
+        raise SteadystepError(lib.SS_ERROR_OUT_OF_RANGE, f"{name} = {shown(value)}: must be an integer")
     value = value.__index__()
     if not low <= value <= high:
-        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be in [{low}, {high}]")
+        raise SteadystepError(lib.SS_ERROR_OUT_OF_RANGE, f"{name} = {shown(value)}: must be in [{low}, {high}]")
     return value
 
 

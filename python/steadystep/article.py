@@ -21,6 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from steadystep._native import SteadystepError, number, shown
+from steadystep.enums import Status
 
 
 class Oscillator(NamedTuple):
@@ -44,7 +45,7 @@ class Oscillator(NamedTuple):
         rate = self.decay_rate
         square = self.stiffness / self.mass - rate * rate  # inf rather than OverflowError when huge
         if not square > 0:
-            raise SteadystepError("out of range", f"k/m - (c/2m)^2 = {square:g} 1/s^2: no damped oscillation")
+            raise SteadystepError(Status.OUT_OF_RANGE, f"k/m - (c/2m)^2 = {square:g} 1/s^2: no damped oscillation")
         return math.sqrt(square)
 
     @property
@@ -63,13 +64,13 @@ def _validate(osc: Oscillator) -> None:
     for name, unit, value in (("mass", "kg", osc.mass), ("stiffness", "N/m", osc.stiffness),
                               ("damping", "N·s/m", osc.damping)):
         if not math.isfinite(value):
-            raise SteadystepError("not finite", f"{name} = {value} {unit}: must be finite")
+            raise SteadystepError(Status.NOT_FINITE, f"{name} = {value} {unit}: must be finite")
     if osc.mass <= 0:
-        raise SteadystepError("out of range", f"mass = {osc.mass} kg: must be positive")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"mass = {osc.mass} kg: must be positive")
     if osc.stiffness <= 0:
-        raise SteadystepError("out of range", f"stiffness = {osc.stiffness} N/m: must be positive")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"stiffness = {osc.stiffness} N/m: must be positive")
     if osc.damping < 0:
-        raise SteadystepError("out of range", f"damping = {osc.damping} N·s/m: must not be negative")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"damping = {osc.damping} N·s/m: must not be negative")
 
 
 def article_step(osc: Oscillator, x: float, v: float, step_s: float) -> tuple[float, float]:
@@ -93,14 +94,14 @@ def integrate(osc: Oscillator, x0: float, v0: float, steps_s, method: str = "art
     _validate(osc)
     step = {"article": article_step, "implicit": implicit_euler_step}.get(method)
     if step is None:
-        raise SteadystepError("unsupported", f"method = {method!r}: must be 'article' or 'implicit'")
+        raise SteadystepError(Status.UNSUPPORTED, f"method = {method!r}: must be 'article' or 'implicit'")
     x0, v0 = number("x0", x0, "m"), number("v0", v0, "m/s")
     try:
         steps = np.asarray(steps_s, dtype=float)
     except (TypeError, ValueError):
-        raise SteadystepError("out of range", f"steps_s = {shown(steps_s)}: must be step lengths in s") from None
+        raise SteadystepError(Status.OUT_OF_RANGE, f"steps_s = {shown(steps_s)}: must be step lengths in s") from None
     if steps.ndim != 1 or not np.all(np.isfinite(steps)) or np.any(steps <= 0):
-        raise SteadystepError("out of range", "steps_s: every step length must be finite and positive (s)")
+        raise SteadystepError(Status.OUT_OF_RANGE, "steps_s: every step length must be finite and positive (s)")
     t = np.concatenate(([0.0], np.cumsum(steps)))
     x = np.empty(len(steps) + 1)
     v = np.empty(len(steps) + 1)
@@ -115,7 +116,7 @@ def exact_parameters(osc: Oscillator, x0: float, v0: float) -> tuple[float, floa
     _validate(osc)
     x0, v0 = number("x0", x0, "m"), number("v0", v0, "m/s")
     if osc.damping_ratio >= 1.0:
-        raise SteadystepError("out of range", f"damping ratio = {osc.damping_ratio:g}: the exact solution here "
+        raise SteadystepError(Status.OUT_OF_RANGE, f"damping ratio = {osc.damping_ratio:g}: the exact solution here "
                                               "is for weak damping (< 1)")
     w = osc.angular_frequency
     # x0 = C sin α and (v0 + γ x0)/ω = C cos α, γ = c/2m.
@@ -129,7 +130,7 @@ def exact(osc: Oscillator, x0: float, v0: float, t) -> tuple[np.ndarray, np.ndar
     try:
         t = np.asarray(t, dtype=float)
     except (TypeError, ValueError):
-        raise SteadystepError("out of range", f"t = {shown(t)}: must be times in s") from None
+        raise SteadystepError(Status.OUT_OF_RANGE, f"t = {shown(t)}: must be times in s") from None
     w, gamma = osc.angular_frequency, osc.decay_rate
     envelope = amplitude * np.exp(-gamma * t)
     phase = w * t + alpha

@@ -33,6 +33,7 @@ import numpy as np
 
 from steadystep import study
 from steadystep._native import SteadystepError, number, printable
+from steadystep.enums import Status
 from steadystep.audit_run import (OWN, SERVED_COLUMNS, STEP_COLUMN, TIME_COLUMN, BadProgram,
                                   Executable, PythonProgram, PythonWorld, Run)
 from steadystep.audit_run import run as run_program
@@ -98,9 +99,9 @@ def validate(program, profiles, seeds, policies, duration_s: float) -> None:
 
     program.check()
     if not profiles:
-        raise SteadystepError("out of range", "profiles = []: name at least one frame-time profile")
+        raise SteadystepError(Status.OUT_OF_RANGE, "profiles = []: name at least one frame-time profile")
     if not seeds:
-        raise SteadystepError("out of range", "seeds = []: name at least one seed")
+        raise SteadystepError(Status.OUT_OF_RANGE, "seeds = []: name at least one seed")
     for seed in seeds:
         seed_value(seed)
     for profile in profiles:
@@ -108,10 +109,10 @@ def validate(program, profiles, seeds, policies, duration_s: float) -> None:
     known = policy_names()
     for policy in policies:
         if policy not in known:
-            raise SteadystepError("parse error", f"policy = {policy!r}: unknown; use one of {', '.join(known)}")
+            raise SteadystepError(Status.PARSE, f"policy = {policy!r}: unknown; use one of {', '.join(known)}")
     duration_s = number("duration_s", duration_s, "s")
     if not (math.isfinite(duration_s) and duration_s > 0):
-        raise SteadystepError("out of range", f"duration_s = {duration_s!r} s: must be finite and above 0")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"duration_s = {duration_s!r} s: must be finite and above 0")
 
 
 def _unit(program, variant: str, profile: str, seed: int, duration_s: float) -> Run:
@@ -223,18 +224,18 @@ def measure(program, variants: list[str], runs_per_variant, duration_s: float, d
     reference, check = done["reference",], done["check",]
     for name, run in (("reference", reference), ("check of the reference", check)):
         if not run.ok:
-            raise BadProgram("bad program", f"{program.name}: the {name} ({REFERENCE_POLICY}, {run.profile}) "
+            raise BadProgram(f"{program.name}: the {name} ({REFERENCE_POLICY}, {run.profile}) "
                              f"failed, so nothing can be measured: {run.status}")
     for run in (reference, check):  # a program that ignores --profile would measure the same run everywhere
         expected = frame_count(run.profile, duration_s, run.seed)
         if run.frames and abs(run.frames - expected) > 1:
-            raise BadProgram("bad program", f"{program.name}: under --profile {run.profile} --duration "
+            raise BadProgram(f"{program.name}: under --profile {run.profile} --duration "
                              f"{duration_s:g} it printed {run.frames} frames, not the profile's {expected}: it does "
                              "not follow --profile (one CSV row per frame of the profile, after a t = 0 row)")
     quantities = reference.quantities()
     for key, run in done.items():
         if run.quantities() != quantities:
-            raise BadProgram("bad program", f"{program.name}: the {run.variant} run under {run.profile} prints the "
+            raise BadProgram(f"{program.name}: the {run.variant} run under {run.profile} prints the "
                              f"columns {', '.join(run.quantities())}, the reference {', '.join(quantities)}: every "
                              "run must follow the same quantities")
     amplitudes = {q: float(np.ptp(reference.columns[q])) for q in quantities}
@@ -345,7 +346,7 @@ def write(result: Audit, out_dir: Path, command: str, force: bool = False) -> Pa
     out_dir = Path(out_dir)
     found = existing_outputs(out_dir)
     if found and not force:
-        raise SteadystepError("exists", f"{found[0]}: an earlier audit is there; pass --force to replace it, or "
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{found[0]}: an earlier audit is there; pass --force to replace it, or "
                               "--out another directory")
     out_dir.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out_dir / "metrics.json", json.dumps(as_json(result, command), indent=1, allow_nan=False))

@@ -7,6 +7,7 @@ import shlex
 from pathlib import Path
 
 from steadystep._native import SteadystepError
+from steadystep.enums import Status
 
 HELP = ("audit your own program: its frame-rate dependence under every policy, against a checked reference")
 DESCRIPTION = (
@@ -66,19 +67,19 @@ def command(args, argv) -> int:
 
     found = audit.existing_outputs(args.out)
     if found and not args.force:  # refused before anything runs
-        raise SteadystepError("exists", f"{found[0]}: an earlier audit is there; pass --force to replace it, or "
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{found[0]}: an earlier audit is there; pass --force to replace it, or "
                               "--out another directory")
     if args.out.exists() and not args.out.is_dir():
-        raise SteadystepError("exists", f"--out {args.out}: exists and is not a directory")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"--out {args.out}: exists and is not a directory")
     if args.python:
         if args.own:
-            raise SteadystepError("out of range", f"--own {args.own}: a --python program is stepped by the library "
+            raise SteadystepError(Status.OUT_OF_RANGE, f"--own {args.own}: a --python program is stepped by the library "
                                   "and has no own stepping to compare")
         program = PythonProgram(args.python)
     else:
         words = shlex.split(args.program)
         if not words:
-            raise SteadystepError("out of range", "PROGRAM = '': name the program to audit")
+            raise SteadystepError(Status.OUT_OF_RANGE, "PROGRAM = '': name the program to audit")
         own = tuple(shlex.split(args.own)) if args.own else None
         program = Executable(tuple(words), own, args.time_limit)
     audit.validate(program, args.profiles, args.seeds, args.policies or [], args.duration)
@@ -88,7 +89,7 @@ def command(args, argv) -> int:
         with study.make_executor(args.executor) as executor:
             result = audit.audit(program, args.profiles, args.seeds, args.policies, args.duration, executor)
     except study.ExecutorUnavailable as error:
-        raise SteadystepError("out of range", f"steadystep audit: {error}") from None
+        raise SteadystepError(Status.OUT_OF_RANGE, f"steadystep audit: {error}") from None
     path = audit.write(result, args.out, shlex.join(["steadystep", *argv]), force=args.force)
     print(path)
     for claim in result.claims:

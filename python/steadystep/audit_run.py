@@ -36,7 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
-from steadystep._native import SteadystepError, one_line, printable
+from steadystep._native import InvalidValue, SteadystepError, one_line, printable
+from steadystep.enums import Status
 
 OWN = "own"  # the variant name of a program's own stepping (a second program, without the library)
 TIME_COLUMN = "t_s"
@@ -48,12 +49,22 @@ NOT_COUNTED = -1  # a count column holding this on every frame (after the t = 0 
 STDERR_SHOWN = 300  # characters of a program's stderr quoted in a message
 
 
-class BadProgram(SteadystepError):
-    """A program that cannot take part in the audit; the message names the program, the run and the fault."""
+class BadProgram(InvalidValue):
+    """A program that cannot take part in the audit; the message names the program, the run and the fault. The
+    program is a value the audit refuses by name: its code is Status.OUT_OF_RANGE, shown as "(bad program)"."""
+
+    def __init__(self, message: str):
+        super().__init__(Status.OUT_OF_RANGE, message)
+
+    def __str__(self) -> str:
+        return f"{self.message} (bad program)"
+
+    def __reduce__(self):
+        return type(self), (self.message,)
 
 
 def _bad(message: str) -> BadProgram:
-    return BadProgram("bad program", one_line(printable(message)))
+    return BadProgram(one_line(printable(message)))
 
 
 @dataclass(frozen=True)

@@ -2,9 +2,11 @@
 
 Whatever the arguments' bytes, the command never shows a traceback. Exit codes: 0 done; 1 a run blew up or broke
 (its records are still written); 2 a refusal: bad arguments, every SteadystepError, a file that cannot be read or
-written, a --json result that is not finite, with one line on stderr naming the value; 3 an internal error (a bug),
-with one line naming it; 130 interrupted; 141 stdout closed early (a pipe to `head`). Output files are written
-whole (temporary name, then rename). --json output is strict JSON (no NaN or Infinity).
+written, an executor that cannot be had, standard output closed or full, a --json result that is not finite, with
+one line on stderr naming the value; 3 an internal error (a bug), with one line naming it; 130 interrupted; 141
+stdout closed early (a pipe to `head`). Output files are written whole (temporary name, then rename) where PATH is a
+regular file, through a symlink to its target, and in place to a device or a FIFO (steadystep.files).
+--json output is strict JSON (no NaN or Infinity).
 """
 
 from __future__ import annotations
@@ -127,7 +129,10 @@ def _executor_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    # Every list below is the library's (scenes, policies, profiles): no second list here.
+    from steadystep.probe import default_policies
     from steadystep.profiles import DEFAULT_PROFILES
+    from steadystep.runs import policy_names, scene_names
 
     parser = _Parser(prog="steadystep", description="Frame-rate independent constraint softness for ODE: the "
                      "article's figure, comparisons on real ODE scenes, single runs and conversions.",
@@ -156,8 +161,9 @@ def build_parser() -> argparse.ArgumentParser:
     compare.add_argument("--scenes", nargs="+", metavar="SCENE", help="default: every scene")
     compare.add_argument("--profiles", nargs="+", metavar="SPEC", default=list(DEFAULT_PROFILES),
                          help=f"frame-time profiles (default: {' '.join(DEFAULT_PROFILES)})")
+    from steadystep.runs import policy_names  # the library's names: no second list here
     compare.add_argument("--policies", nargs="+", metavar="POLICY",
-                         help="default: naive spring fixed, and also matched exact for the oscillator")
+                         help=f"default: every policy the library names ({' '.join(policy_names())})")
     compare.add_argument("--duration", type=_measured_duration, default=5.0, metavar="S",
                          help=f"simulated seconds per run, at least {MIN_MEASURED_DURATION_S:g} (default 5); the "
                          f"reference's 1 ms steps bound it to {MAX_RUN_STEPS / 1000:.0f} s")
@@ -179,12 +185,9 @@ def build_parser() -> argparse.ArgumentParser:
                               "1, when it blows up or breaks: leaves one of the scene's sanity bounds (a torn joint, a "
                               "box through the floor, energy made; the status and message say which). "
                               + RUN_BOUND_HELP)
-    from steadystep.runs import scenes  # the library's table: no second list here
-    scene_names = ", ".join(info.name for info in scenes())
-    run.add_argument("scene", metavar="SCENE", help=scene_names)
+    run.add_argument("scene", metavar="SCENE", help=", ".join(scene_names()))
     run.add_argument("--profile", required=True, metavar="SPEC",
                      help="fixed:FPS, uniform:MIN:MAX, jitter:FPS:MS, hitch:FPS:EVERY:S, vsync:A:B or trace:FILE")
-    from steadystep.runs import policy_names  # the library's names: no second list here
     run.add_argument("--policy", required=True, metavar="P", help=", ".join(policy_names()))
     run.add_argument("--duration", type=_positive_float, default=5.0, metavar="S",
                      help=f"seconds (default 5), at most {MAX_RUN_STEPS:.0e} steps of --max-step")
@@ -199,9 +202,10 @@ def build_parser() -> argparse.ArgumentParser:
                                 "which SCENE stays stable: no blow-up, and its motion within the reference run's "
                                 "range widened by that range on both sides. A trial at --low may take at most "
                                 f"{MAX_RUN_STEPS:.0e} steps.")
-    probe.add_argument("scene", metavar="SCENE", help=scene_names)
-    probe.add_argument("--policies", nargs="+", metavar="POLICY", default=["naive", "implicit-euler", "matched", "exact"],
-                       help="default: naive spring matched exact")
+    probe.add_argument("scene", metavar="SCENE", help=", ".join(scene_names()))
+    probe.add_argument("--policies", nargs="+", metavar="POLICY", default=default_policies(),
+                       help=f"default: {' '.join(default_policies())} (the policies without a fixed step of their "
+                       "own)")
     probe.add_argument("--duration", type=_measured_duration, default=3.0, metavar="S",
                        help=f"seconds per trial, at least {MIN_MEASURED_DURATION_S:g} (default 3)")
     probe.add_argument("--low", type=_positive_float, default=0.001, metavar="S",
@@ -446,7 +450,29 @@ def _dispatch(argv: list[str]) -> int:
 
     handler = {"figure": _figure, "compare": _compare, "run": _run, "probe": _probe,
                "convert": _convert, "audit": audit_cli.command}[args.command]
-    return handler(args, argv)
+    if sys.stdout is None and not (args.command == "run" and args.csv):
+        # Started with its standard output closed (>&-): Python then has no sys.stdout at all.
+        raise _UsageError(f"steadystep {args.command}: standard output is closed, so the results have nowhere to go "
+                          "(redirect it: >FILE or >/dev/null)")
+    code = handler(args, argv)
+    if sys.stdout is not None:
+        try:
+            sys.stdout.flush()  # here, so that a full disk or device (>/dev/full) is a refusal, not a lost write
+        except BrokenPipeError:
+            raise
+        except OSError as error:
+            _silence_stdout()
+            raise _UsageError(f"steadystep {args.command}: cannot write standard output: "
+                              f"{error.strerror or error}") from None
+    return code
+
+
+def _silence_stdout() -> None:
+    """Points standard output at /dev/null, so that nothing is flushed (and fails again) at exit."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError, io.UnsupportedOperation):
+        pass
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -464,10 +490,7 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     except BrokenPipeError:
         # The reader went away (`steadystep run ... | head`): nothing more to say, and nothing to flush at exit.
-        try:
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        except (OSError, ValueError, AttributeError, io.UnsupportedOperation):
-            pass
+        _silence_stdout()
         return EXIT_BROKEN_PIPE
     except OSError as error:
         filename = error.filename if isinstance(error.filename, str) else ""

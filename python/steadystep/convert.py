@@ -13,13 +13,14 @@ here (a spring is a pair): pass np.asarray(...) to convert many.
 from __future__ import annotations
 
 import math
+import sys
 from typing import NamedTuple
 
-import numpy as np
+from steadystep._native import SteadystepError, check, ffi, lib, number, shown, text
+from steadystep.enums import Mapping, Status
 
-from steadystep._native import SteadystepError, check, ffi, lib, number, shown
-
-MAPPINGS = {"implicit-euler": lib.SS_MAPPING_IMPLICIT_EULER, "matched": lib.SS_MAPPING_MATCHED, "exact": lib.SS_MAPPING_EXACT}
+# The mappings by the library's names for them (ssMappingName: "implicit-euler", "matched", "exact").
+MAPPINGS = {text(lib.ssMappingName(mapping)): int(mapping) for mapping in Mapping}
 
 
 class Spring(NamedTuple):
@@ -40,7 +41,8 @@ def _spring(spring: Spring | tuple[float, float]) -> dict:
     try:
         k, c = spring
     except (TypeError, ValueError):
-        raise SteadystepError("out of range", f"spring = {shown(spring)}: must be a pair (k N/m, c N·s/m)") from None
+        raise SteadystepError(Status.OUT_OF_RANGE,
+                              f"spring = {shown(spring)}: must be a pair (k N/m, c N·s/m)") from None
     return {"stiffness": number("k", k, "N/m"), "damping": number("c", c, "N·s/m")}
 
 
@@ -55,10 +57,11 @@ def _checked(what: str, inputs: dict, status: int, outputs) -> None:
     try:
         check(status)
     except SteadystepError as error:
-        raise SteadystepError(error.status, f"{_given(what, inputs)}: {error.message}", error.code) from None
+        raise SteadystepError(error.code, f"{_given(what, inputs)}: {error.message}") from None
     for name, value in outputs().items():
         if not math.isfinite(value):
-            raise SteadystepError("not finite", f"{_given(what, inputs)}: {name} = {value}: the result is not finite")
+            raise SteadystepError(Status.NOT_FINITE,
+                                  f"{_given(what, inputs)}: {name} = {value}: the result is not finite")
 
 
 def _softness_from_spring(spring: Spring | tuple[float, float], step_s: float) -> Softness:
@@ -75,7 +78,7 @@ def _spring_from_softness(softness: Softness | tuple[float, float], step_s: floa
     try:
         erp, cfm = softness
     except (TypeError, ValueError):
-        raise SteadystepError("out of range", f"softness = {shown(softness)}: must be a pair (erp, cfm)") from None
+        raise SteadystepError(Status.OUT_OF_RANGE, f"softness = {shown(softness)}: must be a pair (erp, cfm)") from None
     erp, cfm, step_s = number("erp", erp), number("cfm", cfm, "m/(N·s)"), number("step_s", step_s, "s")
     out = ffi.new("ssSpring*")
     _checked("spring_from_softness", {"erp": erp, "cfm": cfm, "step_s": step_s},
@@ -124,7 +127,7 @@ def _softness_for(mapping: str, spring: Spring | tuple[float, float], mass: floa
                  previous_step_s: float = 0.0) -> Softness:
     """Any mapping by name ("implicit-euler", "matched", "exact")."""
     if not isinstance(mapping, str) or mapping not in MAPPINGS:
-        raise SteadystepError("unsupported", f"mapping = {shown(mapping)}: must be one of {', '.join(MAPPINGS)}")
+        raise SteadystepError(Status.UNSUPPORTED, f"mapping = {shown(mapping)}: must be one of {', '.join(MAPPINGS)}")
     return _mapped(f"softness_for[{mapping}]", lambda *args: lib.ssSoftnessFor(MAPPINGS[mapping], *args), spring,
                    mass, step_s, previous_step_s)
 
@@ -143,7 +146,10 @@ def _mapped(what: str, function, spring, mass, step_s, previous_step_s) -> Softn
 # ---- elementwise over numpy arrays ---------------------------------------------------------------------------------
 
 def _is_array(value) -> bool:
-    return isinstance(value, np.ndarray) and value.ndim > 0
+    # numpy is imported only by a program that has arrays to convert: without it loaded, nothing is an array (and
+    # `import steadystep` stays without numpy's import time).
+    numpy = sys.modules.get("numpy")
+    return numpy is not None and isinstance(value, numpy.ndarray) and value.ndim > 0
 
 
 def _elementwise(scalar, result_type, names: tuple[str, ...], *values):
@@ -151,11 +157,12 @@ def _elementwise(scalar, result_type, names: tuple[str, ...], *values):
     results gathered into arrays of the broadcast shape (as result_type, or a tuple)."""
     if not any(_is_array(value) for value in values):
         return scalar(*values)
+    import numpy as np
     try:
         shape = np.broadcast_shapes(*(np.shape(value) for value in values))
     except ValueError:
         shapes = ", ".join(f"{name} {np.shape(value)}" for name, value in zip(names, values))
-        raise SteadystepError("out of range", f"shapes {shapes}: cannot be broadcast together") from None
+        raise SteadystepError(Status.OUT_OF_RANGE, f"shapes {shapes}: cannot be broadcast together") from None
     columns = [np.broadcast_to(value, shape) if _is_array(value) else None for value in values]
     outputs = None
     for index in np.ndindex(shape):
@@ -163,7 +170,7 @@ def _elementwise(scalar, result_type, names: tuple[str, ...], *values):
         try:
             result = scalar(*element)
         except SteadystepError as error:
-            raise SteadystepError(error.status, f"at index {index}: {error.message}", error.code) from None
+            raise SteadystepError(error.code, f"at index {index}: {error.message}") from None
         if outputs is None:
             outputs = [np.empty(shape) for _ in result]
         for output, number_ in zip(outputs, result):
@@ -180,7 +187,7 @@ def _pair(value, what: str, names: str):
     try:
         first, second = value
     except (TypeError, ValueError):
-        raise SteadystepError("out of range", f"{what} = {shown(value)}: must be a pair ({names})") from None
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{what} = {shown(value)}: must be a pair ({names})") from None
     return first, second
 
 

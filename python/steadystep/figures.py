@@ -20,21 +20,17 @@ from matplotlib.lines import Line2D
 
 from steadystep import article, runs
 from steadystep._native import SteadystepError, number, printable
+from steadystep.enums import Status
 from steadystep.limits import MIN_MEASURED_DURATION_S
 from steadystep.profiles import seed_value
 from steadystep.files import save_figure
 from steadystep.profiles import frame_times
 
-POLICY_COLORS = {
-    "naive": "#e6550d",    # orange
-    "substeps-frozen": "#fdae6b",  # light orange: naive's softness, implicit-euler's cut
-    "implicit-euler": "#756bb1",   # purple
-    "matched": "#8c6d31",  # brown
-    "exact": "#17becf",    # cyan
-    "fixed": "#636363",    # grey
-    "fixed-matched": "#d6616b",  # rose
-    "fixed-exact": "#31a354",    # green
-}
+# One colour per policy, in the library's order of its policies (naive, substeps-frozen, implicit-euler, matched,
+# exact, fixed, fixed-matched, fixed-exact): orange, light orange (naive's softness, implicit-euler's cut), purple,
+# brown, cyan, grey, rose, green. A policy the library adds beyond these is drawn dark grey until it gets its own.
+_POLICY_PALETTE = ("#e6550d", "#fdae6b", "#756bb1", "#8c6d31", "#17becf", "#636363", "#d6616b", "#31a354")
+POLICY_COLORS = dict(zip(runs.policy_names(), _POLICY_PALETTE))
 REFERENCE_COLOR = "#000000"
 EXACT_COLOR = "#1f5fbf"      # the article's blue
 FIXED_30_COLOR = "#d62728"   # the article's red
@@ -84,7 +80,7 @@ def article_figure(out_dir: Path, duration_s: float = 5.0, seed: int = 1) -> lis
     """
     duration_s, seed = number("duration_s", duration_s, "s"), seed_value(seed)
     if not duration_s >= MIN_MEASURED_DURATION_S:
-        raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: the figure needs at least "
+        raise SteadystepError(Status.OUT_OF_RANGE, f"duration_s = {duration_s:g} s: the figure needs at least "
                               f"{MIN_MEASURED_DURATION_S:g} s")
     one_step_per_frame = {"max_step_s": 1.0 / 15.0}
     for profile in ("fixed:30", "uniform:15:45"):

@@ -1,37 +1,64 @@
-"""Writing output files whole or not at all: each is written to a temporary name in its own directory and renamed
-over the target, so a reader (or a crash) never sees half a file."""
+"""Writing output files without changing what their path is.
+
+A regular file (or a path that does not exist yet) is written whole or not at all: to a temporary name in its own
+directory, then renamed over it, so a reader (or a crash) never sees half a file. Through a symlink, the file it
+points to is written that way and the symlink stays. Anything else at the path (a character device such as
+/dev/null or /dev/full, a FIFO) is written in place, as a shell redirection would: renaming over it would replace
+the device node or the pipe with a regular file. A failure raises OSError naming the path as given, never the
+temporary file.
+"""
 
 from __future__ import annotations
 
+import errno
+import io
 import os
+import stat
 import tempfile
-from collections.abc import Callable
 from pathlib import Path
 
 
-def atomic_write(path: str | Path, write: Callable[[Path], None]) -> Path:
-    """Calls write(temporary_path) and renames the result to path. The directory must exist."""
-    path = Path(path)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix, dir=path.parent)
-    os.close(handle)
+def write_bytes(path: str | Path, data: bytes) -> Path:
+    """Writes data to path (see the module's docstring) and returns path. The directory must exist."""
+    given = Path(path)
     try:
-        write(Path(temporary))
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
+        _write(Path(os.path.realpath(given)), data)
+    except OSError as error:
+        raise OSError(error.errno, error.strerror or str(error), str(given)) from None
+    return given
+
+
+def _write(target: Path, data: bytes) -> None:
+    try:
+        mode = os.stat(target).st_mode
+    except FileNotFoundError:
+        mode = None
+    if mode is not None and stat.S_ISDIR(mode):
+        raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR))
+    if mode is not None and not stat.S_ISREG(mode):
+        with open(target, "wb") as out:  # a device or a FIFO (which waits for its reader): in place
+            out.write(data)
+        return
+    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(handle, "wb") as out:
+            out.write(data)
+        os.chmod(temporary, stat.S_IMODE(mode) if mode is not None else 0o644)
+        os.replace(temporary, target)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
-    return path
 
 
 def atomic_write_text(path: str | Path, content: str) -> Path:
-    """Writes text (UTF-8) to path atomically. A lone surrogate (an argument that was not UTF-8, quoted in a report)
-    is written as its backslash escape rather than failing the write."""
-    return atomic_write(path, lambda temporary: temporary.write_text(content, encoding="utf-8",
-                                                                       errors="backslashreplace"))
+    """Writes text (UTF-8) to path. A lone surrogate (an argument that was not UTF-8, quoted in a report) is written
+    as its backslash escape rather than failing the write."""
+    return write_bytes(path, content.encode("utf-8", errors="backslashreplace"))
 
 
 def save_figure(figure, path: str | Path) -> Path:
-    """Saves a matplotlib figure atomically; the format follows path's suffix (.png, .svg)."""
+    """Saves a matplotlib figure to path; the format follows path's suffix (.png, .svg)."""
     path = Path(path)
-    return atomic_write(path, lambda temporary: figure.savefig(temporary, format=path.suffix[1:], dpi=150))
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format=path.suffix[1:], dpi=150)
+    return write_bytes(path, buffer.getvalue())

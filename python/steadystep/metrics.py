@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from steadystep._native import SteadystepError, number, shown
+from steadystep.enums import Status
 
 
 def _samples(name: str, values) -> np.ndarray:
@@ -17,9 +18,9 @@ def _samples(name: str, values) -> np.ndarray:
     try:
         array = np.asarray(values, float)
     except (TypeError, ValueError):
-        raise SteadystepError("out of range", f"{name} = {shown(values)}: must be an array of numbers") from None
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{name} = {shown(values)}: must be an array of numbers") from None
     if array.ndim != 1:
-        raise SteadystepError("out of range", f"{name}: must be one-dimensional, not of shape {array.shape}")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{name}: must be one-dimensional, not of shape {array.shape}")
     return array
 
 
@@ -31,14 +32,14 @@ def rms_deviation(t, y, reference_t, reference_y) -> float:
     t, y = _samples("t", t), _samples("y", y)
     reference_t, reference_y = _samples("reference_t", reference_t), _samples("reference_y", reference_y)
     if len(t) != len(y) or len(reference_t) != len(reference_y):
-        raise SteadystepError("out of range", "rms_deviation: t and y, and the reference's t and y, must match")
+        raise SteadystepError(Status.OUT_OF_RANGE, "rms_deviation: t and y, and the reference's t and y, must match")
     if len(t) == 0 or len(reference_t) < 2:
-        raise SteadystepError("out of range", "rms_deviation: needs samples and a reference of two or more")
+        raise SteadystepError(Status.OUT_OF_RANGE, "rms_deviation: needs samples and a reference of two or more")
     if not np.all(np.isfinite(y)):
         return math.inf
     inside = (t >= reference_t[0]) & (t <= reference_t[-1])
     if not np.any(inside):
-        raise SteadystepError("out of range", "rms_deviation: no sample lies within the reference's time span")
+        raise SteadystepError(Status.OUT_OF_RANGE, "rms_deviation: no sample lies within the reference's time span")
     difference = y[inside] - np.interp(t[inside], reference_t, reference_y)
     amplitude = float(np.max(reference_y) - np.min(reference_y))
     rms = float(np.sqrt(np.mean(difference**2)))
@@ -51,9 +52,9 @@ def rms_vs_exact(x, exact_x, x0: float) -> float:
     """RMS of x minus the exact solution at the same times, relative to |x0| (m/m). inf after a blow-up."""
     x, exact_x, x0 = _samples("x", x), _samples("exact_x", exact_x), number("x0", x0, "m")
     if len(x) != len(exact_x):
-        raise SteadystepError("out of range", f"rms_vs_exact: {len(x)} samples against {len(exact_x)} exact ones")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"rms_vs_exact: {len(x)} samples against {len(exact_x)} exact ones")
     if x0 == 0 or not math.isfinite(x0):
-        raise SteadystepError("out of range", f"x0 = {x0} m: must be finite and non-zero")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"x0 = {x0} m: must be finite and non-zero")
     if not np.all(np.isfinite(x)):
         return math.inf
     return float(np.sqrt(np.mean((x - exact_x) ** 2)) / abs(x0))
@@ -63,7 +64,7 @@ def spread(deviations) -> float:
     """The spread of a policy across profiles: the RMS over profiles of each profile's deviation."""
     values = _samples("deviations", list(deviations))
     if len(values) == 0:
-        raise SteadystepError("out of range", "spread: needs at least one profile's deviation")
+        raise SteadystepError(Status.OUT_OF_RANGE, "spread: needs at least one profile's deviation")
     return float(np.sqrt(np.mean(values**2)))
 
 
@@ -95,18 +96,18 @@ def _prony(t: np.ndarray, x: np.ndarray) -> tuple[float, float]:
     grid = grid[grid <= t[-1]]
     u = np.interp(grid, t, x)
     if len(u) < 8:
-        raise SteadystepError("out of range", "fit_oscillation: needs at least 8 samples")
+        raise SteadystepError(Status.OUT_OF_RANGE, "fit_oscillation: needs at least 8 samples")
     design = np.column_stack((u[1:-1], u[:-2], np.ones(len(u) - 2)))
     solution = _least_squares(design, u[2:])
     if solution is None or not np.all(np.isfinite(solution)) or not math.isfinite(spacing) or spacing <= 0:
-        raise SteadystepError("out of range", "fit_oscillation: the samples do not fit in double precision")
+        raise SteadystepError(Status.OUT_OF_RANGE, "fit_oscillation: the samples do not fit in double precision")
     a1, a2, _ = solution
     if a2 >= 0:
-        raise SteadystepError("out of range", "fit_oscillation: the trajectory does not oscillate")
+        raise SteadystepError(Status.OUT_OF_RANGE, "fit_oscillation: the trajectory does not oscillate")
     r = math.sqrt(-a2)
     cosine = a1 / (2.0 * r)
     if not -1.0 < cosine < 1.0:
-        raise SteadystepError("out of range", "fit_oscillation: the trajectory does not oscillate")
+        raise SteadystepError(Status.OUT_OF_RANGE, "fit_oscillation: the trajectory does not oscillate")
     return -math.log(r) / spacing, math.acos(cosine) / spacing
 
 
@@ -130,11 +131,11 @@ def fit_oscillation(t, x) -> tuple[float, float]:
     t, x = _samples("t", t), _samples("x", x)
     if (t.shape != x.shape or len(t) < 8 or not np.all(np.isfinite(x)) or not np.all(np.isfinite(t))
             or np.any(np.diff(t) <= 0)):
-        raise SteadystepError("out of range", "fit_oscillation: needs 8 or more finite samples at rising times")
+        raise SteadystepError(Status.OUT_OF_RANGE, "fit_oscillation: needs 8 or more finite samples at rising times")
     # γ and ω do not depend on the amplitude: fitting x / max|x| keeps every product far from overflow.
     scale = float(np.max(np.abs(x)))
     if scale == 0:
-        raise SteadystepError("out of range", "fit_oscillation: the trajectory does not oscillate")
+        raise SteadystepError(Status.OUT_OF_RANGE, "fit_oscillation: the trajectory does not oscillate")
     t, x = t - t[0], x / scale
     params = np.array(_prony(t, x))
     damping = 1e-3
@@ -164,5 +165,5 @@ def fit_oscillation(t, x) -> tuple[float, float]:
         if not improved or change < 1e-13:
             break
     if not np.all(np.isfinite(params)):
-        raise SteadystepError("out of range", "fit_oscillation: the fit does not converge to finite values")
+        raise SteadystepError(Status.OUT_OF_RANGE, "fit_oscillation: the fit does not converge to finite values")
     return float(params[0]), float(params[1])

@@ -16,11 +16,20 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from steadystep import runs
-from steadystep._native import SteadystepError, number
+from steadystep._native import SteadystepError, lib, number
+from steadystep.enums import Status
 from steadystep.limits import MAX_RUN_STEPS, MIN_MEASURED_DURATION_S
 
 DEFAULT_LOW_S = 1.0 / 1000.0
 DEFAULT_HIGH_S = 0.25
+
+
+def default_policies() -> list[str]:
+    """The library's policies that do not cut frames at a fixed step of their own (naive, implicit-euler, matched,
+    exact): with every frame one step of h, a fixed policy steps as its mapping's substep policy does."""
+    return [policy for policy in runs.policy_names() if runs.make_stepping(policy)["cut"] != lib.SS_CUT_FIXED]
+
+
 # Below this the bisection's midpoint would no longer move between its ends in double precision.
 MIN_TOLERANCE = 1e-9
 
@@ -45,7 +54,7 @@ def _trial(scene: str, policy: str, step_s: float, duration_s: float, bounds: di
                           stepping={"max_step_s": step_s, "fixed_step_s": step_s})
     except SteadystepError as error:
         if error.status != "no finite mapping":  # a mapping with nothing to offer at this step is a failure of it
-            raise SteadystepError(error.status, f"{name} = {step_s:g} s: {error.message}", error.code) from None
+            raise SteadystepError(error.code, f"{name} = {step_s:g} s: {error.message}") from None
         return f"{error.status}: {error.message}"
     if result.failed:  # blew up or broke
         return f"{result.status}: {result.message}"
@@ -67,17 +76,17 @@ def largest_stable_step(scene: str, policy: str, duration_s: float = 3.0, low_s:
     for name, value in (("duration_s", duration_s), ("low_s", low_s), ("high_s", high_s), ("tolerance", tolerance)):
         value = values[name] = number(name, value)
         if not math.isfinite(value) or value <= 0:
-            raise SteadystepError("out of range", f"{name} = {value}: must be a positive finite number")
+            raise SteadystepError(Status.OUT_OF_RANGE, f"{name} = {value}: must be a positive finite number")
     duration_s, low_s, high_s, tolerance = values.values()
     if duration_s < MIN_MEASURED_DURATION_S:
-        raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: a trial needs at least "
+        raise SteadystepError(Status.OUT_OF_RANGE, f"duration_s = {duration_s:g} s: a trial needs at least "
                               f"{MIN_MEASURED_DURATION_S:g} s to be measured")
     if tolerance < MIN_TOLERANCE:
-        raise SteadystepError("out of range", f"tolerance = {tolerance:g}: must be at least {MIN_TOLERANCE:g}")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"tolerance = {tolerance:g}: must be at least {MIN_TOLERANCE:g}")
     if low_s >= high_s:
-        raise SteadystepError("out of range", f"low_s = {low_s} s: must be shorter than high_s = {high_s} s")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"low_s = {low_s} s: must be shorter than high_s = {high_s} s")
     if duration_s / low_s > MAX_RUN_STEPS:
-        raise SteadystepError("out of range", f"low_s = {low_s:g} s: a trial of duration_s = {duration_s:g} s "
+        raise SteadystepError(Status.OUT_OF_RANGE, f"low_s = {low_s:g} s: a trial of duration_s = {duration_s:g} s "
                               f"would take more than the bound of {MAX_RUN_STEPS} steps per run")
     reference = runs.reference_run(scene, duration_s, params)
     bounds = {}

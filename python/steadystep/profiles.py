@@ -8,11 +8,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from steadystep._native import SteadystepError, c_string, check, ffi, integer, lib, number, shown
+from steadystep.enums import Status
 from steadystep.limits import MAX_RUN_FRAMES
+
+if TYPE_CHECKING:  # numpy is imported where an array is made, not by `import steadystep`
+    import numpy as np
 
 DEFAULT_PROFILES = ("fixed:30", "uniform:15:45", "jitter:30:3", "hitch:60:30:0.1", "vsync:60:30")
 SEED_RANGE = (0, 2**64 - 1)
@@ -42,6 +45,8 @@ class Profile:
     def frames(self, count: int) -> np.ndarray:
         """The next `count` frame durations (s); count in [0, MAX_RUN_FRAMES] (limits.py)."""
         count = integer("count", count, 0, MAX_RUN_FRAMES)
+        import numpy as np
+
         return np.array([lib.ssProfile_Next(self._profile) for _ in range(count)], dtype=float)
 
     def reset(self) -> None:
@@ -68,7 +73,8 @@ def frames_within(spec: str, duration_s: float, seed: int = 1) -> Iterator[float
     while duration_s - elapsed_s > end_tolerance_s:
         frame_s = next_frame(handle)
         if not (math.isfinite(frame_s) and frame_s > 0):
-            raise SteadystepError("out of range", f"profile = {shown(spec)}: frame {count + 1} lasts {frame_s!r} s, "
+            raise SteadystepError(Status.OUT_OF_RANGE,
+                                  f"profile = {shown(spec)}: frame {count + 1} lasts {frame_s!r} s, "
                                   "not a finite positive duration")
         frame_s = min(frame_s, duration_s - elapsed_s)
         elapsed_s += frame_s

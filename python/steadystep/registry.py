@@ -13,64 +13,47 @@ body must be unbound (or destroyed through Stepper.destroy_joint/destroy_body) b
 
 from __future__ import annotations
 
-import dataclasses
-from dataclasses import dataclass, field
+import weakref
 
 from steadystep import _handles
-from steadystep._native import SteadystepError, check, ffi, integer, last_error, lib, number, shown, status_name
+from steadystep._native import SteadystepError, check, ffi, integer, last_error, lib, number, shown
+from steadystep._structs import StructView
 from steadystep.convert import Spring
-from steadystep.enums import JointParam, Mapping
+from steadystep.enums import JointParam, Mapping, Status
 
 
-def from_struct(cls, cdata):
-    """A dataclass of the C struct's fields (the dataclass declares the same names; nested dataclasses too)."""
-    values = {}
-    for item in dataclasses.fields(cls):
-        value = getattr(cdata, item.name)
-        nested = item.metadata.get("struct")
-        values[item.name] = from_struct(nested, value) if nested else item.metadata.get("convert", lambda v: v)(value)
-    return cls(**values)
+class ServedCounts(StructView, c_type="ssServedCounts"):
+    """Who served the rows or contacts of a step, or of a frame summed over its steps (ssServedCounts), read-only;
+    each row or contact is counted once, in one of: by_mapping (the stepping's own mapping: every one under implicit
+    Euler), handed_to_matched (exact only: no finite exact softness at this step length), handed_to_implicit_euler
+    (matched/exact only: above the step's Nyquist frequency, undamped, no effective mass, a static load, no finite
+    softness)."""
+
+    __slots__ = ()
 
 
-@dataclass(frozen=True)
-class ServedCounts:
-    """Who served the rows or contacts of a step, or of a frame summed over its steps (ssServedCounts); each row or
-    contact is counted once, in one of the three."""
+class ApplyReport(StructView, c_type="ssApplyReport"):
+    """What one Apply did (ssApplyReport), read-only: rows (ServedCounts: every bound row, the world's included,
+    once), row_writes (parameter sets actually written into ODE; unchanged values are skipped)."""
 
-    by_mapping: int                # served by the stepping's own mapping (every one under implicit Euler)
-    handed_to_matched: int         # exact only: served by matched (no finite exact softness at this step length)
-    handed_to_implicit_euler: int  # matched/exact only: served by implicit Euler (above the step's Nyquist
-    #                                frequency, undamped, no effective mass, a static load, no finite softness)
+    __slots__ = ()
 
 
-@dataclass(frozen=True)
-class ApplyReport:
-    """What one Apply did (ssApplyReport)."""
+class AdoptReport(StructView, c_type="ssAdoptReport"):
+    """What one adoption call bound, by kind (ssAdoptReport, adopt.h), read-only: world (1 when the world's ERP/CFM
+    were adopted), joints, their rows by kind (joint_rows, stop_rows, motor_rows, suspension_rows), hard_rows (of
+    those, tuned with cfm = 0, kept hard), bodies (known to the stepper), skipped_joints (contact, null, plane-2D),
+    and any field adopt.h adds (FIELDS lists them)."""
 
-    rows: ServedCounts = field(metadata={"struct": ServedCounts})  # every bound row, the world's included, once
-    row_writes: int  # parameter sets actually written into ODE (unchanged values are skipped)
-
-
-@dataclass(frozen=True)
-class AdoptReport:
-    """What one adoption call bound, by kind (ssAdoptReport)."""
-
-    world: int            # 1 when the world's ERP/CFM were adopted
-    joints: int           # joints adopted
-    joint_rows: int       # JointParam.JOINT sets (ball, fixed, double ball, double hinge, transmission)
-    stop_rows: int        # JointParam.STOP sets, one per axis
-    motor_rows: int       # JointParam.MOTOR sets, one per axis
-    suspension_rows: int  # JointParam.SUSPENSION sets
-    hard_rows: int        # of all rows above (world included), those tuned with cfm = 0, kept hard
-    bodies: int           # bodies adopted (known to the stepper; damping and auto-disable bound in seconds)
-    skipped_joints: int   # contact, null and plane-2D joints
+    __slots__ = ()
 
 
 def _spring(spring) -> dict:
     try:
         k, c = spring
     except (TypeError, ValueError):
-        raise SteadystepError("out of range", f"spring = {shown(spring)}: must be a Spring(k N/m, c N·s/m)") from None
+        raise SteadystepError(Status.OUT_OF_RANGE,
+                              f"spring = {shown(spring)}: must be a Spring(k N/m, c N·s/m)") from None
     return {"stiffness": number("k", k, "N/m"), "damping": number("c", c, "N·s/m")}
 
 
@@ -97,9 +80,10 @@ class Registry:
         self._world = _handles.handle("world", "world", world)
         created = lib.ssRegistry_Create(self._world)
         if created == ffi.NULL:
-            raise SteadystepError(status_name(lib.SS_ERROR_OUT_OF_RANGE if self._world == ffi.NULL
-                                              else lib.SS_ERROR_OUT_OF_MEMORY), last_error())
+            raise SteadystepError(Status.OUT_OF_RANGE if self._world == ffi.NULL else Status.OUT_OF_MEMORY,
+                                  last_error())
         self._registry = ffi.gc(created, lib.ssRegistry_Destroy)
+        self._steppers = weakref.WeakSet()  # the Steppers made with this registry (close() refuses while one lives)
 
     @property
     def world_address(self) -> int:
@@ -108,22 +92,32 @@ class Registry:
 
     def _handle(self):
         if self._registry is None:
-            raise SteadystepError("out of range", "registry: used after close()")
+            raise SteadystepError(Status.OUT_OF_RANGE, "registry: used after close()")
         return self._registry
 
     def close(self) -> None:
-        """Destroys the registry now (ODE objects are left as they are). A stepper made with it must be closed
-        first; Stepper keeps its registry alive, so this is only needed for a registry used alone."""
-        if self._registry is not None:
-            ffi.release(self._registry)
-            self._registry = None
+        """Destroys the registry now (ODE objects are left as they are). Raises SteadystepError naming the registry
+        while a Stepper made with it is open: close the stepper first (a Stepper keeps its registry alive, so close()
+        is needed only for a registry used alone)."""
+        if self._registry is None:
+            return
+        open_steppers = [stepper for stepper in self._steppers if not stepper.closed]
+        if open_steppers:
+            raise SteadystepError(Status.OUT_OF_RANGE, f"registry.close(): {len(open_steppers)} open Stepper(s) "
+                                  "still step with this registry; close them first (stepper.close())")
+        ffi.release(self._registry)
+        self._registry = None
+
+    def _add_stepper(self, stepper) -> None:
+        """A Stepper now steps with this registry: close() refuses until it is closed."""
+        self._steppers.add(stepper)
 
     # ---- adoption (adopt.h) -----------------------------------------------------------------------------------
 
     def _adopt(self, call, *args) -> AdoptReport:
-        out = ffi.new("ssAdoptReport*")
+        out = AdoptReport.new()
         check(call(self._handle(), *args, out))
-        return from_struct(AdoptReport, out[0])
+        return AdoptReport.of(out)
 
     def adopt(self, tuned_step_s: float, space) -> AdoptReport:
         """Adopts what the program tuned at tuned_step_s (s, > 0): the world's ERP/CFM, damping and auto-disable
@@ -203,10 +197,10 @@ class Registry:
         """Writes every binding for a step of step_s (s, > 0) under mapping; previous_step_s (s; 0 = no history)
         is read by Mapping.EXACT only. Either all is written or, on an error, nothing is. A Stepper does this
         before each of its steps: call it yourself only to step the world with ODE directly."""
-        out = ffi.new("ssApplyReport*")
+        out = ApplyReport.new()
         check(lib.ssRegistry_Apply(self._handle(), _mapping(mapping), number("step_s", step_s, "s"),
                                    number("previous_step_s", previous_step_s, "s"), out))
-        return from_struct(ApplyReport, out[0])
+        return ApplyReport.of(out)
 
     @property
     def joint_binding_count(self) -> int:

@@ -7,6 +7,7 @@ import math
 
 from steadystep import runs, study
 from steadystep._native import SteadystepError, number
+from steadystep.enums import Status
 from steadystep.limits import MIN_MEASURED_DURATION_S
 from steadystep.profiles import Profile
 
@@ -28,7 +29,7 @@ def grid_points(grid: dict | None) -> tuple[list[dict], list[dict]]:
     grid = grid or {}
     unknown = set(grid) - set(GRID_AXES)
     if unknown:
-        raise SteadystepError("out of range", f"grid: no axis {sorted(unknown)[0]!r} (axes: {', '.join(GRID_AXES)})")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"grid: no axis {sorted(unknown)[0]!r} (axes: {', '.join(GRID_AXES)})")
     springs = study.grid(**{axis: grid[axis] for axis in ("stiffness", "damping") if axis in grid})
     steps = study.grid(**{axis: grid[axis] for axis in ("max_step_s",) if axis in grid})
     return springs, steps
@@ -56,20 +57,20 @@ def validate(scenes, profiles, policies, duration_s: float = 5.0, seed: int = 1,
         runs.scene_info(scene)
     profiles = list(profiles)
     if not profiles:
-        raise SteadystepError("out of range", "profiles = []: name at least one frame-time profile")
+        raise SteadystepError(Status.OUT_OF_RANGE, "profiles = []: name at least one frame-time profile")
     for profile in profiles:
         Profile(profile, seed)
     for policy in policies or ():
         runs.make_stepping(policy)
     duration_s = number("duration_s", duration_s, "s")
     if not duration_s >= MIN_MEASURED_DURATION_S or not math.isfinite(duration_s):
-        raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: must be finite and at least "
+        raise SteadystepError(Status.OUT_OF_RANGE, f"duration_s = {duration_s:g} s: must be finite and at least "
                               f"{MIN_MEASURED_DURATION_S:g} s to be measured")
     for axis, values in (grid or {}).items():
         if axis in GRID_AXES and not isinstance(values, (list, tuple)):
-            raise SteadystepError("out of range", f"grid.{axis} = {values!r}: must be a list of values")
+            raise SteadystepError(Status.OUT_OF_RANGE, f"grid.{axis} = {values!r}: must be a list of values")
         if axis in GRID_AXES and not values:
-            raise SteadystepError("out of range", f"grid.{axis} = []: give at least one value or leave it out")
+            raise SteadystepError(Status.OUT_OF_RANGE, f"grid.{axis} = []: give at least one value or leave it out")
         for value in values if axis in GRID_AXES else ():
             number(f"grid.{axis}", value, GRID_AXES[axis])
     springs, steps = grid_points(grid)

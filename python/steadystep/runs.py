@@ -13,17 +13,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from steadystep._native import SteadystepError, c_string, check, ffi, lib, number, shown, text
+from steadystep.enums import Status
 from steadystep.limits import MAX_RUN_FRAMES, MAX_RUN_STEPS
 from steadystep.profiles import frame_count, seed_value
+from steadystep.stepping import policy_names  # noqa: F401 - the lab's policies are the library's presets
 
 REFERENCE_STEP_S = 1.0 / 1000.0
 REFERENCE_PROFILE = "fixed:1000"
 
 
-def policy_names() -> list[str]:
-    """The lab's policies by name, as the library lists them (stepping.h): naive, implicit-euler, matched, exact,
-    fixed, fixed-matched, fixed-exact."""
-    return [text(lib.ssPolicyNameAt(i)) for i in range(lib.ssPolicyCount())]
+def scene_names() -> list[str]:
+    """The library's scenes by name (scene.h): oscillator, buggy, drop, chain, pile ..."""
+    return [text(lib.ssSceneInfoAt(i).name) for i in range(lib.ssSceneCount())]
 
 
 @dataclass(frozen=True)
@@ -65,7 +66,7 @@ def scene_info(name: str) -> SceneInfo:
     info = lib.ssSceneFind(c_string("scene", name))
     if info == ffi.NULL:
         known = ", ".join(s.name for s in scenes())
-        raise SteadystepError("not found", f"scene = {shown(name)}: unknown (known: {known})")
+        raise SteadystepError(Status.NOT_FOUND, f"scene = {shown(name)}: unknown (known: {known})")
     return _scene_info(info)
 
 
@@ -105,11 +106,11 @@ def _merge(base: dict, changes: dict | None, what: str) -> dict:
     if changes is None:
         return dict(base)
     if not isinstance(changes, dict):
-        raise SteadystepError("out of range", f"{what} = {shown(changes)}: must be a dict of fields")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{what} = {shown(changes)}: must be a dict of fields")
     merged = dict(base)
     for key, value in changes.items():
         if key not in base:
-            raise SteadystepError("out of range", f"{what}: no field {shown(key)} (fields: {', '.join(base)})")
+            raise SteadystepError(Status.OUT_OF_RANGE, f"{what}: no field {shown(key)} (fields: {', '.join(base)})")
         if isinstance(base[key], dict):
             merged[key] = _merge(base[key], value, f"{what}.{key}")
         else:
@@ -122,10 +123,10 @@ def _field_value(name: str, default, value):
     field any real number."""
     if isinstance(default, int):
         if isinstance(value, bool) or not hasattr(value, "__index__"):
-            raise SteadystepError("out of range", f"{name} = {shown(value)}: must be an integer")
+            raise SteadystepError(Status.OUT_OF_RANGE, f"{name} = {shown(value)}: must be an integer")
         value = value.__index__()
         if not -2**31 <= value < 2**31:
-            raise SteadystepError("out of range", f"{name} = {shown(value)}: outside C's int")
+            raise SteadystepError(Status.OUT_OF_RANGE, f"{name} = {shown(value)}: outside C's int")
         return value
     return number(name, value)
 
@@ -144,10 +145,12 @@ def reference_stepping() -> dict:
 
 
 # How a run ends (RunResult.status): "ok" ran to the end within the scene's sanity bounds; "blow-up", "speed limit"
-# and "position limit" ended early with a state that was not finite, absurdly fast or absurdly far; "broken" ended
-# early, finite but physically wrong: a step left one of the scene's sanity bounds (scene.h: a torn joint, a box
-# through the floor, energy made). Only "ok" is a run to measure: a report counts every other status as failed.
-BLOW_UP_STATUSES = frozenset({"blow-up", "speed limit", "position limit"})
+# and "position limit" (the library's names for those statuses) ended early with a state that was not finite,
+# absurdly fast or absurdly far; "broken" ended early, finite but physically wrong: a step left one of the scene's
+# sanity bounds (scene.h: a torn joint, a box through the floor, energy made). Only "ok" is a run to measure: a
+# report counts every other status as failed.
+BLOW_UP_STATUSES = frozenset(text(lib.ssStatusName(status)) for status in (
+    lib.SS_ERROR_BLOWUP, lib.SS_ERROR_SPEED_LIMIT, lib.SS_ERROR_POSITION_LIMIT))
 BROKEN = "broken"
 
 
@@ -215,19 +218,20 @@ def check_run_size(profile: str, duration_s: float, seed: int, stepping: dict) -
     MAX_RUN_FRAMES frames within duration_s. Raises SteadystepError naming the value."""
     duration_s = number("duration_s", duration_s, "s")
     if not math.isfinite(duration_s):
-        raise SteadystepError("not finite", f"duration_s = {duration_s} s: must be a finite number of seconds")
+        raise SteadystepError(Status.NOT_FINITE, f"duration_s = {duration_s} s: must be a finite number of seconds")
     if duration_s <= 0:
-        raise SteadystepError("out of range", f"duration_s = {duration_s} s: must be positive")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"duration_s = {duration_s} s: must be positive")
     fixed = stepping.get("cut") == lib.SS_CUT_FIXED
     step_name = "fixed_step_s" if fixed else "max_step_s"
     step_s = number(f"stepping.{step_name}", stepping.get(step_name, math.nan), "s")
     if math.isfinite(step_s) and step_s > 0 and duration_s / step_s > MAX_RUN_STEPS:
-        raise SteadystepError("out of range", f"duration_s = {duration_s:g} s: more than the bound of "
+        raise SteadystepError(Status.OUT_OF_RANGE, f"duration_s = {duration_s:g} s: more than the bound of "
                               f"{MAX_RUN_STEPS} steps of {step_name} = {step_s:g} s per run")
     # A bad step length is left to the library, which names it; the frames are counted on the profile itself.
     frames = frame_count(profile, duration_s, seed, MAX_RUN_FRAMES)
     if frames > MAX_RUN_FRAMES:
-        raise SteadystepError("out of range", f"profile = {shown(profile)}: more than the bound of {MAX_RUN_FRAMES} "
+        raise SteadystepError(Status.OUT_OF_RANGE,
+                              f"profile = {shown(profile)}: more than the bound of {MAX_RUN_FRAMES} "
                               f"frames per run within duration_s = {duration_s:g} s")
 
 
@@ -311,7 +315,7 @@ class Scene:
 
     def _handle(self):
         if self._scene is None:
-            raise SteadystepError("out of range", f"scene {self.info.name!r}: used after close()")
+            raise SteadystepError(Status.OUT_OF_RANGE, f"scene {self.info.name!r}: used after close()")
         return self._scene
 
     def frame(self, frame_s: float) -> int:

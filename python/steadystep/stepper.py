@@ -11,7 +11,10 @@ each physics step (stepper.current_step() tells the step), step_done(step_s) aft
 checks. collide typically calls odepy.dSpaceCollide(space, None, near) and the near callback calls
 stepper.soften_contact(contact, body1, body2) before dJointCreateContact. An exception raised by a callback does
 not cross C: it is kept, the callbacks are not called again for the rest of that frame (whose remaining steps
-ODE still takes), and step() raises it once the frame is over.
+ODE still takes), and step() raises it once the frame is over. The near callback is called by ODE through ctypes,
+which prints an exception and goes on: a refusal of the stepper's own calls made there (soften_contact ...) is
+kept for step() all the same, and wrapping the near callback, odepy.dNearCallback(stepper.near_callback(near)),
+keeps any exception it raises.
 
 Handles (world, bodies, joints, the contact group) are odepy handles or integer addresses, borrowed: the world and
 the registry must outlive the stepper (it keeps its Registry alive; close() the stepper before dWorldDestroy).
@@ -22,47 +25,44 @@ from __future__ import annotations
 import dataclasses
 import weakref
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 from steadystep import _handles
-from steadystep._native import SteadystepError, check, ffi, lib, number, shown
+from steadystep._native import SteadystepError, check, ffi, last_error, lib, number, shown
+from steadystep._structs import StructView, address_of
 from steadystep.enums import Mapping, Solver, Status
-from steadystep.registry import AdoptReport, Registry, ServedCounts, from_struct
+from steadystep.registry import AdoptReport, Registry  # also declares ServedCounts, the view of rows, contacts
 from steadystep.stepping import Stepping, stepping_from
 
 
-@dataclass(frozen=True)
-class StepInfo:
-    """The physics step about to be taken (ssStepInfo), as current_step() gives it inside the callbacks."""
+class StepInfo(StructView, c_type="ssStepInfo", convert={"mapping": Mapping}):
+    """The physics step about to be taken (ssStepInfo), as current_step() gives it inside the callbacks: mapping
+    (the Mapping this step's softness is written with), step_s (the length of the step about to be taken, s),
+    softness_step_s (the step length the softness is for, s: step_s, or stepping.frozen_step_s), previous_step_s
+    (the step before, for Mapping.EXACT, s; 0 when there is no usable history), index (0-based, within the frame),
+    count (steps this frame takes). Fields as stepper.h declares them, read-only."""
 
-    mapping: Mapping = field(metadata={"convert": Mapping})  # the mapping this step's softness is written with
-    step_s: float            # the length of the step about to be taken (s)
-    softness_step_s: float   # the step length the softness is for (s): step_s, or stepping.frozen_step_s
-    previous_step_s: float   # the step before, for Mapping.EXACT (s); 0 when there is no usable history
-    index: int               # 0-based index of this step within the frame
-    count: int               # steps this frame takes
+    __slots__ = ()
 
 
-@dataclass(frozen=True)
-class FrameReport:
-    """What one frame did (ssFrameReport)."""
+class FrameReport(StructView, c_type="ssFrameReport", convert={"failed_body": address_of}):
+    """What one frame did (ssFrameReport), with the fields and meanings stepper.h gives them, read-only and read
+    from the C report when asked for (FIELDS lists them; as_dict() copies them). failed_body is the address of
+    the body that failed, else 0 (compare with ctypes.cast(body, c_void_p).value)."""
 
-    steps: int                   # physics steps taken
-    step_s: float                # length of the last step taken (s); 0 when none
-    simulated_s: float           # time simulated this frame (s)
-    carried_s: float             # time carried to the next frame (s): FIXED's accumulator, or a too-short frame
-    dropped_s: float             # time dropped by max_steps_per_frame (s), never simulated
-    interpolation: float         # FIXED: accumulator / fixed_step_s in [0, 1), to blend the last two states
-    rows: ServedCounts = field(metadata={"struct": ServedCounts})  # row-steps: every bound row once per step
-    contacts: ServedCounts = field(metadata={"struct": ServedCounts})  # contacts softened with soften_contact
-    row_writes: int              # parameter sets written into ODE, summed over the frame's Applies
-    failed_body: int = field(metadata={"convert": lambda body: int(ffi.cast("uintptr_t", body))})
-    # the address of the body that blew up or ran too fast, else 0 (compare with ctypes.cast(body, c_void_p).value)
+    __slots__ = ()
+
+
+# The per-frame path, looked up once. ssStepper_Step zeroes its report before anything else, on every path
+# (src/stepper.c; tests/python/test_lifetimes.py holds it to that), so the report's memory is not cleared twice.
+_FRAME_REPORT = ffi.typeof("ssFrameReport*")
+_new_frame_report = ffi.new_allocator(should_clear_after_alloc=False)
+_step_frame = lib.ssStepper_Step
+_frame_report = FrameReport.of
 
 
 def _checked_callable(name: str, value):
     if value is not None and not callable(value):
-        raise SteadystepError("out of range", f"{name} = {shown(value)}: must be callable or None")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{name} = {shown(value)}: must be callable or None")
     return value
 
 
@@ -86,7 +86,8 @@ class Stepper:
                  collide: Callable[["Stepper"], object] | None = None,
                  step_done: Callable[[float], object] | None = None, contact_group=None):
         if registry is not None and not isinstance(registry, Registry):
-            raise SteadystepError("out of range", f"registry = {shown(registry)}: must be a steadystep.Registry or "
+            raise SteadystepError(Status.OUT_OF_RANGE,
+                                  f"registry = {shown(registry)}: must be a steadystep.Registry or "
                                   "None")
         tuned_step_s = number("tuned_step_s", tuned_step_s, "s")
         if reference_step_s is None:
@@ -101,7 +102,7 @@ class Stepper:
                       "step_done": _checked_callable("step_done", step_done)}
         self._pending: BaseException | None = None  # the first exception a callback raised in this frame
         self._in_frame = False
-        self._report = None
+        self._stepper = None
 
         definition = ffi.new("ssStepperDef*", lib.ssDefaultStepperDef())
         definition.world = _handles.handle("world", "world", world)
@@ -122,12 +123,15 @@ class Stepper:
             definition.step_done = self._callback("ssStepDoneCallback*",
                                                   lambda context, step_s: _call(me, "step_done", step_s))
         if self._stepping.solver == Solver.UNSET and definition.world != ffi.NULL:  # (C names a NULL world first)
-            raise SteadystepError("unsupported", "solver = None: say which ODE step the program calls "
-                                  "(Solver.QUICK for dWorldQuickStep, Solver.STEP for dWorldStep)",
-                                  int(Status.UNSUPPORTED))
+            raise SteadystepError(Status.UNSUPPORTED, "solver = None: say which ODE step the program calls "
+                                  "(Solver.QUICK for dWorldQuickStep, Solver.STEP for dWorldStep)")
         out = ffi.new("ssStepper**")
         check(lib.ssStepper_Create(definition, out))
-        self._stepper = ffi.gc(out[0], lib.ssStepper_Destroy)
+        # The destructor holds the C registry, so that however the two are collected, the stepper goes first.
+        kept = registry._registry if registry is not None else None
+        self._stepper = ffi.gc(out[0], lambda stepper, kept=kept: lib.ssStepper_Destroy(stepper))
+        if registry is not None:
+            registry._add_stepper(self)
 
     def _callback(self, ctype: str, function):
         made = ffi.callback(ctype, function)
@@ -136,14 +140,26 @@ class Stepper:
 
     def _handle(self):
         if self._stepper is None:
-            raise SteadystepError("out of range", "stepper: used after close()")
+            raise self._refused(SteadystepError(Status.OUT_OF_RANGE, "stepper: used after close()"))
         return self._stepper
 
     def _between_frames(self, what: str):
         if self._in_frame:
-            raise SteadystepError("reentered", f"stepper.{what}: called from a callback of the same stepper, "
-                                  "inside its frame", int(Status.REENTERED))
+            raise self._refused(SteadystepError(Status.REENTERED, f"stepper.{what}: called from a callback of the same "
+                                                "stepper, inside its frame"))
         return self._handle()
+
+    def _refused(self, error: BaseException) -> BaseException:
+        """error, also kept for step() to raise when it happens inside a frame: a call made from odepy's near
+        callback (soften_contact, ...) raises into ctypes, which prints the exception and goes on."""
+        if self._in_frame and self._pending is None:
+            self._pending = error
+        return error
+
+    @property
+    def closed(self) -> bool:
+        """Whether close() was called (or the stepper was never made)."""
+        return self._stepper is None
 
     @property
     def registry(self) -> Registry | None:
@@ -165,31 +181,33 @@ class Stepper:
     def step(self, frame_s: float) -> FrameReport:
         """Advances the world by one frame of frame_s seconds (0 <= frame_s <= 3600; 0 takes no step). Forces the
         program added to known bodies before this call act for the whole frame (a frame of 0 s reads and clears
-        them: F·0 = 0). Raises SteadystepError with the
-        library's message (the world left as it was for a refused frame); for a body refused at the boundary
-        before the frame or a step (a state or force ODE cannot step, Status.POSITION_LIMIT, ...) or one that blew
+        them: F·0 = 0). Returns the frame's FrameReport. Raises SteadystepError with the library's message (the
+        world left as it was for a refused frame); for a body refused at the boundary before the frame or a step (a state or force ODE cannot step, Status.POSITION_LIMIT, ...) or one that blew
         up or ran away in a step (Status.BLOWUP, Status.SPEED_LIMIT) the error's `report` is the FrameReport, whose
         failed_body names the body, and every later frame is refused (Status.FAILED) until reset(). An exception
-        raised by a callback is raised here, after the frame, with the frame's FrameReport (or its error) as its
-        `steadystep_report` (or `__context__`)."""
-        handle = self._between_frames("step")
-        frame_s = number("frame_s", frame_s, "s")
-        report = ffi.new("ssFrameReport*")
-        self._pending = None
+        raised by a callback, or by a call the near callback made (soften_contact ...), is raised here, after the
+        frame, with the frame's FrameReport (or its error) as its `steadystep_report` (or `__context__`)."""
+        if self._in_frame or self._stepper is None:
+            self._between_frames("step")
+        if type(frame_s) is not float:
+            frame_s = number("frame_s", frame_s, "s")
+        report = _new_frame_report(_FRAME_REPORT)
         self._in_frame = True
         try:
-            status = lib.ssStepper_Step(handle, frame_s, report)
+            status = _step_frame(self._stepper, frame_s, report)
         finally:
             self._in_frame = False
+        if status or self._pending is not None:
+            self._raise_for_frame(status, _frame_report(report))
+        return _frame_report(report)
+
+    def _raise_for_frame(self, status: int, made: FrameReport):
         pending, self._pending = self._pending, None
-        made = from_struct(FrameReport, report[0])
         error = None
-        try:
-            check(status)
-        except SteadystepError as failure:
+        if status:
+            error = SteadystepError(status, last_error())
             if made.failed_body:  # a body refused at the boundary, or that blew up or ran away in a step
-                failure.report = made
-            error = failure
+                error.report = made
         if pending is not None:
             try:
                 pending.steadystep_report = made
@@ -198,14 +216,12 @@ class Stepper:
             if error is not None:
                 raise pending from error
             raise pending
-        if error is not None:
-            raise error
-        return made
+        raise error
 
     @property
     def adopted(self) -> AdoptReport:
         """What the stepper's own adoption (space=...) reached, at creation and since (ssStepper_Adopted)."""
-        return from_struct(AdoptReport, lib.ssStepper_Adopted(self._handle()))
+        return AdoptReport.of(lib.ssStepper_Adopted(self._handle()))
 
     @property
     def known_body_count(self) -> int:
@@ -220,16 +236,36 @@ class Stepper:
     def current_step(self) -> StepInfo:
         """The step about to be taken: meaningful inside before_step and collide; between frames, the next step of
         the default length."""
-        return from_struct(StepInfo, lib.ssStepper_CurrentStep(self._handle()))
+        return StepInfo.of(lib.ssStepper_CurrentStep(self._handle()))
+
+    def near_callback(self, near: Callable) -> Callable:
+        """near (an odepy near callback, near(data, geom1, geom2)) wrapped so that an exception it raises during a
+        frame is kept and raised by step(), as a callback's is, instead of being printed and lost by ctypes:
+        odepy.dSpaceCollide(space, None, odepy.dNearCallback(stepper.near_callback(near)))."""
+        me = weakref.ref(self)
+
+        def kept_near(*args):
+            stepper = me()
+            try:
+                near(*args)
+            except BaseException as error:  # noqa: BLE001 - raised by step() after the frame
+                if stepper is None or not stepper._in_frame:
+                    raise
+                stepper._refused(error)
+
+        return kept_near
 
     def soften_contact(self, contact, body1, body2) -> None:
         """In the near callback, before dJointCreateContact: turns the contact's tuned softness (its soft_erp /
         soft_cfm where surface.mode has them, else the world's ERP/CFM, as tuned at the registry's tuned step) into
         the softness for the step about to be taken. contact: an odepy dContact (or its address); body1, body2 its
         bodies (None for the static world). Raises SteadystepError with the contact unchanged (adopt first)."""
-        check(lib.ssStepper_SoftenContact(self._handle(), _handles.contact("contact", contact),
-                                          _handles.handle("body1", "body", body1),
-                                          _handles.handle("body2", "body", body2)))
+        try:
+            check(lib.ssStepper_SoftenContact(self._handle(), _handles.contact("contact", contact),
+                                              _handles.handle("body1", "body", body1),
+                                              _handles.handle("body2", "body", body2)))
+        except SteadystepError as error:
+            raise self._refused(error)
 
     def interpolated_pose(self, body) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
         """The pose to draw body at after the last frame (steadystep/interpolation.h): (position in m, rotation as
@@ -246,7 +282,7 @@ class Stepper:
         """Keeps the poses to draw under the fixed cut (True, the default) or nothing (False: a program that draws
         nothing; interpolated_pose then gives ODE's pose)."""
         if not isinstance(on, bool):
-            raise SteadystepError("out of range", f"on = {shown(on)}: must be True or False")
+            raise SteadystepError(Status.OUT_OF_RANGE, f"on = {shown(on)}: must be True or False")
         check(lib.ssStepper_SetInterpolation(self._between_frames("set_interpolation"), int(on)))
 
     def reset(self) -> None:
@@ -261,11 +297,17 @@ class Stepper:
 
     def watch_body(self, body) -> None:
         """Makes a body known: its forces kept for the whole frame, its state checked after each step."""
-        check(lib.ssStepper_WatchBody(self._handle(), _handles.handle("body", "body", body)))
+        try:
+            check(lib.ssStepper_WatchBody(self._handle(), _handles.handle("body", "body", body)))
+        except SteadystepError as error:
+            raise self._refused(error)
 
     def unwatch_body(self, body) -> None:
         """Stops watching a body; SteadystepError ("not found") when it was not watched."""
-        check(lib.ssStepper_UnwatchBody(self._handle(), _handles.handle("body", "body", body)))
+        try:
+            check(lib.ssStepper_UnwatchBody(self._handle(), _handles.handle("body", "body", body)))
+        except SteadystepError as error:
+            raise self._refused(error)
 
     def destroy_body(self, body) -> None:
         """Destroys a body the stepper may know (unwatched, unbound, its joints unbound, then dBodyDestroy). Use it

@@ -16,7 +16,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from steadystep._native import SteadystepError, c_string, check, ffi, integer, lib, number, shown, text
-from steadystep.enums import FrameCut, Mapping, Solver
+from steadystep.enums import FrameCut, Mapping, Solver, Status
 
 _DEFAULT = lib.ssDefaultStepping()
 _INT_RANGE = (-2**31, 2**31 - 1)
@@ -84,11 +84,12 @@ class Stepping:
 def stepping_from(stepping: Stepping | None, policy: str | None, reference_step_s: float) -> Stepping:
     """One stepping from a Stepper's arguments: stepping, or the named policy, or the defaults (not both)."""
     if stepping is not None and policy is not None:
-        raise SteadystepError("out of range", f"policy = {shown(policy)}: give either stepping or policy, not both")
+        raise SteadystepError(Status.OUT_OF_RANGE,
+                              f"policy = {shown(policy)}: give either stepping or policy, not both")
     if policy is not None:
         return Stepping.for_policy(policy, reference_step_s)
     if stepping is None:
         return Stepping()
     if not isinstance(stepping, Stepping):
-        raise SteadystepError("out of range", f"stepping = {shown(stepping)}: must be a steadystep.Stepping")
+        raise SteadystepError(Status.OUT_OF_RANGE, f"stepping = {shown(stepping)}: must be a steadystep.Stepping")
     return stepping

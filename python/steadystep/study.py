@@ -30,8 +30,9 @@ import itertools
 import os
 from collections.abc import Callable, Iterable, Iterator, Mapping
 
-# How long to wait for an existing Dask scheduler before calling it unreachable (s).
+# How long to wait for an existing Dask scheduler before calling it unreachable, and then for it to have a worker (s).
 DASK_CONNECT_TIMEOUT_S = 10
+DASK_WORKER_TIMEOUT_S = 10
 DASK_EXTRA_HINT = "pip install 'steadystep[dask]'"
 EXECUTOR_NAMES = ("local", "serial", "none", "dask", "dask:ADDRESS")
 # What the local pool's fork server imports once for all its workers: the units of the report's task graph.
@@ -103,8 +104,9 @@ def usable_cores() -> int:
 @contextlib.contextmanager
 def make_executor(spec: str = "local") -> Iterator[concurrent.futures.Executor]:
     """The executor that spec names (see the module's docstring), shut down (and a local Dask cluster closed) when
-    the with-block ends. Raises ExecutorUnavailable for an unknown spec, Dask missing, or a scheduler not reached
-    within DASK_CONNECT_TIMEOUT_S (10 s)."""
+    the with-block ends. Raises ExecutorUnavailable, one line naming the spec, for an unknown spec, Dask missing, a
+    scheduler that does not answer as one within DASK_CONNECT_TIMEOUT_S (10 s), or one without a worker within
+    DASK_WORKER_TIMEOUT_S (10 s)."""
     if not isinstance(spec, str):
         raise ExecutorUnavailable(f"executor = {spec!r}: must be one of {', '.join(EXECUTOR_NAMES)}")
     if spec in ("serial", "none"):
@@ -182,18 +184,47 @@ def _dask_executor(spec: str) -> Iterator[concurrent.futures.Executor]:
                     silence_logs=logging.ERROR))
             client = stack.enter_context(distributed.Client(cluster))
         else:
+            client = stack.enter_context(_connect(distributed, spec, address))
             try:
-                client = distributed.Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
-            except (OSError, TimeoutError, ValueError) as error:
-                reason = " ".join(str(error).split()) or type(error).__name__
-                raise ExecutorUnavailable(f"executor = {spec!r}: cannot reach the Dask scheduler at {address} "
-                                          f"(waited {DASK_CONNECT_TIMEOUT_S} s): {reason}") from None
-            stack.enter_context(client)
+                client.wait_for_workers(1, timeout=DASK_WORKER_TIMEOUT_S)
+            except Exception:  # TimeoutError, or the scheduler went away
+                raise ExecutorUnavailable(f"executor = {spec!r}: the Dask scheduler at {address} has no workers "
+                                          f"(waited {DASK_WORKER_TIMEOUT_S} s): start some (dask worker "
+                                          f"{address}) or use --executor local") from None
         executor = client.get_executor()
         try:
             yield executor
         finally:
             executor.shutdown(wait=False)
+
+
+def _connect(distributed, spec: str, address: str):
+    """A Client of the scheduler at address, or ExecutorUnavailable within DASK_CONNECT_TIMEOUT_S. Dask bounds the
+    TCP connection but not its handshake (a peer that accepts and says nothing is waited for for ever), and fails
+    with whatever the transport raises (ucx:// not installed, tls:// without certificates, a peer speaking another
+    protocol: TypeError, MemoryError ...): the connection is made in a thread that is given up on after the
+    timeout, and every failure becomes the one-line refusal."""
+    import threading
+
+    outcome: dict = {}
+
+    def connect() -> None:
+        try:
+            outcome["client"] = distributed.Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
+        except BaseException as error:  # noqa: BLE001 - handed to the caller below as the refusal's reason
+            outcome["error"] = error
+
+    connecting = threading.Thread(target=connect, name="steadystep-dask-connect", daemon=True)
+    connecting.start()
+    connecting.join(DASK_CONNECT_TIMEOUT_S + 1)
+    if "client" in outcome:
+        return outcome["client"]
+    error = outcome.get("error")
+    if error is None:
+        reason = f"no answer within {DASK_CONNECT_TIMEOUT_S} s (is it a Dask scheduler?)"
+    else:  # Dask's own timeout says how long it waited
+        reason = f"{type(error).__name__}: {' '.join(str(error).split())[:200]}"
+    raise ExecutorUnavailable(f"executor = {spec!r}: cannot reach the Dask scheduler at {address}: {reason}")
 
 
 def grid(**axes: Iterable) -> list[dict]:

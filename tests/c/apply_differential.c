@@ -37,15 +37,18 @@ static const double kLoads[] = {0, -9.81, 25.0, -400.0, 3e4, 1e6};
 /* More laws than Apply's table holds: springs stiff and soft (some above Nyquist at the longer steps), dampers,
  * undamped springs, hard rows with finite and infinite rates, and the world's own. */
 static ssRowLaw lawAt(int index) {
-  ssRowLaw law = {{0, 0}, 0, 0};
+  ssRowLaw law = ssRowLawOfSpring((ssSpring){0, 0});
   switch (index % 6) {
     case 0: law = ssRowLawOfSpring((ssSpring){5.0 * (1 + index), 0.05 * (1 + index % 5)}); break;
-    case 1: law = ssRowLawOfSpring((ssSpring){400.0 + 97.0 * index, 12.0}); break;
+    case 1: /* every other one read from a program's erp/cfm tuned at 1/60 s (adoption), one of the steps */
+      if (index % 12 == 7) ssRowLawFromTuned("law", 0.3 + 0.01 * index, 1e-4 * (1 + index % 5), 1.0 / 60, &law);
+      else law = ssRowLawOfSpring((ssSpring){400.0 + 97.0 * index, 12.0});
+      break;
     case 2: law = ssRowLawOfSpring((ssSpring){0.0, 0.01 * (1 + index)}); break;        /* a damper */
     case 3: law = ssRowLawOfSpring((ssSpring){1e5 * (1 + index % 3), 30.0 + index}); break; /* above Nyquist */
     case 4: law = ssRowLawOfSpring((ssSpring){50.0 + index, 0.0}); break;              /* undamped */
     case 5:
-      law = (ssRowLaw){{0, 0}, 1, index % 4 == 1 ? INFINITY : 2.0 + index};              /* hard */
+      law = (ssRowLaw){.hard = 1, .hard_rate_per_s = index % 4 == 1 ? INFINITY : 2.0 + index}; /* hard */
       break;
   }
   return law;

@@ -3,6 +3,7 @@
 // callback; refusals that leave the registry as it was.
 #include <cmath>
 #include <cstring>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,10 @@
 #include "ode_fixture.h"
 #include "precision.h"
 #include "steadystep/steadystep.h"
+
+// A value the library computed and ODE holds, rounded once to dReal: within tolerance (stated for double) of expected.
+#define EXPECT_READ_BACK(held, expected, tolerance) \
+  EXPECT_NEAR(held, expected, ReadBackTolerance(tolerance, expected))
 
 namespace {
 
@@ -89,11 +94,12 @@ class AdoptTest : public OdeTest {
     Tune(limited[3].joint, dParamSuspensionCFM, 1);
   }
 
+  // Bit for bit: what the program set is what ODE holds again.
   void ExpectTunedValues(const char* when) {
     for (const Tuned& t : tuned) {
       double now = GetParam(t.joint, t.param, t.axis);
-      EXPECT_NEAR(now, t.value, ReadBackTolerance(1e-12 * t.value, t.value))
-          << when << ": joint type " << dJointGetType(t.joint) << " param " << t.param << " axis " << t.axis;
+      EXPECT_EQ(now, AsDReal(t.value)) << when << ": joint type " << dJointGetType(t.joint) << " param " << t.param
+                              << " axis " << t.axis;
     }
   }
 
@@ -128,8 +134,8 @@ TEST_F(AdoptTest, EveryJointTypeKeepsItsTunedValuesAtTheTunedStep) {
   // ...and the tuned step gives back exactly what the program tuned.
   ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, kTunedStep, 0, nullptr), SS_OK);
   ExpectTunedValues("at the tuned step");
-  EXPECT_NEAR(dWorldGetERP(world), 0.35, ReadBackTolerance(1e-12, 0.35));
-  EXPECT_NEAR(dWorldGetCFM(world), 2e-5, ReadBackTolerance(1e-12 * 2e-5, 2e-5));
+  EXPECT_EQ(dWorldGetERP(world), AsDReal(0.35));
+  EXPECT_EQ(dWorldGetCFM(world), AsDReal(2e-5));
 }
 
 TEST_F(AdoptTest, OdeDefaultsAreAdoptedLikeTunedValues) {
@@ -141,8 +147,8 @@ TEST_F(AdoptTest, OdeDefaultsAreAdoptedLikeTunedValues) {
   for (ssMapping mapping : {SS_MAPPING_IMPLICIT_EULER, SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
     ssApplyReport applied;
     ASSERT_EQ(ssRegistry_Apply(registry, mapping, kTunedStep, kTunedStep, &applied), SS_OK) << ssLastError();
-    EXPECT_NEAR(dJointGetBallParam(ball, dParamCFM), cfm, 1e-12 * cfm);
-    EXPECT_NEAR(dJointGetBallParam(ball, dParamERP), erp, 1e-12);
+    EXPECT_EQ(dJointGetBallParam(ball, dParamCFM), cfm);
+    EXPECT_EQ(dJointGetBallParam(ball, dParamERP), erp);
     // near-rigid: far above the step's Nyquist frequency, so the accurate mappings hand the rows to spring
     if (mapping != SS_MAPPING_IMPLICIT_EULER) {
       EXPECT_GE(applied.rows.handed_to_implicit_euler, 2) << ssMappingName(mapping);
@@ -166,10 +172,10 @@ TEST_F(AdoptTest, HardRowsAndDampersAreCarriedAsTheyAre) {
     ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, h, 0, nullptr), SS_OK);
     // hard: cfm stays 0, and the error is corrected at the same rate per second r = erp/(h0 (1 - erp))
     const double rate = 0.4 / (kTunedStep * 0.6);
-    EXPECT_EQ(dJointGetHingeParam(hard, dParamStopCFM), 0.0);
+    EXPECT_EQ(dJointGetHingeParam(hard, dParamStopCFM), AsDReal(0.0));
     EXPECT_NEAR(dJointGetHingeParam(hard, dParamStopERP), rate * h / (rate * h + 1), ReadBackTolerance(1e-12, 1)) << h;
     // a pure damper (erp 0): k = 0, c = 1/cfm, the same at every step
-    EXPECT_EQ(dJointGetSliderParam(damper, dParamStopERP), 0.0);
+    EXPECT_EQ(dJointGetSliderParam(damper, dParamStopERP), AsDReal(0.0));
     EXPECT_NEAR(dJointGetSliderParam(damper, dParamStopCFM), 0.02, ReadBackTolerance(1e-15, 0.02)) << h;
   }
 }
@@ -204,12 +210,12 @@ TEST_F(AdoptTest, DampingAndAutoDisableBecomeSecondsAndReachBodiesMadeLater) {
   EXPECT_EQ(report.bodies, 1);
   ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, kTunedStep, 0, nullptr), SS_OK);
   for (dBodyID body : {early, late}) {
-    EXPECT_NEAR(dBodyGetLinearDamping(body), 0.01, ReadBackTolerance(1e-12, 0.01));
+    EXPECT_EQ(dBodyGetLinearDamping(body), AsDReal(0.01));
     EXPECT_EQ(dBodyGetAutoDisableSteps(body), 12);
     EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(body), 3u);
   }
   EXPECT_EQ(dBodyGetAutoDisableSteps(own), 30);
-  EXPECT_NEAR(dBodyGetLinearDamping(own), 0.05, ReadBackTolerance(1e-12, 0.05));
+  EXPECT_EQ(dBodyGetLinearDamping(own), AsDReal(0.05));
 }
 
 TEST_F(AdoptTest, JointsMadeLaterAdoptTheWorldsSpringAndAdoptingAgainChangesNothing) {
@@ -224,8 +230,8 @@ TEST_F(AdoptTest, JointsMadeLaterAdoptTheWorldsSpringAndAdoptingAgainChangesNoth
   ASSERT_EQ(ssRegistry_AdoptJoint(registry, ball, &report), SS_OK) << ssLastError();
   EXPECT_EQ(report.joint_rows, 1);
   ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, kTunedStep, 0, nullptr), SS_OK);
-  EXPECT_NEAR(dJointGetBallParam(ball, dParamERP), 0.3, ReadBackTolerance(1e-12, 0.3));
-  EXPECT_NEAR(dJointGetBallParam(ball, dParamCFM), 1e-4, ReadBackTolerance(1e-16, 1e-4));
+  EXPECT_EQ(dJointGetBallParam(ball, dParamERP), AsDReal(0.3));
+  EXPECT_EQ(dJointGetBallParam(ball, dParamCFM), AsDReal(1e-4));
 
   const int rows = ssRegistry_JointBindingCount(registry);
   ssAdoptReport again = {};
@@ -256,6 +262,17 @@ TEST_F(AdoptTest, BadInputIsRefusedByNameAndNothingIsBound) {
   EXPECT_NE(std::string(ssLastError()).find("erp = 1.5"), std::string::npos) << ssLastError();
   EXPECT_EQ(ssRegistry_JointBindingCount(registry), 0);
   EXPECT_EQ(ssRegistry_TunedStep(registry), 0.0);
+  // A body's value that stands for no rate (a damping scale of 1 or more) is named with its body.
+  dJointSetHingeParam(hinge, dParamStopERP, 0.2);
+  dBodySetLinearDamping(body, 1.5);
+  char named[64];
+  std::snprintf(named, sizeof named, "body %p", static_cast<void*>(body));
+  EXPECT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find(named), std::string::npos) << ssLastError();
+  EXPECT_NE(std::string(ssLastError()).find("1.5"), std::string::npos) << ssLastError();
+  EXPECT_EQ(ssRegistry_TunedStep(registry), 0.0);
+  dBodySetLinearDamping(body, 0);
+  dJointSetHingeParam(hinge, dParamStopERP, 1.5);
   const double world_erp = dWorldGetERP(world);
   ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 0.1, 0, nullptr), SS_OK);
   EXPECT_EQ(dWorldGetERP(world), world_erp);
@@ -271,6 +288,299 @@ TEST_F(AdoptTest, BadInputIsRefusedByNameAndNothingIsBound) {
   EXPECT_NE(std::string(ssLastError()).find("tuned at"), std::string::npos) << ssLastError();
   EXPECT_EQ(ssRegistry_AdoptJoint(registry, nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
   EXPECT_EQ(ssRegistry_AdoptBody(registry, nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
+}
+
+TEST_F(AdoptTest, AtTheTunedStepEveryNumberIsTheProgramsOwnAtOthersItsRateInSeconds) {
+  // Numbers whose round trip through k and c (or rates) is not exact in floating point.
+  dWorldSetERP(world, 0.37);
+  dWorldSetCFM(world, 3.3e-5);
+  dWorldSetLinearDamping(world, 0.0013);
+  dWorldSetAngularDamping(world, 0.0071);
+  dWorldSetAutoDisableSteps(world, 10);  // "10 idle steps, no idle time"
+  dWorldSetAutoDisableTime(world, 0);
+  dWorldSetAutoDisableAverageSamplesCount(world, 7);
+  dBodyID body = Body(0, 0, 1);  // copies the world's defaults
+  dJointID hinge = dJointCreateHinge(world, 0);
+  dJointAttach(hinge, body, 0);
+  dJointSetHingeParam(hinge, dParamStopERP, 0.47);  // hard: cfm 0
+  dJointSetHingeParam(hinge, dParamStopCFM, 0);
+  dJointSetHingeParam(hinge, dParamCFM, 7.7e-3);  // the motor, a damper
+  const double tuned_step = 1.0 / 47;            // no power of two
+  ASSERT_EQ(ssRegistry_Adopt(registry, tuned_step, space, nullptr), SS_OK) << ssLastError();
+
+  auto expect_as_tuned = [&](const char* when) {
+    SCOPED_TRACE(when);
+    EXPECT_EQ(dWorldGetERP(world), AsDReal(0.37));
+    EXPECT_EQ(dWorldGetCFM(world), AsDReal(3.3e-5));
+    EXPECT_EQ(dJointGetHingeParam(hinge, dParamStopERP), AsDReal(0.47));
+    EXPECT_EQ(dJointGetHingeParam(hinge, dParamStopCFM), AsDReal(0.0));
+    EXPECT_EQ(dJointGetHingeParam(hinge, dParamCFM), AsDReal(7.7e-3));
+    EXPECT_EQ(dWorldGetLinearDamping(world), AsDReal(0.0013));
+    EXPECT_EQ(dWorldGetAngularDamping(world), AsDReal(0.0071));
+    EXPECT_EQ(dBodyGetLinearDamping(body), AsDReal(0.0013));
+    EXPECT_EQ(dBodyGetAngularDamping(body), AsDReal(0.0071));
+    EXPECT_EQ(dBodyGetAutoDisableSteps(body), 10);
+    EXPECT_EQ(dBodyGetAutoDisableTime(body), 0.0);
+    EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(body), 7u);
+    EXPECT_EQ(dWorldGetAutoDisableSteps(world), 10);
+    EXPECT_EQ(dWorldGetAutoDisableTime(world), 0.0);
+    EXPECT_EQ(dWorldGetAutoDisableAverageSamplesCount(world), 7u);
+  };
+  for (ssMapping mapping : {SS_MAPPING_IMPLICIT_EULER, SS_MAPPING_MATCHED, SS_MAPPING_EXACT}) {
+    ASSERT_EQ(ssRegistry_Apply(registry, mapping, tuned_step, 0, nullptr), SS_OK) << ssLastError();
+    // the accurate mappings have their own softness for soft rows; hard rows and bodies are theirs alike
+    if (mapping == SS_MAPPING_IMPLICIT_EULER) expect_as_tuned("implicit Euler at the tuned step, first");
+    EXPECT_EQ(dJointGetHingeParam(hinge, dParamStopERP), AsDReal(0.47)) << ssMappingName(mapping);
+    EXPECT_EQ(dBodyGetAutoDisableTime(body), 0.0) << ssMappingName(mapping);
+  }
+
+  // Half the step: the rate-independent form (10 steps of h0 are 10 h0 seconds, whatever the step).
+  const double h = tuned_step / 2;
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, h, 0, nullptr), SS_OK);
+  EXPECT_READ_BACK(1 - dBodyGetLinearDamping(body), std::sqrt(1 - 0.0013), 1e-15);
+  EXPECT_EQ(dBodyGetAutoDisableSteps(body), 20);
+  EXPECT_READ_BACK(dBodyGetAutoDisableTime(body), 10 * tuned_step, 1e-15);
+  EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(body), 14u);
+  const double rate = 0.47 / (tuned_step * (1 - 0.47));
+  EXPECT_READ_BACK(dJointGetHingeParam(hinge, dParamStopERP), rate * h / (rate * h + 1), 1e-15);
+  // k = erp/(h0 cfm), c = (1 - erp)/cfm written at h: erp = hk/(hk + c), cfm = 1/(hk + c)
+  const double k = 0.37 / (tuned_step * 3.3e-5), c = (1 - 0.37) / 3.3e-5;
+  EXPECT_READ_BACK(dWorldGetERP(world), h * k / (h * k + c), 1e-15);
+  EXPECT_READ_BACK(dWorldGetCFM(world), 1 / (h * k + c), 1e-20);
+
+  // Back at the tuned step, after another: the program's numbers again.
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, tuned_step, 0, nullptr), SS_OK);
+  expect_as_tuned("implicit Euler at the tuned step, after half of it");
+}
+
+// The near callback of a program softening its contacts through the stepper, recording what it got.
+struct ContactProbe {
+  dWorldID world;
+  dSpaceID space;
+  dJointGroupID group;
+  int mode;
+  double soft_erp, soft_cfm;
+  std::vector<dSurfaceParameters> softened;
+};
+
+struct ProbeContext {
+  ContactProbe* probe;
+  ssStepper* stepper;
+};
+
+void ProbeNearWithContext(void* data, dGeomID g1, dGeomID g2) {
+  auto* context = static_cast<ProbeContext*>(data);
+  ContactProbe* probe = context->probe;
+  dContact contact[4];
+  int count = dCollide(g1, g2, 4, &contact[0].geom, sizeof(dContact));
+  for (int i = 0; i < count; ++i) {
+    contact[i].surface = dSurfaceParameters{};
+    contact[i].surface.mode = probe->mode;
+    contact[i].surface.mu = 0.5;
+    contact[i].surface.soft_erp = probe->soft_erp;
+    contact[i].surface.soft_cfm = probe->soft_cfm;
+    dBodyID b1 = dGeomGetBody(g1), b2 = dGeomGetBody(g2);
+    EXPECT_EQ(ssStepper_SoftenContact(context->stepper, &contact[i], b1, b2), SS_OK) << ssLastError();
+    probe->softened.push_back(contact[i].surface);
+    dJointAttach(dJointCreateContact(probe->world, probe->group, &contact[i]), b1, b2);
+  }
+}
+
+void ProbeCollide(void* context, ssStepper* stepper) {
+  auto* probe = static_cast<ContactProbe*>(context);
+  ProbeContext near = {probe, stepper};
+  dSpaceCollide(probe->space, &near, ProbeNearWithContext);
+}
+
+TEST_F(AdoptTest, ContactsSoftenedAtTheFrozenTunedStepGetTheProgramsOwnNumbers) {
+  dWorldSetGravity(world, 0, 0, -9.81);
+  dWorldSetERP(world, 0.27);
+  dCreatePlane(space, 0, 0, 1, 0);
+  Body(0, 0, 0.049);  // resting on the plane, touching it
+  const double tuned_step = 1.0 / 47;
+  ASSERT_EQ(ssRegistry_Adopt(registry, tuned_step, space, nullptr), SS_OK) << ssLastError();
+  ContactProbe probe = {world, space, dJointGroupCreate(0), 0, 0, 0, {}};
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = world;
+  def.registry = registry;
+  def.collide = ProbeCollide;
+  def.collide_context = &probe;
+  def.contact_group = probe.group;
+  def.stepping.solver = SS_SOLVER_QUICK;
+  ASSERT_EQ(ssSteppingForPolicy("naive", tuned_step, &def.stepping), SS_OK);
+  ssStepper* stepper = nullptr;
+  ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK) << ssLastError();
+
+  // soft CFM alone (ERP is the world's), and both soft; frames of the tuned step and of others: naive freezes the
+  // softness at the tuned step, so every contact gets what the program set.
+  struct Case {
+    int mode;
+    double erp, cfm;
+  } cases[] = {{dContactSoftCFM, 0, 1.3e-4}, {dContactSoftERP | dContactSoftCFM, 0.41, 2.9e-3}};
+  for (const Case& c : cases) {
+    probe.mode = c.mode;
+    probe.soft_erp = c.erp;
+    probe.soft_cfm = c.cfm;
+    for (double frame_s : {tuned_step, 1.0 / 30, 1.0 / 120}) {
+      probe.softened.clear();
+      ASSERT_EQ(ssStepper_Step(stepper, frame_s, nullptr), SS_OK) << ssLastError();
+      ASSERT_FALSE(probe.softened.empty());
+      for (const dSurfaceParameters& surface : probe.softened) {
+        EXPECT_EQ(surface.soft_erp, AsDReal((c.mode & dContactSoftERP) ? c.erp : 0.27)) << frame_s;
+        EXPECT_EQ(surface.soft_cfm, AsDReal(c.cfm)) << frame_s;
+      }
+    }
+  }
+
+  // Frozen at another step, the rate-independent form: what the tuned numbers stand for at that step.
+  ssStepping other = ssStepper_Stepping(stepper);
+  other.frozen_step_s = tuned_step / 2;
+  ASSERT_EQ(ssStepper_SetStepping(stepper, &other), SS_OK);
+  probe.softened.clear();
+  ASSERT_EQ(ssStepper_Step(stepper, tuned_step, nullptr), SS_OK) << ssLastError();
+  ASSERT_FALSE(probe.softened.empty());
+  const double h = tuned_step / 2, k = 0.41 / (tuned_step * 2.9e-3), c = (1 - 0.41) / 2.9e-3;
+  EXPECT_READ_BACK(probe.softened[0].soft_erp, h * k / (h * k + c), 1e-15);
+  EXPECT_READ_BACK(probe.softened[0].soft_cfm, 1 / (h * k + c), 1e-18);
+  ssStepper_Destroy(stepper);
+  dJointGroupDestroy(probe.group);
+}
+
+TEST_F(AdoptTest, AutoDisableSamplesWrittenAreBoundedAndAProgramThatNeverSamplesKeepsNot) {
+  dWorldSetAutoDisableFlag(world, 1);
+  dWorldSetAutoDisableSteps(world, 20);
+  dWorldSetAutoDisableAverageSamplesCount(world, 5);  // a window of 5 samples of 1/60 s
+  dBodyID sampled = Body(0, 0, 1);
+  dBodyID never = Body(1, 0, 1);
+  dBodySetAutoDisableAverageSamplesCount(never, 0);  // ODE never samples it: it never sleeps
+  dBodyID by_hand = MakeBody(1.0, 2, 0, 1);           // no geom: bound by hand
+  ASSERT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, nullptr), SS_OK) << ssLastError();
+  ASSERT_EQ(ssRegistry_BindAutoDisable(registry, by_hand, 0.5, 5 * kTunedStep), SS_OK) << ssLastError();
+
+  // 1 ns: the window would take ceil(5/60 s / 1e-9 s) = 83,333,334 samples (5 GB a body).
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 1e-9, 0, nullptr), SS_OK) << ssLastError();
+  EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(sampled), (unsigned)SS_MAX_AVERAGE_SAMPLES);
+  EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(by_hand), (unsigned)SS_MAX_AVERAGE_SAMPLES);
+  EXPECT_EQ(dWorldGetAutoDisableAverageSamplesCount(world), (unsigned)SS_MAX_AVERAGE_SAMPLES);
+  EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(never), 0u);
+  // ODE steps the bodies with their buffers
+  EXPECT_EQ(dWorldQuickStep(world, 1e-9), 1);
+  // within the bound, the window in seconds: 5 samples of 1/60 s are 10 of 1/120 s
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, kTunedStep / 2, 0, nullptr), SS_OK);
+  EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(sampled), 10u);
+  EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(by_hand), 10u);
+  EXPECT_EQ(dBodyGetAutoDisableAverageSamplesCount(never), 0u);
+}
+
+// What a program bound by hand before adopting, observable through what Apply writes at a step.
+struct HandBindings {
+  ssSpring world_spring{2000.0, 30.0};
+  ssSpring joint_spring{500.0, 4.0};
+  double world_damping_rate = 0.7, body_idle_s = 0.4;
+};
+
+TEST_F(AdoptTest, ARefusedAdoptionLeavesEveryEarlierBinding) {
+  const HandBindings hand;
+  dBodyID body = Body(0, 0, 1);
+  dJointID ball = dJointCreateBall(world, 0);
+  dJointAttach(ball, body, 0);
+  ASSERT_EQ(ssRegistry_BindWorld(registry, hand.world_spring, 0), SS_OK) << ssLastError();
+  ASSERT_EQ(ssRegistry_BindJoint(registry, ball, SS_PARAM_JOINT, 1, hand.joint_spring, 0), SS_OK);
+  ASSERT_EQ(ssRegistry_BindDamping(registry, 0, hand.world_damping_rate, 0), SS_OK);
+  ASSERT_EQ(ssRegistry_BindAutoDisable(registry, body, hand.body_idle_s, 0), SS_OK);
+
+  const double h = 1.0 / 100;
+  auto expect_hand_bindings = [&](const char* after) {
+    SCOPED_TRACE(after);
+    EXPECT_EQ(ssRegistry_TunedStep(registry), 0.0);
+    EXPECT_EQ(ssRegistry_JointBindingCount(registry), 1);
+    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, h, 0, nullptr), SS_OK) << ssLastError();
+    const double kw = hand.world_spring.stiffness, cw = hand.world_spring.damping;
+    EXPECT_READ_BACK(dWorldGetERP(world), h * kw / (h * kw + cw), 1e-15);
+    EXPECT_READ_BACK(dWorldGetCFM(world), 1 / (h * kw + cw), 1e-18);
+    const double kj = hand.joint_spring.stiffness, cj = hand.joint_spring.damping;
+    EXPECT_READ_BACK(dJointGetBallParam(ball, dParamERP), h * kj / (h * kj + cj), 1e-15);
+    EXPECT_READ_BACK(dWorldGetLinearDamping(world), 1 - std::exp(-hand.world_damping_rate * h), 1e-15);
+    EXPECT_EQ(dBodyGetAutoDisableSteps(body), 40);
+    EXPECT_READ_BACK(dBodyGetAutoDisableTime(body), hand.body_idle_s, 1e-15);
+    // an Apply at another step tells the next check apart from a leftover
+    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, 2 * h, 0, nullptr), SS_OK);
+  };
+  expect_hand_bindings("binding by hand");
+
+  // One bad value anywhere refuses the adoption: a joint row's, a body's, the world's.
+  dJointID hinge = dJointCreateHinge(world, 0);
+  dJointAttach(hinge, body, 0);
+  dJointSetHingeParam(hinge, dParamStopERP, 1.5);
+  EXPECT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("erp = 1.5"), std::string::npos) << ssLastError();
+  expect_hand_bindings("a refused joint row");
+  dJointSetHingeParam(hinge, dParamStopERP, 0.5);
+
+  dBodyID damped = Body(1, 0, 1);
+  dBodySetLinearDamping(damped, 1.0);  // removes all velocity: no rate
+  EXPECT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("damping scale = 1"), std::string::npos) << ssLastError();
+  expect_hand_bindings("a refused body");
+  dBodySetLinearDamping(damped, 0);
+
+  dWorldSetAutoDisableTime(world, -1);
+  EXPECT_EQ(ssRegistry_AdoptWorld(registry, kTunedStep, nullptr), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("world auto-disable time = -1"), std::string::npos) << ssLastError();
+  expect_hand_bindings("a refused world");
+  dWorldSetAutoDisableTime(world, 0);
+
+  // Now valid: adopted, the rows and bodies already bound keeping their bindings.
+  ssAdoptReport report = {};
+  ASSERT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, &report), SS_OK) << ssLastError();
+  EXPECT_EQ(report.world, 1);
+  EXPECT_EQ(report.bodies, 1);  // `damped`: `body` was bound by hand
+  const double kj = hand.joint_spring.stiffness, cj = hand.joint_spring.damping;
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, h, 0, nullptr), SS_OK) << ssLastError();
+  EXPECT_READ_BACK(dJointGetBallParam(ball, dParamERP), h * kj / (h * kj + cj), 1e-15);
+  EXPECT_EQ(dBodyGetAutoDisableSteps(body), 40);
+}
+
+TEST_F(AdoptTest, ObjectsOfAnotherWorldAreRefusedByName) {
+  dWorldID other = dWorldCreate();
+  Body(0, 0, 1);
+  dBodyID foreign = dBodyCreate(other);
+  dBodyID foreign_too = dBodyCreate(other);
+  dJointID foreign_ball = dJointCreateBall(other, 0);
+  dJointAttach(foreign_ball, foreign, foreign_too);
+  auto expect_named = [&](ssStatus status, const char* call) {
+    EXPECT_EQ(status, SS_ERROR_OUT_OF_RANGE) << call;
+    const std::string message = ssLastError();
+    EXPECT_NE(message.find("is of world"), std::string::npos) << call << ": " << message;
+    EXPECT_NE(message.find("not of the registry's world"), std::string::npos) << call << ": " << message;
+  };
+  expect_named(ssRegistry_BindJoint(registry, foreign_ball, SS_PARAM_JOINT, 1, {100, 1}, 0), "BindJoint");
+  expect_named(ssRegistry_BindDamping(registry, foreign, 0.1, 0.1), "BindDamping");
+  expect_named(ssRegistry_BindAutoDisable(registry, foreign, 1, 0), "BindAutoDisable");
+  EXPECT_EQ(ssRegistry_JointBindingCount(registry), 0);
+
+  // a geom of the space carrying a body of the other world: the whole adoption is refused, nothing is bound
+  dGeomID stray = dCreateSphere(space, 0.1);
+  dGeomSetBody(stray, foreign);
+  expect_named(ssRegistry_Adopt(registry, kTunedStep, space, nullptr), "Adopt");
+  EXPECT_EQ(ssRegistry_TunedStep(registry), 0.0);
+  dGeomSetBody(stray, 0);
+  // (a joint between bodies of two worlds cannot be made: dJointAttach aborts the process)
+  ASSERT_EQ(ssRegistry_Adopt(registry, kTunedStep, space, nullptr), SS_OK) << ssLastError();
+  expect_named(ssRegistry_AdoptBody(registry, foreign, nullptr), "AdoptBody");
+  expect_named(ssRegistry_AdoptJoint(registry, foreign_ball, nullptr), "AdoptJoint");
+  EXPECT_EQ(ssRegistry_JointBindingCount(registry), 0);
+
+  // a registry of this world given to a stepper of the other
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = other;
+  def.registry = registry;
+  def.stepping.solver = SS_SOLVER_QUICK;
+  ssStepper* stepper = nullptr;
+  EXPECT_EQ(ssStepper_Create(&def, &stepper), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(stepper, nullptr);
+  EXPECT_NE(std::string(ssLastError()).find("registry of world"), std::string::npos) << ssLastError();
+  dWorldDestroy(other);
 }
 
 }  // namespace

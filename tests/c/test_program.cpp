@@ -1,6 +1,7 @@
 // What a real ODE program does around the stepper: forces added once a frame, its own solver settings, contacts
 // softened in its own near callback. The truths: momentum F·dt, settings read back, the tuned softness.
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -293,7 +294,9 @@ TEST_F(ProgramTest, ForcesAndLoadsODECannotStepAreRefusedByNameBeforeAnythingMov
   def.registry = registry;
   ssStepper* stepper = nullptr;
   ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
-  for (double force : {1e300, double(NAN), double(INFINITY)}) {
+  // beyond the build's SS_MAX_FORCE_N, up to the largest torque dReal holds, and not finite
+  const double largest = std::numeric_limits<dReal>::max();
+  for (double force : {10 * SS_MAX_FORCE_N, largest, double(NAN), double(INFINITY)}) {
     dBodySetForce(body, 0, 0, 0);
     dBodyAddTorque(body, force, 0, 0);
     const double z = dBodyGetPosition(body)[2];
@@ -303,7 +306,7 @@ TEST_F(ProgramTest, ForcesAndLoadsODECannotStepAreRefusedByNameBeforeAnythingMov
     EXPECT_EQ(report.steps, 0);
     EXPECT_EQ(report.failed_body, body);
     EXPECT_EQ(dBodyGetPosition(body)[2], z);
-    EXPECT_TRUE(dBodyGetTorque(body)[0] == force || std::isnan(force)) << "left as it was";
+    EXPECT_TRUE(dBodyGetTorque(body)[0] == AsDReal(force) || std::isnan(force)) << "left as it was";
     EXPECT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_ERROR_FAILED);  // latched until the program repairs
     dBodySetTorque(body, 0, 0, 0);
     ssStepper_Reset(stepper);
@@ -427,8 +430,9 @@ void AlternatingNear(void* data, dGeomID a, dGeomID b) {
     ASSERT_EQ(ssStepper_SoftenContact(stepper, &contact[i], dGeomGetBody(a), dGeomGetBody(b)), SS_OK)
         << ssLastError();
     const ssStepInfo step = ssStepper_CurrentStep(stepper);
-    const double h0 = g_alternating->tuned_s;
-    const ssSpring spring = {erp / (h0 * cfm), (1 - erp) / cfm};
+    // the pair as the contact holds it (rounded once to dReal) is what the stepper reads
+    const double h0 = g_alternating->tuned_s, held_erp = AsDReal(erp), held_cfm = AsDReal(cfm);
+    const ssSpring spring = {held_erp / (h0 * held_cfm), (1 - held_erp) / held_cfm};
     ASSERT_EQ(ssContactSoften(&fresh, dGeomGetBody(a), dGeomGetBody(b), spring, step.mapping, step.softness_step_s,
                               step.previous_step_s),
               SS_OK)

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include "ode_fixture.h"
+#include "precision.h"
 #include "test_stepping.h"
 #include "steadystep/steadystep.h"
 
@@ -91,7 +93,7 @@ TEST_F(PromiseTest, ANanTorqueAddedByAControllerInBeforeStepIsRefusedByNameNotAn
   def.before_step_context = &pd;
   ASSERT_EQ(Make(def), SS_OK) << ssLastError();
   const dReal* p = dBodyGetPosition(arm);
-  const double before[3] = {p[0], p[1], p[2]};
+  const dReal before[3] = {p[0], p[1], p[2]};  // as ODE holds it, bit for bit
   ssFrameReport report;
   EXPECT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_ERROR_NOT_FINITE);
   EXPECT_TRUE(Names("torque (") && Names("nan, 0, 0) N*m")) << ssLastError();
@@ -106,22 +108,36 @@ TEST_F(PromiseTest, ANanTorqueAddedByAControllerInBeforeStepIsRefusedByNameNotAn
   EXPECT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_OK) << ssLastError();
 }
 
+// Beyond the build's bounds and held by dReal: in double a speed whose square (the guard squares in double) is near
+// DBL_MAX; a float holds no such speed, so there ten times SS_MAX_SAFE_SPEED. A force ten times SS_MAX_FORCE_N.
+constexpr double kTooFastRadPerS = kSinglePrecision ? 10 * SS_MAX_SAFE_SPEED : 1e154;
+constexpr double kTooStrongN = 10 * SS_MAX_FORCE_N;
+
+// What a message prints for x as ODE holds it.
+std::string Printed(const char* format, double x) {
+  char text[64];
+  std::snprintf(text, sizeof text, format, AsDReal(x));
+  return text;
+}
+
 TEST_F(PromiseTest, AStateSetBetweenFramesIsRefusedByNameBeforeODEOrTheSpaceSeesIt) {
   dBodyID body = Box(0, 0, 1);
   ssStepperDef def = Def();
   def.stepping.max_speed = 0;  // the guard at its widest: SS_MAX_SAFE_SPEED
   def.stepping.max_angular_speed = 0;
   ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  const std::string too_fast = Printed("angular speed %g rad/s", kTooFastRadPerS);
+  const std::string too_strong = Printed("force (0, 0, %g) N", kTooStrongN);
   struct Case {
     void (*set)(dBodyID);
     ssStatus status;
     const char* named;
   } cases[] = {
-      {[](dBodyID b) { dBodySetAngularVel(b, 1e154, 0, 0); }, SS_ERROR_SPEED_LIMIT, "angular speed 1e+154 rad/s"},
+      {[](dBodyID b) { dBodySetAngularVel(b, kTooFastRadPerS, 0, 0); }, SS_ERROR_SPEED_LIMIT, too_fast.c_str()},
       {[](dBodyID b) { dBodySetAngularVel(b, 0, INFINITY, 0); }, SS_ERROR_BLOWUP, "angular velocity (0, inf, 0)"},
       {[](dBodyID b) { dBodySetLinearVel(b, NAN, 0, 0); }, SS_ERROR_BLOWUP, "linear velocity (nan, 0, 0)"},
       {[](dBodyID b) { dBodySetPosition(b, 1e9, 0, 1); }, SS_ERROR_POSITION_LIMIT, "position (1e+09, 0, 1) m"},
-      {[](dBodyID b) { dBodyAddForce(b, 0, 0, 1e31); }, SS_ERROR_OUT_OF_RANGE, "force (0, 0, 1e+31) N"},
+      {[](dBodyID b) { dBodyAddForce(b, 0, 0, kTooStrongN); }, SS_ERROR_OUT_OF_RANGE, too_strong.c_str()},
   };
   for (const Case& c : cases) {
     dBodySetPosition(body, 0, 0, 1);
@@ -292,7 +308,8 @@ TEST_F(PromiseTest, AFrameOfZeroSecondsReadsAndClearsTheFramesForces) {
     dBodyAddForce(body, 1, 0, 0);  // 1 N on 1 kg, added every frame
     ASSERT_EQ(ssStepper_Step(stepper, frame_s, nullptr), SS_OK) << ssLastError();
   }
-  EXPECT_NEAR(dBodyGetLinearVel(body)[0], 2.0 / 60, 1e-9);  // F·(1/60 + 0 + 1/60) / m
+  // F·(1/60 + 0 + 1/60) / m, over 2 steps (float: each rounds v, 1.7e-9 m/s measured)
+  EXPECT_NEAR(dBodyGetLinearVel(body)[0], 2.0 / 60, IntegratedTolerance(1e-9, 2 * kDRealEpsilon * 2.0 / 60));
 }
 
 // ---- d. the bodies the stepper knows ----
@@ -309,7 +326,8 @@ TEST_F(PromiseTest, ABodySpawnedAfterAdoptionGetsItsWholeFrameForce) {
     ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 20, &report), SS_OK) << ssLastError();
     ASSERT_EQ(report.steps, 3);
   }
-  EXPECT_NEAR(dBodyGetLinearVel(spawned)[0], 1.0, 1e-9);  // F·t / m
+  // F·t / m, over 60 steps (float: each rounds v, 3e-7 m/s measured)
+  EXPECT_NEAR(dBodyGetLinearVel(spawned)[0], 1.0, IntegratedTolerance(1e-9, 60 * kDRealEpsilon * 1.0));
   EXPECT_EQ(ssStepper_Adopted(stepper).bodies, adopted + 1);
 }
 
@@ -367,7 +385,8 @@ TEST_F(PromiseTest, ABobHungFromAKnownBodyIsKnownThroughItsJointAndOneHungFromTh
     ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 20, nullptr), SS_OK) << ssLastError();
   }
   EXPECT_EQ(ssStepper_KnownBodyCount(stepper), 3);
-  EXPECT_NEAR(dBodyGetLinearVel(hung)[0], 1.0, 1e-9);  // F·t / m on its rail
+  // F·t / m on its rail, over 60 steps (float: each rounds v, 3e-7 m/s measured)
+  EXPECT_NEAR(dBodyGetLinearVel(hung)[0], 1.0, IntegratedTolerance(1e-9, 60 * kDRealEpsilon * 1.0));
   // the bob and the box share the momentum along the slider: (m_bob + m_box) v = F t
   EXPECT_NEAR(dBodyGetLinearVel(bob)[0] + dBodyGetLinearVel(box)[0] - v_box, 1.0, 1e-6);
 }
@@ -410,7 +429,9 @@ TEST_F(PromiseTest, AOneStepFrameStepsTheProgramsForcesBitForBit) {
     ASSERT_EQ(ssStepper_Step(stepper, h, nullptr), SS_OK) << ssLastError();
   }
   ASSERT_EQ(seen.forces.size(), 30u);
-  for (double seen_force : seen.forces) EXPECT_EQ(seen_force, force);  // as added, not F·h/h
+  // as added (ODE holds F rounded once to dReal), not F·h/h; in float a rewrite in double would round back to the
+  // same bits, and the states compared below are what says the steps were the program's own
+  for (double seen_force : seen.forces) EXPECT_EQ(seen_force, AsDReal(force));
   EXPECT_EQ(std::memcmp(dBodyGetLinearVel(mine), dBodyGetLinearVel(body), 3 * sizeof(dReal)), 0);
   EXPECT_EQ(std::memcmp(dBodyGetAngularVel(mine), dBodyGetAngularVel(body), 3 * sizeof(dReal)), 0);
   EXPECT_EQ(std::memcmp(dBodyGetPosition(mine), dBodyGetPosition(body), 3 * sizeof(dReal)), 0);
@@ -424,7 +445,7 @@ TEST_F(PromiseTest, TheStepperWritesNoSolverSettingTheProgramDidNotAskFor) {
   ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
   for (int frame = 0; frame < 5; ++frame) ASSERT_EQ(ssStepper_Step(stepper, 0.05, nullptr), SS_OK);
   EXPECT_EQ(dWorldGetQuickStepNumIterations(world), 37);
-  EXPECT_EQ(dWorldGetQuickStepW(world), 1.1);
+  EXPECT_EQ(dWorldGetQuickStepW(world), AsDReal(1.1));
 }
 
 }  // namespace

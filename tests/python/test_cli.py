@@ -5,6 +5,7 @@ import csv
 import io
 import json
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -31,6 +32,18 @@ def test_every_command_has_help():
     for command in ([], ["figure"], ["compare"], ["run"], ["probe"], ["convert"]):
         result = steadystep(*command, "--help")
         assert result.returncode == 0 and "usage: steadystep" in result.stdout
+
+
+def test_help_names_policies_the_library_knows():
+    # "spring" was the implicit-Euler policy's name in 0.1.0: help texts must name the policies that exist
+    from steadystep.runs import policy_names
+    known = set(policy_names())
+    for command in ("compare", "probe"):
+        text = " ".join(steadystep(command, "--help").stdout.split())
+        default = text.rsplit("--policies POLICY [POLICY ...]", 1)[1].split("default:", 1)[1].split("--", 1)[0]
+        listed = default.split("(", 1)[1].split(")", 1)[0] if "(" in default else default  # "every policy (...)"
+        named = listed.split()
+        assert named and set(named) <= known, (command, named)
 
 
 def test_figure_writes_png_and_svg(tmp_path):
@@ -209,3 +222,20 @@ def test_the_old_policy_name_spring_is_refused_naming_its_new_name():
     result = steadystep("run", "oscillator", "--policy", "spring", "--profile", "fixed:30", "--duration", "1")
     assert result.returncode == 2 and result.stdout == ""
     assert '"spring" is now called implicit-euler' in result.stderr and "Traceback" not in result.stderr
+
+
+def test_the_help_lists_are_the_librarys():
+    from steadystep import probe, runs
+
+    scenes = ", ".join(runs.scene_names())
+    for command in ("compare", "probe", "run"):
+        text = " ".join(steadystep(command, "--help").stdout.split())  # argparse wraps lines anywhere
+        # The policy once called "spring" is implicit-euler: "spring" is left only as the scenes' spring itself.
+        assert re.findall(r"\bspring\b(?! (?:stiffness|damping))", text) == [], command
+        if command != "compare":
+            assert scenes in text, command
+    compare = " ".join(steadystep("compare", "--help").stdout.split())
+    assert " ".join(runs.policy_names()) in compare
+    probe_help = " ".join(steadystep("probe", "--help").stdout.split())
+    assert f"default: {' '.join(probe.default_policies())}" in probe_help
+    assert probe.default_policies() == [p for p in runs.policy_names() if not p.startswith("fixed")]
