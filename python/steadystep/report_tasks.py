@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from steadystep import animation, cost, probe, runs, study
-from steadystep.files import atomic_write
+from steadystep.files import write_bytes
 from steadystep.profiles import frame_times
 from steadystep.report_aggregate import deviation, exact_curve
 from steadystep.report_validate import with_spring
@@ -155,8 +155,7 @@ def run_phases(report, units: dict[tuple, dict], executor, progress: bool | None
 
         def figures_done(scene: str, files: list[tuple[str, bytes]]):
             paths = report.figures.setdefault(scene, [])
-            paths += [atomic_write(figure_dir / name, lambda t, data=data: Path(t).write_bytes(data))
-                      for name, data in files]
+            paths += [write_bytes(figure_dir / name, data) for name, data in files]
             paths.sort(key=lambda path: (path.name.startswith("deviation_"), path.name))  # as drawn in order
             bar.set_postfix_str(f"{scene} figures", refresh=False)
             bar.update()
