@@ -77,9 +77,9 @@ static void countRow(const ssRowFallback* fallback, ssApplyReport* report) {
 
 /* The softness of one row for this step, counting in the report how it was obtained. */
 static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass, double step_s,
-                            double previous_step_s, ssApplyReport* report, ssRowFallback* fallback,
-                            ssSoftness* out) {
-  ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, fallback, out);
+                            double previous_step_s, int load_declared, ssApplyReport* report,
+                            ssRowFallback* fallback, ssSoftness* out) {
+  ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, load_declared, fallback, out);
   countRow(fallback, report);
   return status;
 }
@@ -89,6 +89,7 @@ typedef struct SharedSoftness {
   const ssRowLaw* law;
   int law_slot;
   double mass; /* compared only where the mapping reads it */
+  int load_declared; /* an accurate mapping keeps a loaded row's softness where it hands an unloaded one on */
   ssSoftness softness;
   ssRowFallback fallback;
 } SharedSoftness;
@@ -277,14 +278,16 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
     const SharedSoftness* hit = NULL;
     for (int j = 0; j < shared_count && hit == NULL; ++j)
-      if ((any_mass || shared[j].mass == mass) && sharedLaw(&shared[j], law, binding->law_slot)) hit = &shared[j];
+      if ((any_mass || shared[j].mass == mass) && shared[j].load_declared == (binding->load != 0) &&
+          sharedLaw(&shared[j], law, binding->law_slot))
+        hit = &shared[j];
     if (hit != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
       countRow(&hit->fallback, counts);
     } else {
-      status = softnessFor(law, mapping, mass, step_s, previous_s, counts, &binding->computed_fallback,
-                           &binding->pending);
+      status = softnessFor(law, mapping, mass, step_s, previous_s, binding->load != 0, counts,
+                           &binding->computed_fallback, &binding->pending);
       /* the boundary with ODE: nothing outside limits.h's ranges is ever written */
       if (status == SS_OK) status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
       if (status != SS_OK) {
@@ -293,7 +296,8 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       }
       if (!(registry->disabled_caches & SS_CACHE_SHARED)) {
         shared[shared_next] =
-            (SharedSoftness){law, binding->law_slot, mass, binding->pending, binding->computed_fallback};
+            (SharedSoftness){law, binding->law_slot, mass, binding->load != 0, binding->pending,
+                             binding->computed_fallback};
         shared_next = (shared_next + 1) % kSharedSize;
         if (shared_count < kSharedSize) shared_count += 1;
       }
@@ -369,7 +373,8 @@ static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* s
       softness[j] = (ssSoftness){.erp = step_s * law->spring.stiffness / hk_plus_c, .cfm = 1.0 / hk_plus_c};
       if (softness[j].cfm > 0 && softness[j].cfm <= SS_MAX_CFM) continue;
     }
-    ssStatus status = ssRowSoftness(&registry->laws[j], SS_MAPPING_IMPLICIT_EULER, NAN, step_s, 0, NULL, &softness[j]);
+    ssStatus status =
+        ssRowSoftness(&registry->laws[j], SS_MAPPING_IMPLICIT_EULER, NAN, step_s, 0, 0, NULL, &softness[j]);
     if (status == SS_OK) status = ssCheckSoftnessForOde("softness", softness[j].erp, softness[j].cfm);
     if (status == SS_OK) continue;
     for (int i = 0; i < registry->joint_count; ++i)
@@ -436,7 +441,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   }
   if (registry->world_bound) {
     ssRowFallback fallback;
-    status = softnessFor(&registry->world_law, mapping, registry->world_mass, step_s, previous_step_s, &counts,
+    status = softnessFor(&registry->world_law, mapping, registry->world_mass, step_s, previous_step_s, 0, &counts,
                          &fallback, &registry->world_pending);
     if (status == SS_OK)
       status = ssCheckSoftnessForOde("softness", registry->world_pending.erp, registry->world_pending.cfm);

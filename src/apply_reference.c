@@ -46,7 +46,8 @@ static ssStatus computeRow(const ssJointRowBinding* row, ssMapping mapping, doub
                            ssApplyReport* report, Computed* out) {
   double mass = row->effective_mass > 0 ? row->effective_mass : row->law.hard ? NAN : measuredMass(row);
   ssRowFallback fallback;
-  ssStatus status = ssRowSoftness(&row->law, mapping, mass, step_s, previous_s, &fallback, &out->softness);
+  ssStatus status =
+      ssRowSoftness(&row->law, mapping, mass, step_s, previous_s, row->load != 0, &fallback, &out->softness);
   if (status == SS_OK) status = ssCheckSoftnessForOde("softness", out->softness.erp, out->softness.cfm);
   if (status != SS_OK) return status;
   out->correction = 0;
@@ -121,7 +122,7 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
   if (world_bound) {
     double mass = ssRegistryWorldMass(registry);
     ssRowFallback fallback;
-    status = ssRowSoftness(&world_law, mapping, mass, step_s, previous_s, &fallback, &world);
+    status = ssRowSoftness(&world_law, mapping, mass, step_s, previous_s, 0, &fallback, &world);
     if (status == SS_OK) status = ssCheckSoftnessForOde("softness", world.erp, world.cfm);
     if (status != SS_OK) return status;
     count(&fallback, &counts);

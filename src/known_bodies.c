@@ -232,22 +232,40 @@ static ssStatus describe(dBodyID body, const ssBodyBounds* bounds, const char* w
   return ssFail(SS_ERROR_BLOWUP, "body %p: failed a check %s", (void*)body, when); /* not reached */
 }
 
+/* Whether a transmission joint gears the body (read only for a body spinning fast enough to matter). */
+static int geared(dBodyID body) {
+  for (int i = dBodyGetNumJoints(body) - 1; i >= 0; --i)
+    if (dJointGetType(dBodyGetJoint(body, i)) == dJointTypeTransmission) return 1;
+  return 0;
+}
+
 ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       dBodyID* failed) {
   const double max_speed2 = bounds->max_speed * bounds->max_speed;
   const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
+  const double gear_spin = bounds->gear_step_s > 0 ? SS_MAX_GEAR_TURN_RAD / bounds->gear_step_s : INFINITY;
+  const double gear_spin2 = gear_spin * gear_spin;
   for (int k = 0; k < known->count; ++k) {
     dBodyID body = known->ids[k];
+    double spin2 = squared(dBodyGetAngularVel(body));
     /* every comparison is false for a NaN, and an infinity is beyond every bound: one test a number */
     int ok = within(dBodyGetPosition(body), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(body)) <= max_speed2 &&
-             squared(dBodyGetAngularVel(body)) <= max_spin2;
+             spin2 <= max_spin2;
     if (ok && bounds->forces)
       ok = within(dBodyGetForce(body), SS_MAX_FORCE_N) && within(dBodyGetTorque(body), SS_MAX_FORCE_N);
+    char named[64];
     if (!ok) {
       *failed = body;
-      char named[64];
       snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
       return describe(body, bounds, named);
+    }
+    if (spin2 > gear_spin2 && geared(body)) {
+      *failed = body;
+      snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
+      return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: angular speed %g rad/s %s turns its transmission gear %g rad in a "
+                    "step of %g s: above SS_MAX_GEAR_TURN_RAD = %g rad (ODE 0.16 aborts from pi)", (void*)body,
+                    sqrt(spin2), named, sqrt(spin2) * bounds->gear_step_s, bounds->gear_step_s,
+                    SS_MAX_GEAR_TURN_RAD);
     }
   }
   return SS_OK;

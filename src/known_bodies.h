@@ -56,10 +56,14 @@ void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces)
 typedef struct ssBodyBounds {
   double max_speed, max_angular_speed; /* m/s, rad/s */
   int forces;                          /* the force and torque accumulators, within SS_MAX_FORCE_N */
+  /* > 0: the step (s) just taken or about to be: a body geared by a transmission joint turns less than
+   * SS_MAX_GEAR_TURN_RAD in it (ODE 0.16 aborts when a gear turns by pi or more between two steps) */
+  double gear_step_s;
 } ssBodyBounds;
 
 /* Checks every listed body, one pass over the packed handles: its position within SS_MAX_POSITION_M, velocities finite
- * and within the bounds, and with bounds->forces its accumulators. On the first failure records the message (the body,
+ * and within the bounds, a geared body's turn within a step (bounds->gear_step_s), and with bounds->forces its
+ * accumulators. On the first failure records the message (the body,
  * the quantity, its value, "`when` step `step` of `steps`", formatted then only), sets *failed to the body and returns
  * SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a force or
  * torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). */

@@ -97,10 +97,10 @@ enum {
 void ssRegistryDisableCaches(ssRegistry* registry, unsigned mask);
 
 /* The last contact's softness, for the contacts that follow with the same numbers. A program softens every contact
- * of a step with one or a few surfaces: a contact whose tuned erp/cfm, tuned step, mapping and step (and, for the
- * exact mapping, previous step) are the last one's reuses its law and, where the softness does not depend on the
- * bodies (implicit Euler, naive, hard rows) or the effective mass is the same, its softness, with no conversion and
- * no check repeated: they were made, and passed, for the same inputs. */
+ * of a step with one or a few surfaces: a contact whose tuned erp/cfm, tuned step, mapping and step are the last
+ * one's reuses its law and its softness (which depends on the step
+ * alone: every mapping serves a contact with implicit Euler, contact.c), with no conversion and no check repeated:
+ * they were made, and passed, for the same inputs. previous_step_s and mass are kept empty (0, NAN). */
 typedef struct ssContactCache {
   double tuned_erp, tuned_cfm, tuned_step_s; /* NAN: empty */
   ssRowLaw law;

@@ -65,8 +65,43 @@ static ssStatus implicitEuler(const ssRowLaw* law, double step_s, ssSoftness* ou
   return ssSoftnessFromSpring(law->spring, step_s, out);
 }
 
+/* When an accurate mapping may serve a row: the rule that keeps matched and exact from losing to implicit Euler.
+ *
+ * Both accurate mappings spend ODE's two free numbers (erp, cfm) on the poles of one row of effective mass m:
+ * the homogeneous motion m x'' + c x' + k x = 0 is reproduced, and nothing else is. What a row carries besides
+ * its own spring is not. ODE's row law is f = -(erp/(h·cfm))·x - (1/cfm)·v', so a constant load F along the row
+ * rests at x = F/k' with the step's static stiffness
+ *     k' = erp/(h·cfm) = m·(1 - z1)(1 - z2)/(h²·z1·z2)   (matched; z = e^(s·h), the poles)
+ *        ≈ k·(1 + σh)·sinc²(ω·h/2)                        (lightly damped; σ = c/2m, ω the frequency),
+ * while implicit Euler (erp = hk/(hk + c), cfm = 1/(hk + c)) has k' = k exactly, at every step. A load the registry
+ * knows (ssRegistry_SetJointLoad) is corrected: the registry adds F·(k'/k - 1) along the row, which moves the rest
+ * back to F/k without touching the poles. A load it does not know is the weight a stacked contact carries, the
+ * motor pressing a ram into its stop, the chassis on a suspension nobody declared: the row then rests at F/k'
+ * where the spring rests at F/k, an error of F/k·|k/k' - 1| in every quantity the row holds up, which no accuracy
+ * of the poles repays once the motion has settled (the lab's stack stood 4 mm too high, k'/k about 3).
+ *
+ * Where k' is far from k, h is not short against the row's own time scales (σh or ω·h of order 1: a contact of a
+ * light box under a stiff, strongly damped law, a stop of a ram whose decay takes a fraction of a step), which is
+ * also where the isolated row's effective mass describes the motion least: the mode of a box on four contact
+ * points, or of a ram between its stop and its motor, is not one row's. So the rule, applied to every row whose
+ * load is not declared (contacts, whose load is never known, go further: contact.c):
+ *     an accurate softness serves the row only if |k/k' - 1| <= SS_STATIC_RESPONSE_TOLERANCE (5 %),
+ *     otherwise implicit Euler serves it (counted in handed_to_implicit_euler);
+ * a pure damper (k = 0, motors) likewise with its static damping 1/cfm against c (a load drives it at F·cfm where
+ * the damper moves at F/c; matched's 1/cfm = m(e^(ch/m) - 1)/h). The rule keeps rows with σh up to about 0.05
+ * and ω·h up to about 0.75 (eight steps a period): where one spring dominates one body at steps short against it
+ * (the oscillator: σh = 0.008 at 1/60 s, 0.033 at 1/15 s; a suspension with its load declared) the accurate
+ * mappings keep serving; elsewhere the row moves under implicit Euler, as it would without them. */
+int ssKeepsStaticResponse(ssSpring spring, ssSoftness softness, double step_s) {
+  if (spring.stiffness > 0) {
+    double static_stiffness = softness.erp / (step_s * softness.cfm);
+    return fabs(spring.stiffness / static_stiffness - 1.0) <= SS_STATIC_RESPONSE_TOLERANCE;
+  }
+  return fabs(spring.damping * softness.cfm - 1.0) <= SS_STATIC_RESPONSE_TOLERANCE;
+}
+
 ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
-                       ssRowFallback* fallback, ssSoftness* out) {
+                       int load_declared, ssRowFallback* fallback, ssSoftness* out) {
   ssRowFallback local;
   if (fallback == NULL) fallback = &local;
   *fallback = (ssRowFallback){0, 0};
@@ -75,20 +110,29 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
     /* The accurate mappings need a mass, damping (c = 0 puts the poles on the unit circle) and a frequency the
      * step can sample: a near-rigid row above Nyquist has poles that no (erp, cfm) of this step reproduces. */
     int servable = mass > 0 && isfinite(mass) && law->spring.damping > 0 && !ssOverNyquist(law->spring, mass, step_s);
-    if (servable) {
-      /* A pure damper (k = 0) has no position to correct: its velocity decays by exp(-c·h/m) per step whatever the
-       * steps before, which the matched mapping reproduces exactly; the exact mapping's history adds nothing. The
-       * law, the mass and the step are valid here, so the matched mapping needs no second check. */
-      int matched = mapping == SS_MAPPING_MATCHED || law->spring.stiffness == 0;
-      ssStatus status = matched ? ssMatchedSoftnessUnchecked(law->spring, mass, step_s, out)
-                                : ssExactSoftness(law->spring, mass, step_s, previous_step_s, out);
-      if (status == SS_ERROR_NO_FINITE_MAPPING && !matched) {
-        status = ssMatchedSoftnessUnchecked(law->spring, mass, step_s, out);
-        fallback->exact_to_matched = status == SS_OK;
+    /* The matched softness first: it is the rule's measure (the static response of steady steps, which exact
+     * equals at h = h_p; exact's own varies with h/h_p around it, and a row that changed mappings with h/h_p would
+     * lose the history exact needs) and exact's fallback. The law, the mass and the step are valid here, so it
+     * needs no second check. A declared load is corrected by the caller (pure dampers get no correction). */
+    ssSoftness matched;
+    ssStatus status = servable ? ssMatchedSoftnessUnchecked(law->spring, mass, step_s, &matched)
+                               : SS_ERROR_NO_FINITE_MAPPING;
+    int load_corrected = load_declared && law->spring.stiffness > 0;
+    if (status == SS_OK && (load_corrected || ssKeepsStaticResponse(law->spring, matched, step_s))) {
+      /* A pure damper (k = 0) has no position to correct: its velocity decays by exp(-c·h/m) per step whatever
+       * the steps before, which the matched mapping reproduces exactly; the exact mapping's history adds nothing. */
+      if (mapping == SS_MAPPING_MATCHED || law->spring.stiffness == 0) {
+        *out = matched;
+        return SS_OK;
       }
+      status = ssExactSoftness(law->spring, mass, step_s, previous_step_s, out);
       if (status == SS_OK) return SS_OK;
       if (status != SS_ERROR_NO_FINITE_MAPPING) return status;
+      *out = matched;
+      fallback->exact_to_matched = 1;
+      return SS_OK;
     }
+    if (status != SS_OK && status != SS_ERROR_NO_FINITE_MAPPING) return status;
     fallback->exact_to_matched = 0;
     fallback->to_implicit_euler = 1;
   }

@@ -43,11 +43,26 @@ ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law);
 
 /* The softness of the row for a step of step_s under mapping: for a tuned law at its tuned step under implicit Euler
  * (or a hard law, whose rule is the same under every mapping), the tuned erp/cfm themselves. mass (kg or kg·m²) is
- * read by the accurate mappings only; pass NAN when the row has none. Where MATCHED or EXACT cannot serve the row (no mass, c = 0, natural
- * frequency above the step's Nyquist frequency, no finite softness) the implicit-Euler mapping serves it and
- * fallback->to_implicit_euler says so. fallback may be NULL. Errors: those of ssSoftnessFromSpring. */
+ * read by the accurate mappings only; pass NAN when the row has none. load_declared: the program declared the
+ * steady load the row carries (ssRegistry_SetJointLoad), and the caller adds the force that puts its rest back at
+ * load/k. Where MATCHED or EXACT cannot serve the row the implicit-Euler mapping serves it and
+ * fallback->to_implicit_euler says so: no mass, c = 0, natural frequency above the step's Nyquist frequency, no
+ * finite softness, or (the rule of ssKeepsStaticResponse) a static response so far from the law's that an
+ * undeclared load would rest elsewhere than under the spring. fallback may be NULL. Errors: those of
+ * ssSoftnessFromSpring. */
 ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
-                       ssRowFallback* fallback, ssSoftness* out);
+                       int load_declared, ssRowFallback* fallback, ssSoftness* out);
+
+/* How far (relative) an accurate softness' static response may be from the spring's for the row to be served
+ * with an undeclared load: the rest position is then within this fraction of the sag F/k that implicit Euler gives
+ * exactly. Issue 15's tolerance (1.05 times implicit Euler's deviation) on the part of the motion a load sets. */
+#define SS_STATIC_RESPONSE_TOLERANCE 0.05
+
+/* Whether the softness, written for a step of step_s, responds to a constant load as the spring does, within
+ * SS_STATIC_RESPONSE_TOLERANCE: the static stiffness k' = erp/(h·cfm) of ODE's step against k (a load F rests at
+ * F/k' instead of F/k), or for a pure damper (k = 0) its static damping 1/cfm against c (a load drives it at F·cfm
+ * instead of F/c). The implicit-Euler mapping keeps both exactly (k' = k, 1/cfm = h·k + c). */
+int ssKeepsStaticResponse(ssSpring spring, ssSoftness softness, double step_s);
 
 /* w·h > π, i.e. k·h² > π²·m: the spring's natural frequency is above half the step rate. False for a NAN
  * mass. Inline: the registry asks it of every row at every Apply. */

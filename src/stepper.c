@@ -442,10 +442,10 @@ static ssStatus latch(ssStepper* stepper, ssStatus status) {
 }
 
 /* Every known body's state and forces (as asked) within limits.h and the stepping's speeds. */
-static ssStatus checkKnown(ssStepper* stepper, int forces, const char* when, int index, int steps,
+static ssStatus checkKnown(ssStepper* stepper, int forces, const char* when, int index, int steps, double step_s,
                            ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
-  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, forces};
+  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, forces, step_s};
   dBodyID failed = 0;
   ssStatus status = ssKnownCheck(&stepper->known, &bounds, when, index + 1, steps, &failed);
   if (status != SS_OK) report->failed_body = failed;
@@ -514,7 +514,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
      * frame's checked forces spread over its steps, and load corrections within SS_MAX_FORCE_N */
     int called_back = def->before_step || def->collide;
     if ((status = refreshKnown(stepper)) != SS_OK ||
-        (called_back && (status = checkKnown(stepper, 1, "before", i, steps, report)) != SS_OK))
+        (called_back && (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistory_BeforeLastStep(stepper->poses);
     int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, step_s)
@@ -525,7 +525,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     addServed(&report->rows, &applied.rows);
     report->step_s = step_s;
     report->simulated_s += step_s;
-    if ((status = checkKnown(stepper, 0, "after", i, steps, report)) != SS_OK) return latch(stepper, status);
+    if ((status = checkKnown(stepper, 0, "after", i, steps, step_s, report)) != SS_OK) return latch(stepper, status);
     stepper->previous_step_s = use_history ? step_s : 0;
     if (def->step_done) def->step_done(def->step_done_context, step_s);
     if (stepper->destroy_requested) return SS_OK;
@@ -593,7 +593,7 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
  * SS_MAX_POSITION_M would abort), and the frame's forces read. Nothing is touched on an error. */
 static ssStatus startFrame(ssStepper* stepper, ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
-  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, 1};
+  ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, 1, 0};
   ssStatus status = findNew(stepper, 0);
   for (int joints_changed = 1; status == SS_OK && joints_changed;) {
     dBodyID failed = 0;

@@ -151,6 +151,14 @@
  *  back as it was at the step it was tuned for (adopt.h), whatever its size. */
 #define SS_MAX_AVERAGE_SAMPLES 1000
 
+/** The largest turn (rad) of a body geared by a transmission joint in one physics step: pi/2. ODE 0.16's
+ *  transmission joint tracks each gear's phase from step to step and aborts the process (`fabs(phase_hat - phase[i])
+ *  < M_PI`, transmission.cpp) when a gear turns by pi or more between two steps: at 1/60 s that is 188 rad/s, far
+ *  inside the speed guard. A stepper refuses the step (SS_ERROR_SPEED_LIMIT, named) once a geared body spins faster
+ *  than this turn per step, before and after every step, with half of ODE's edge as the margin for the step that
+ *  follows. */
+#define SS_MAX_GEAR_TURN_RAD 1.5707963267948966
+
 /** The shortest and longest frame (s) a lab profile hands out (profile.h): 1e-12 s to SS_MAX_STEP_S. Frames
  *  shorter than SS_MIN_STEP_S are allowed on purpose, to exercise carrying a frame over. */
 #define SS_MIN_PROFILE_FRAME_S 1e-12

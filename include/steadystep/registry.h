@@ -47,7 +47,8 @@ typedef struct ssServedCounts {
   int by_mapping;               /* served by the stepping's own mapping (every one under implicit Euler) */
   int handed_to_matched;        /* exact only: served by matched (this step length gave exact no finite softness) */
   int handed_to_implicit_euler; /* matched/exact only: served by implicit Euler (above the step's Nyquist
-                                 * frequency, undamped, no effective mass, a static load, no finite softness) */
+                                 * frequency, undamped, no effective mass, a static stiffness off by more than
+                                 * 5 % with no load declared, no finite softness; every contact) */
 } ssServedCounts;
 
 /** What one Apply did. */
@@ -127,8 +128,10 @@ SS_API ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body);
  *  previous_step_s is the length of the step before (0 when there is none or after a teleport); only
  *  SS_MAPPING_EXACT reads it. A row that matched or exact cannot serve at this step (no effective mass, c = 0, a
  *  natural frequency above the step's Nyquist frequency, no finite softness, a load correction beyond
- *  SS_MAX_FORCE_N) is written with implicit Euler and counted. Either everything is written or, on an error,
- *  nothing is. report may be NULL.
+ *  SS_MAX_FORCE_N, or, with no load declared (ssRegistry_SetJointLoad), a matched static stiffness
+ *  erp/(step_s·cfm) more than 5 % from k, or a pure damper's 1/cfm more than 5 % from c: an undeclared load would
+ *  rest elsewhere than the spring puts it; docs/exact-mappings.md) is written with implicit Euler and counted.
+ *  Either everything is written or, on an error, nothing is. report may be NULL.
  *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (registry NULL, step_s, previous_step_s);
  *  SS_ERROR_UNSUPPORTED for an unknown mapping. */
 SS_API ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
@@ -151,11 +154,13 @@ SS_API int ssJointSupports(dJointID joint, ssJointParam param, int axis);
 SS_API ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axis, double* mass);
 
 /** Fills contact->surface.soft_erp and soft_cfm from spring for a step of step_s and sets dContactSoftERP and
- *  dContactSoftCFM in surface.mode. The effective mass along the contact normal is computed from body1, body2
- *  (either may be 0 for the static world) and the contact position; the matched and exact mappings need it.
- *  Call it in the near callback that ssStepper hands the step length to.
- *  Errors: those of ssSoftnessFor; SS_ERROR_OUT_OF_RANGE when neither body is dynamic and the mapping needs a mass.
- *  On error contact is unchanged. */
+ *  dContactSoftCFM in surface.mode. Every mapping writes the implicit-Euler softness: matched and exact serve no
+ *  contact, whose load is never known (a contact is made anew each step), whose bodies carry other contacts, and
+ *  which exists only while it penetrates (docs/exact-mappings.md); body1, body2 (either may be 0 for the static
+ *  world) and previous_step_s are therefore not read. Call it in the near callback that ssStepper hands the step
+ *  length to.
+ *  Errors: those of ssSoftnessFromSpring; SS_ERROR_OUT_OF_RANGE (contact NULL, step_s or previous_step_s),
+ *  SS_ERROR_UNSUPPORTED (unknown mapping). On error contact is unchanged. */
 SS_API ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpring spring, ssMapping mapping,
                                 double step_s, double previous_step_s);
 

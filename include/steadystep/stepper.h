@@ -204,10 +204,10 @@ SS_API ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
 /** In the program's near callback: turns the contact's tuned softness into the softness for the step about to be
  *  taken. The contact's soft_erp/soft_cfm (where surface.mode has dContactSoftERP/dContactSoftCFM), or else the
  *  world's ERP/CFM, as the program tuned them at the registry's tuned step (ssRegistry_Adopt), become a spring; it
- *  is written back as soft_erp/soft_cfm for this step's length and mapping, both mode bits set. body1 and body2
- *  (either may be 0 for the static world) give the effective mass along the normal for matched and exact; where
- *  those cannot serve the contact, the implicit-Euler mapping does (counted in the frame report). A contact tuned with
- *  cfm = 0 stays hard (erp follows h as for adopted hard rows).
+ *  is written back as soft_erp/soft_cfm for this step's length, both mode bits set. Under every mapping the
+ *  implicit-Euler softness serves it: matched and exact serve no contact (its load is never known; ssContactSoften),
+ *  and count it in the frame report's contacts.handed_to_implicit_euler. body1 and body2 are not read. A contact
+ *  tuned with cfm = 0 stays hard (erp follows h as for adopted hard rows).
  *  Errors, with the contact unchanged: SS_ERROR_OUT_OF_RANGE (stepper or contact NULL, no tuned step: adopt
  *  first, or a tuned erp outside [0, 1] or cfm < 0); SS_ERROR_NOT_FINITE. */
 SS_API ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2);

@@ -223,8 +223,10 @@ def joint_effective_mass(joint, param: JointParam | int, axis: int) -> float:
 def contact_soften(contact, body1, body2, spring: Spring | tuple[float, float], mapping: Mapping | int,
                    step_s: float, previous_step_s: float = 0.0) -> None:
     """Writes the softness of spring (k N/m, c N·s/m) for a step of step_s (s) into an ODE contact (an odepy
-    dContact or its address): surface.soft_erp, soft_cfm and both mode bits. body1, body2: the contact's bodies
-    (None for the static world), for the effective mass along the normal. On an error the contact is unchanged.
+    dContact or its address): surface.soft_erp, soft_cfm and both mode bits. Every mapping writes the
+    implicit-Euler softness: matched and exact serve no contact, whose load is never known (docs/exact-mappings.md);
+    body1, body2 (the contact's bodies, None for the static world) are checked but not read. On an error the contact
+    is unchanged.
     With a Stepper, use Stepper.soften_contact instead, which knows the step."""
     pointer = _handles.contact("contact", contact)
     check(lib.ssContactSoften(pointer, _handles.handle("body1", "body", body1),

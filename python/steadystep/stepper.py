@@ -258,8 +258,10 @@ class Stepper:
     def soften_contact(self, contact, body1, body2) -> None:
         """In the near callback, before dJointCreateContact: turns the contact's tuned softness (its soft_erp /
         soft_cfm where surface.mode has them, else the world's ERP/CFM, as tuned at the registry's tuned step) into
-        the softness for the step about to be taken. contact: an odepy dContact (or its address); body1, body2 its
-        bodies (None for the static world). Raises SteadystepError with the contact unchanged (adopt first)."""
+        the softness for the step about to be taken: implicit Euler's under every mapping (matched and exact serve no
+        contact and count it in report.contacts.handed_to_implicit_euler). contact: an odepy dContact (or its
+        address); body1, body2 its bodies (None for the static world). Raises SteadystepError with the contact
+        unchanged (adopt first)."""
         try:
             check(lib.ssStepper_SoftenContact(self._handle(), _handles.contact("contact", contact),
                                               _handles.handle("body1", "body", body1),

@@ -205,6 +205,53 @@ void DestroyBodyOnce(void* context, ssStepper* stepper) {
   EXPECT_EQ(ssStepper_DestroyBody(stepper, d->body), SS_OK);
 }
 
+// Two gears on hinges to the static world, geared 2:1 by a transmission joint. ODE 0.16 aborts the process when a
+// gear turns by pi or more between two steps (transmission.cpp): a torque added in step_done that spins a gear up
+// within the speed guard (at 1/60 s, 188 rad/s turn pi) is stopped by name after the step that spun it, not stepped
+// again; the frame before it, at a modest spin, is stepped as usual.
+TEST_F(PromiseTest, AGearSpunPastHalfATurnAStepIsStoppedBeforeODEsTransmissionAborts) {
+  dBodyID gears[2] = {Box(0, 0, 1), Box(0.6, 0, 1)};
+  for (dBodyID gear : gears) {
+    dJointID hinge = dJointCreateHinge(world, 0);
+    dJointAttach(hinge, gear, 0);
+    const dReal* p = dBodyGetPosition(gear);
+    dJointSetHingeAnchor(hinge, p[0], p[1], p[2]);
+    dJointSetHingeAxis(hinge, 0, 1, 0);
+  }
+  dJointID transmission = dJointCreateTransmission(world, 0);
+  dJointAttach(transmission, gears[0], gears[1]);
+  dJointSetTransmissionMode(transmission, dTransmissionParallelAxes);
+  dJointSetTransmissionAxis(transmission, 0, 1, 0);
+  dJointSetTransmissionAnchor1(transmission, 0, 0, 1);
+  dJointSetTransmissionAnchor2(transmission, 0.6, 0, 1);
+  dJointSetTransmissionRatio(transmission, 2.0);
+  dBodySetAngularVel(gears[0], 0, 1, 0);
+  ssStepperDef def = Def();
+  def.stepping.solver = SS_SOLVER_STEP;
+  struct Spin {
+    dBodyID gear;
+    bool on = false;
+  } spin{gears[0]};
+  def.step_done = [](void* context, double) {
+    auto* spin = static_cast<Spin*>(context);
+    if (spin->on) dBodyAddTorque(spin->gear, 0, 10, 0);  // about 100 rad/s more a step on a 0.1 m box
+  };
+  def.step_done_context = &spin;
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  ssFrameReport report;
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 30, &report), SS_OK) << ssLastError();
+  spin.on = true;
+  ssStatus status = SS_OK;
+  for (int frame = 0; frame < 20 && status == SS_OK; ++frame) status = ssStepper_Step(stepper, 1.0 / 30, &report);
+  EXPECT_EQ(status, SS_ERROR_SPEED_LIMIT);
+  EXPECT_TRUE(Names("turns its transmission gear") && Names("SS_MAX_GEAR_TURN_RAD")) << ssLastError();
+  EXPECT_TRUE(report.failed_body == gears[0] || report.failed_body == gears[1]);
+  const double spun = std::sqrt(std::pow(dBodyGetAngularVel(report.failed_body)[1], 2));
+  EXPECT_GT(spun * (1.0 / 60), SS_MAX_GEAR_TURN_RAD);
+  EXPECT_LT(spun, 1e3);  // far inside the speed guard's 1e4 rad/s: this guard, not that one, stopped it
+  EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 30, &report), SS_ERROR_FAILED);
+}
+
 TEST_F(PromiseTest, DestroyingAKnownBodyFromEachCallbackIsSafe) {
   for (int where = 0; where < 3; ++where) {  // before_step, collide, step_done
     SCOPED_TRACE(where);

@@ -319,9 +319,40 @@ TEST_F(StepperTest, RowsAboveHalfTheStepRateAreHandedToImplicitEulerAndCounted) 
   ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 30.0, &report), SS_OK);
   EXPECT_EQ(report.rows.handed_to_implicit_euler, 1);
   EXPECT_EQ(report.rows.by_mapping, 0);
-  ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 100.0, &report), SS_OK);
+  // w h = 0.4: below Nyquist, and the matched static stiffness within 5 % of k (issue 15's rule, row_law.c)
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 500.0, &report), SS_OK);
   EXPECT_EQ(report.rows.handed_to_implicit_euler, 0);
   EXPECT_EQ(report.rows.by_mapping, 1);
+  // w h = 2 (1/100 s): below Nyquist, but matched's static stiffness is k·sinc²(w h / 2) = 0.71 k there, where
+  // an undeclared load would rest 41 % further out than F/k: implicit Euler serves the row
+  ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 100.0, &report), SS_OK);
+  EXPECT_EQ(report.rows.handed_to_implicit_euler, 1);
+  EXPECT_EQ(report.rows.by_mapping, 0);
+}
+
+// Issue 15's rule on damping: a spring whose decay takes a few steps (c/2m · h = 1) has a matched static stiffness
+// far from k; implicit Euler serves it, and its load-free motion is then the implicit-Euler recurrence itself.
+TEST_F(StepperTest, RowsWhoseStaticStiffnessTheAccurateMappingsMissAreHandedToImplicitEuler) {
+  for (const char* policy : {"matched", "exact"}) {
+    OscillatorRig rig;
+    rig.spring = {400.0, 120.0};  // 1 kg: σ h = 1 at 1/60 s
+    ssSteppingForPolicy(policy, 1.0 / 60, &rig.def.stepping);
+    ASSERT_EQ(rig.Build(), SS_OK);
+    ssFrameReport report;
+    ASSERT_EQ(ssStepper_Step(rig.stepper, 1.0 / 60.0, &report), SS_OK);
+    EXPECT_EQ(report.rows.handed_to_implicit_euler, 1) << policy;
+    EXPECT_EQ(report.rows.by_mapping + report.rows.handed_to_matched, 0) << policy;
+    // a declared load is corrected (the registry adds F·(k'/k - 1) along the row): the mapping serves the row
+    OscillatorRig loaded;
+    loaded.spring = rig.spring;
+    loaded.gravity = 9.81;
+    loaded.declare_load = true;
+    loaded.def.stepping = rig.def.stepping;
+    ASSERT_EQ(loaded.Build(), SS_OK);
+    ASSERT_EQ(ssStepper_Step(loaded.stepper, 1.0 / 60.0, &report), SS_OK);
+    EXPECT_EQ(report.rows.by_mapping, 1) << policy;
+    EXPECT_EQ(report.rows.handed_to_implicit_euler, 0) << policy;
+  }
 }
 
 TEST_F(StepperTest, ExactFallsBackToMatchedWhereAStepPairHasNoFiniteMapping) {
