@@ -1,11 +1,14 @@
 """The report's wall time on this machine: the whole comparison (every scene, profile and policy, the references,
-the largest-stable-step probes, the side-by-side table, the animation, the cost benchmark and the figures) in one
-process against a local process pool over every core.
+the repeats under the next seed, the largest-stable-step probes, the side-by-side table, the animation, the figures
+and the cost benchmark) in one process against a local process pool over every core.
 
-Prints each timing, with the part of it that is the cost benchmark (which runs in this process alone either way),
-and the ratio one process / local pool, measured in this one run in the order serial, local, local, serial (ABBA)
-so that a drift in the machine's load falls on both sides alike, and the load average before and after (the
-machine may be shared). Usage: python bench/bench_report.py [DURATION_S] (default 5, the report's)
+Prints each timing with its phases (report_tasks: runs, figures still drawing after the runs, the cost benchmark,
+which runs in this process alone either way), the ratio one process / local pool, and the load average before and
+after (the machine may be shared). The order is serial, local, local, serial (ABBA), so that a drift in the load
+falls on both sides alike; --once measures serial, local once each (half the time). First it prints the
+parallelism the machine gives two processes at that moment (two CPU-bound loops in one process, then in two): a
+shared machine whose cores others take gives about 1, and then no pool can be faster.
+Usage: python bench/bench_report.py [DURATION_S] [--once] (default 5, the report's)
 """
 
 from __future__ import annotations
@@ -20,28 +23,55 @@ from pathlib import Path
 from steadystep import report, study
 
 
-def wall_s(executor: str, duration_s: float) -> tuple[float, float]:
-    """The report's wall time (s) and, within it, the cost benchmark's (which always runs in this process alone)."""
-    with tempfile.TemporaryDirectory() as figures:
+def wall_s(executor: str, duration_s: float) -> tuple[float, dict]:
+    """The report's wall time (s), figures and page written, and its phases' (s)."""
+    with tempfile.TemporaryDirectory() as out:
         started = time.perf_counter()
         with study.make_executor(executor) as made:  # a pool's start-up is part of the report's time
-            result = report.compare(duration_s=duration_s, progress=False, figure_dir=Path(figures), executor=made)
-        return time.perf_counter() - started, result.cost_wall_s
+            result = report.compare(duration_s=duration_s, progress=False, figure_dir=Path(out), executor=made)
+        report.write(result, Path(out), "bench/bench_report.py")
+        return time.perf_counter() - started, result.phases_s
+
+
+def _spin(count: int) -> int:
+    total = 0
+    for i in range(count):
+        total += i
+    return total
+
+
+def parallelism(count: int = 3_000_000) -> float:
+    """What the machine gives two processes at this moment: the time of two CPU-bound loops one after the other
+    over their time in two processes at once (2 on two idle cores; about 1 when others take the cores)."""
+    import concurrent.futures
+
+    started = time.perf_counter()
+    _spin(count), _spin(count)
+    serial = time.perf_counter() - started
+    with study.make_executor("local") as pool:
+        pool.submit(_spin, 1).result()  # the workers started
+        started = time.perf_counter()
+        concurrent.futures.wait([pool.submit(_spin, count) for _ in range(2)])
+        return serial / (time.perf_counter() - started)
 
 
 def main() -> None:
-    duration_s = float(sys.argv[1]) if len(sys.argv) > 1 else 5.0
+    arguments = [a for a in sys.argv[1:] if a != "--once"]
+    duration_s = float(arguments[0]) if arguments else 5.0
+    order = ("serial", "local") if "--once" in sys.argv[1:] else ("serial", "local", "local", "serial")
     print(f"report wall time, duration {duration_s:g} s per run, {study.usable_cores()} usable cores, "
-          f"load average {os.getloadavg()[0]:.2f}")
+          f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}", flush=True)
+    print(f"two CPU-bound loops: {parallelism():.2f} times faster in two processes than in one (the machine's "
+          "parallelism now; 2 on two idle cores)", flush=True)
     times: dict[str, list[float]] = {"serial": [], "local": []}
-    for executor in ("serial", "local", "local", "serial"):
-        total_s, cost_s = wall_s(executor, duration_s)
+    for executor in order:
+        total_s, phases = wall_s(executor, duration_s)
         times[executor].append(total_s)
-        print(f"  {executor:6s} {total_s:8.2f} s (of which the cost benchmark, one process either way: {cost_s:.2f} s)",
-              flush=True)
+        said = ", ".join(f"{name} {seconds:.1f} s" for name, seconds in phases.items())
+        print(f"  {executor:6s} {total_s:8.2f} s ({said}); load average {os.getloadavg()[0]:.2f}", flush=True)
     serial, local = statistics.mean(times["serial"]), statistics.mean(times["local"])
     print(f"one process / local pool: {serial / local:.2f} (mean {serial:.2f} s / {local:.2f} s); "
-          f"load average after {os.getloadavg()[0]:.2f}")
+          f"load average after {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 
 if __name__ == "__main__":

@@ -79,6 +79,9 @@ typedef struct Policy {
 
 static const Policy policies[] = {
     {"naive", SS_CUT_WHOLE_FRAME, SS_MAPPING_IMPLICIT_EULER, 1},
+    /* The control: naive's frozen softness, but the frame cut as implicit-euler cuts it, so that a comparison
+     * separates what cutting the frame gives (naive -> substeps-frozen) from what the mapping adds. */
+    {"substeps-frozen", SS_CUT_SUBSTEPS, SS_MAPPING_IMPLICIT_EULER, 1},
     {"implicit-euler", SS_CUT_SUBSTEPS, SS_MAPPING_IMPLICIT_EULER, 0},
     {"matched", SS_CUT_SUBSTEPS, SS_MAPPING_MATCHED, 0},
     {"exact", SS_CUT_SUBSTEPS, SS_MAPPING_EXACT, 0},

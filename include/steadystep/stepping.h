@@ -77,6 +77,7 @@ SS_API const char* ssFrameCutName(ssFrameCut cut);
 
 /** The lab's policies, named presets of (cut, mapping, frozen step), in the order the lab reports them:
  *    naive           whole frame, implicit Euler frozen at the reference step: the problem the article fixes
+ *    substeps-frozen substeps, implicit Euler frozen at the reference step: the control (what the cut alone gives)
  *    implicit-euler  substeps, implicit Euler at each step's length: the article's method
  *    matched         substeps, matched
  *    exact           substeps, exact
@@ -89,7 +90,7 @@ SS_API int ssPolicyCount(void);
 SS_API const char* ssPolicyNameAt(int index);
 
 /** Sets stepping's cut, mapping and frozen step to the policy's (the other fields are kept). reference_step_s (s,
- *  in the step range) is the length naive freezes its softness at, e.g. the step a program was tuned for.
+ *  in the step range) is the length naive and substeps-frozen freeze their softness at, e.g. the step a program was tuned for.
  *  Errors, with stepping unchanged: SS_ERROR_PARSE for an unknown name (named, with the known ones);
  *  SS_ERROR_OUT_OF_RANGE for NULL or a reference_step_s out of range; SS_ERROR_NOT_FINITE. */
 SS_API ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssStepping* stepping);

@@ -16,6 +16,7 @@
 #include "error.h"
 #include "ode_bounds.h"
 #include "scene_internal.h"
+#include "steadystep/interpolation.h"
 
 /* No reference scene moves anything faster than a few m/s; 100 m/s means it exploded. */
 #define SS_SCENE_MAX_SPEED_M_PER_S 100.0
@@ -273,7 +274,34 @@ int ssScene_Points(const ssScene* scene, double* xyz, int capacity) {
     return 0;
   }
   if (scene->desc->points == NULL) return 0;
-  return scene->desc->points(scene->state, xyz, capacity);
+  return scene->desc->points(scene->state, NULL, xyz, capacity);
+}
+
+int ssScene_InterpolatedPoints(const ssScene* scene, double* xyz, int capacity) {
+  if (scene == NULL || capacity < 0 || (xyz == NULL && capacity > 0)) {
+    ssFail(SS_ERROR_OUT_OF_RANGE,
+           "%s: ssScene_InterpolatedPoints needs a scene, capacity >= 0 and xyz for capacity > 0",
+           scene == NULL ? "scene = NULL" : capacity < 0 ? "capacity < 0" : "xyz = NULL");
+    return 0;
+  }
+  if (scene->desc->points == NULL) return 0;
+  return scene->desc->points(scene->state, scene->parts.stepper, xyz, capacity);
+}
+
+void ssScenePointOnBody(const ssStepper* drawn_by, dBodyID body, const double rel[3], double out[3]) {
+  double position[3], q[4];
+  if (drawn_by == NULL || ssStepper_InterpolatedPose(drawn_by, body, position, q) != SS_OK) {
+    dVector3 point;
+    dBodyGetRelPointPos(body, rel[0], rel[1], rel[2], point);
+    for (int k = 0; k < 3; ++k) out[k] = point[k];
+    return;
+  }
+  /* position + R(q) rel, R the rotation of the unit quaternion (w, x, y, z), as ODE's dQtoR. */
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  const double r[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                          {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                          {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
+  for (int k = 0; k < 3; ++k) out[k] = position[k] + r[k][0] * rel[0] + r[k][1] * rel[1] + r[k][2] * rel[2];
 }
 
 static double now_s(void) {

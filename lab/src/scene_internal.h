@@ -48,12 +48,17 @@ typedef struct ssSceneDesc {
    * scene asks for the line only when a bound is left: formatting it after every step would cost more than the
    * check. May be NULL: no bounds. */
   double (*check)(const void* state, char* worst, size_t size);
-  /* The scene's drawing (ssScene_Points): writes at most capacity points (x y z) and returns how many it has.
-   * May be NULL (no drawing). */
-  int (*points)(const void* state, double* xyz, int capacity);
+  /* The scene's drawing (ssScene_Points, ssScene_InterpolatedPoints): writes at most capacity points (x y z) and
+   * returns how many it has, each a point on a body placed by ssScenePointOnBody(drawn_by, ...): drawn_by NULL,
+   * at ODE's pose; else at the stepper's interpolated pose. May be NULL (no drawing). */
+  int (*points)(const void* state, const ssStepper* drawn_by, double* xyz, int capacity);
   /* Frees the state (ODE objects go with the world). */
   void (*destroy)(void* state);
 } ssSceneDesc;
+
+/* The world position (m) of the point at rel (m, body frame) of body: drawn_by NULL, at ODE's pose; else at the pose
+ * drawn_by gives to draw (ssStepper_InterpolatedPose; ODE's pose for a body it does not know). */
+void ssScenePointOnBody(const ssStepper* drawn_by, dBodyID body, const double rel[3], double out[3]);
 
 /* The scenes, each defined in its own file under lab/src/scenes/. */
 extern const ssSceneDesc ssOscillatorScene;

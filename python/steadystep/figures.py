@@ -26,10 +26,10 @@ from steadystep.profiles import seed_value
 from steadystep.files import save_figure
 from steadystep.profiles import frame_times
 
-# One colour per policy, in the library's order of its policies (naive, implicit-euler, matched, exact, fixed,
-# fixed-matched, fixed-exact): orange, purple, brown, cyan, grey, rose, green. A policy the library adds beyond these
-# is drawn dark grey until it gets its own.
-_POLICY_PALETTE = ("#e6550d", "#756bb1", "#8c6d31", "#17becf", "#636363", "#d6616b", "#31a354")
+# One colour per policy, in the library's order of its policies (naive, substeps-frozen, implicit-euler, matched,
+# exact, fixed, fixed-matched, fixed-exact): orange, light orange (naive's softness, implicit-euler's cut), purple,
+# brown, cyan, grey, rose, green. A policy the library adds beyond these is drawn dark grey until it gets its own.
+_POLICY_PALETTE = ("#e6550d", "#fdae6b", "#756bb1", "#8c6d31", "#17becf", "#636363", "#d6616b", "#31a354")
 POLICY_COLORS = dict(zip(runs.policy_names(), _POLICY_PALETTE))
 REFERENCE_COLOR = "#000000"
 EXACT_COLOR = "#1f5fbf"      # the article's blue

@@ -1,21 +1,33 @@
 """The report's opening: the policies defined, and the recommendation computed from this run's numbers.
 
 Every sentence of the recommendation is made from the metrics on the page (never typed once and left to go
-stale), and links to the table or figure that shows it. The needs it answers:
+stale), says for which scenes it holds (each scene a kind of program: its description, in the table "per scene"),
+and links to the table or figure that shows it. The needs it answers:
 
 - consistency: the same motion at every frame rate (consistency.py: runs of one policy against each other);
+- what cutting the frame gives and what each mapping adds: naive, then the control substeps-frozen (the same
+  frozen softness, the frame cut into substeps), then implicit-euler, matched and exact (the same cut, the
+  softness mapped to each step);
 - accuracy: closest to the exact solution (the oscillator at 15-45 fps) and to the fine-step reference (the
   deviation, RMS over profiles);
+- where the accurate mappings serve: the share of rows and contacts they served, and what fell back;
 - cost: wall time against plain ODE in one interleaved benchmark (cost.py);
 - the largest stable step (probe.py);
 and which policies failed (blew up or broke) on some run.
+
+A winner is named only where its lead is larger than the measured spread of repeats: for the deviation and the
+consistency, how much each moved when the random profiles were run again with the next seed
+(report_aggregate); for the cost, the ranges over the benchmark's blocks. Otherwise the page says they tie.
+Every piece of markup here is a markupsafe.Markup whose arguments are escaped as they are put in (Markup.format,
+Markup.join): nothing is escaped by hand.
 """
 
 from __future__ import annotations
 
-import html
 import math
 import statistics
+
+from markupsafe import Markup
 
 from steadystep import runs
 from steadystep._native import lib
@@ -29,6 +41,10 @@ MAPPINGS = {
     lib.SS_MAPPING_EXACT: ("exact", "erp and cfm solved from the step before, so that a linear spring-damper's "
                            "samples equal the exact solution under any sequence of steps"),
 }
+# The ladder that separates the cut from the mapping: each policy differs from the one before in one thing.
+CONTROL_LADDER = ("naive", "substeps-frozen", "implicit-euler", "matched", "exact")
+# Consistency at or below this (relative to the amplitude) is rounding: the runs are the same motion.
+IDENTICAL = 1e-9
 
 
 def _ms(seconds: float) -> str:
@@ -55,18 +71,12 @@ def mapping_text(stepping: dict) -> str:
     return f"{name}: {meaning}"
 
 
-def definitions(policies: list[str]) -> str:
-    """A table: each policy's cut and mapping, read from the library's own presets (runs.make_stepping)."""
-    rows = []
-    for policy in policies:
-        stepping = runs.make_stepping(policy)
-        rows.append(f"<tr><td><b>{html.escape(policy)}</b></td><td>{html.escape(cut_text(stepping))}</td>"
-                    f"<td>{html.escape(mapping_text(stepping))}</td></tr>")
-    return ("<table id='policies'><thead><tr><th>policy</th><th>how a frame is cut</th><th>softness of each step"
-            "</th></tr></thead><tbody>" + "".join(rows) + "</tbody></table>")
+def definitions(policies: list[str]) -> list[list[str]]:
+    """Each policy's (name, cut, mapping), read from the library's own presets (runs.make_stepping)."""
+    return [[policy, cut_text(s), mapping_text(s)] for policy in policies for s in [runs.make_stepping(policy)]]
 
 
-def _first(report, scene: str) -> str:
+def _first(scene: str) -> str:
     return runs.motion_quantities(scene)[0]
 
 
@@ -74,96 +84,200 @@ def _finite(value) -> bool:
     return value is not None and isinstance(value, (int, float)) and math.isfinite(value)
 
 
-def _link(anchor: str, text: str) -> str:
-    return f"<a href='#{html.escape(anchor)}'>{html.escape(text)}</a>"
+def link(anchor: str, text: str) -> Markup:
+    return Markup("<a href='#{}'>{}</a>").format(anchor, text)
+
+
+def bold(text: str) -> Markup:
+    return Markup("<b>{}</b>").format(text)
 
 
 def _x(value: float) -> str:
     return f"×{value:.3g}" if math.isfinite(value) else "∞"
 
 
-def _ranking(per_scene: dict[str, dict[str, float]]) -> list[tuple[str, float, int]]:
-    """Policies by the geometric mean over scenes of (value / the scene's best value): (policy, that mean, scenes
-    where it is the best). A policy with an infinite value on a scene ranks last. Lower values are better."""
-    policies = sorted({p for values in per_scene.values() for p in values})
-    scored = []
-    for policy in policies:
-        logs, wins = [], 0
-        for values in per_scene.values():
-            if policy not in values:
-                continue
-            finite = [v for v in values.values() if _finite(v)]
-            best = min(finite) if finite else math.nan
-            value = values[policy]
-            if not _finite(value):
-                logs.append(math.inf)
-                continue
-            if value <= best:
-                wins += 1
-            logs.append(0.0 if value == best else math.log(max(value, 1e-300) / max(best, 1e-300)))
-        mean = math.exp(sum(logs) / len(logs)) if logs and all(math.isfinite(v) for v in logs) else math.inf
-        scored.append((policy, mean, wins))
-    return sorted(scored, key=lambda item: (item[1], -item[2], item[0]))
+def _and(items) -> Markup:
+    return Markup(", ").join(items)
 
 
-# Consistency at or below this (relative to the amplitude) is rounding: the runs are the same motion.
-IDENTICAL = 1e-9
+def leaders(values: dict[str, float], noise: dict[str, float] | None = None) -> list[str]:
+    """The policies tied for the lowest value: the lowest, and every other whose value less its spread of repeats
+    reaches the lowest's plus its own (lower is better; a spread not measured counts 0). One name: a winner."""
+    finite = {p: v for p, v in values.items() if _finite(v)}
+    if not finite:
+        return []
+    noise = {p: n if _finite(n) else 0.0 for p, n in (noise or {}).items()}
+    best = min(finite, key=lambda p: (finite[p], p))
+    reach = finite[best] + noise.get(best, 0.0)
+    tied = [p for p in finite if p == best or finite[p] - noise.get(p, 0.0) <= reach]
+    return sorted(tied, key=lambda p: (finite[p], p))
 
 
-def _consistency(report) -> str | None:
-    per_scene = {s: {p: report.consistency[s][p][_first(report, s)] for p in report.policies[s]}
+def _verdict(tied: list[str]) -> Markup:
+    if len(tied) == 1:
+        return bold(tied[0])
+    return Markup("tie: {}").format(_and(bold(p) for p in tied))
+
+
+def _per_scene(report, values: dict, noise: dict, zero: float = 0.0, exclude=()) -> dict[str, list[str]]:
+    """scene -> the leaders on its first quantity (values, noise: scene -> policy -> quantity)."""
+    out = {}
+    for scene in report.scenes:
+        if scene not in values:
+            continue
+        q = _first(scene)
+        cells = {p: values[scene][p][q] for p in report.policies[scene] if p in values[scene] and p not in exclude}
+        cells = {p: 0.0 if _finite(v) and v <= zero else v for p, v in cells.items()}
+        spread = {p: noise.get(scene, {}).get(p, {}).get(q, 0.0) for p in cells}
+        out[scene] = leaders(cells, spread)
+    return out
+
+
+def _grouped(by_scene: dict[str, list[str]]) -> Markup:
+    """"p on a, b; tie (p, q) on c": each verdict with the scenes it holds for, linked to their sections."""
+    groups: dict[tuple, list[str]] = {}
+    for scene, tied in by_scene.items():
+        if tied:
+            groups.setdefault(tuple(tied), []).append(scene)
+    parts = [Markup("{} on {}").format(_verdict(list(tied)), _and(link(s, s) for s in scenes))
+             for tied, scenes in sorted(groups.items(), key=lambda item: (len(item[0]), -len(item[1])))]
+    return Markup("; ").join(parts)
+
+
+def same_everywhere(report) -> list[str]:
+    """The policies whose motion is the same under every profile on every scene (consistency <= IDENTICAL)."""
+    per_scene = {s: {p: report.consistency[s][p][_first(s)] for p in report.policies[s]}
+                 for s in report.scenes if s in report.consistency}
+    policies = list(dict.fromkeys(p for values in per_scene.values() for p in values))
+    return [p for p in policies if per_scene and all(_finite(v.get(p)) and v[p] <= IDENTICAL
+                                                     for v in per_scene.values())]
+
+
+def _consistency(report) -> Markup | None:
+    per_scene = {s: {p: report.consistency[s][p][_first(s)] for p in report.policies[s]}
                  for s in report.scenes if s in report.consistency}
     if not per_scene:
         return None
-    policies = list(dict.fromkeys(p for values in per_scene.values() for p in values))
-    same = [p for p in policies if all(_finite(v.get(p)) and v[p] <= IDENTICAL for v in per_scene.values())]
-    moving = {s: {p: v for p, v in values.items() if p not in same} for s, values in per_scene.items()}
-    ranking = _ranking(moving) if any(moving.values()) else []
+    same = same_everywhere(report)
     parts = []
     if same:
-        parts.append(" and ".join(f"<b>{html.escape(p)}</b>" for p in same)
-                     + f": the same motion under every frame-time profile on all {len(per_scene)} scenes "
-                     f"(consistency ≤ {IDENTICAL:g}): every physics step has the same length whatever the frames")
-    if ranking and math.isfinite(ranking[0][1]):
-        best = ranking[0][0]
-        text = ", ".join(f"{html.escape(p)} {_x(m)}" for p, m, _ in ranking)
-        lead = "among the policies whose steps follow the frames, " if same else ""
-        parts.append(f"{lead}<b>{html.escape(best)}</b> is the most alike across profiles (consistency as a multiple "
-                     f"of each scene's best, geometric mean over scenes: {text})")
-    return "; ".join(parts) + ". " + _link("consistency", "consistency table")
+        parts.append(Markup("{}: the same motion under every frame-time profile on all {} scenes (consistency ≤ {}): "
+                            "every physics step has the same length whatever the frames")
+                     .format(Markup(" and ").join(bold(p) for p in same), len(per_scene), f"{IDENTICAL:g}"))
+    moving = _per_scene(report, report.consistency, getattr(report, "repeat_consistency", {}), IDENTICAL, same)
+    if any(moving.values()):
+        lead = "among the policies whose steps follow the frames, the most alike across profiles: " if same else \
+            "the most alike across profiles: "
+        parts.append(Markup("{}{}").format(lead, _grouped(moving)))
+    return Markup("; ").join(parts) + Markup(". ") + link("consistency", "consistency table")
 
 
-def _accuracy_exact(report) -> str | None:
+def control_ladder(report) -> dict[str, list[tuple[str, float, float]]]:
+    """scene -> [(policy, consistency, deviation) of its first quantity] along CONTROL_LADDER, for the policies
+    the scene ran."""
+    out = {}
+    for scene in report.scenes:
+        if scene not in report.consistency:
+            continue
+        q = _first(scene)
+        ladder = [(p, report.consistency[scene][p][q], report.spreads[scene][p][q]) for p in CONTROL_LADDER
+                  if p in report.consistency[scene]]
+        if {"naive", "substeps-frozen", "implicit-euler"} <= {p for p, _, _ in ladder}:
+            out[scene] = ladder
+    return out
+
+
+def _number(value) -> str:
+    return "failed" if value is not None and math.isinf(value) else "-" if not _finite(value) else f"{value:.2g}"
+
+
+def _cut_and_mapping(report) -> Markup | None:
+    ladders = control_ladder(report)
+    if not ladders:
+        return None
+    parts = []
+    for scene, ladder in ladders.items():
+        values = {p: c for p, c, _ in ladder}
+        parts.append(Markup("{}: {}").format(link(scene, scene), Markup(" → ").join(
+            f"{_number(values[p])}" for p in ("naive", "substeps-frozen", "implicit-euler"))))
+    return (Markup("the consistency of each scene's first quantity from naive (one step a frame) to the control "
+                   "substeps-frozen (substeps, the softness still frozen at the tuned step: what cutting the frame "
+                   "gives) to implicit-euler (the same substeps, the softness mapped to each: what the mapping adds): ")
+            + Markup("; ").join(parts) + Markup(". ") + link("control", "cut and mapping table"))
+
+
+def _accuracy_exact(report) -> Markup | None:
     entries = [e for e in report.side_by_side if e["profile"] == "uniform:15:45" and _finite(e["rms_vs_exact"])]
     if not entries:
         return None
     entries.sort(key=lambda e: e["rms_vs_exact"])
     best = entries[0]
-    others = ", ".join(f"{html.escape(e['policy'])} {e['rms_vs_exact']:.2g}" for e in entries[1:])
-    return (f"<b>{html.escape(best['policy'])}</b>: closest to the exact solution of the oscillator at 15-45 fps, "
-            f"RMS error {best['rms_vs_exact']:.2g}·x0 (then {others}). " + _link("exact", "oscillator table"))
+    others = _and(f"{e['policy']} {e['rms_vs_exact']:.2g}" for e in entries[1:])
+    return Markup("{}: closest to the exact solution of the oscillator at 15-45 fps, RMS error {}·x0 (then {}); a "
+                  "deterministic comparison with the exact solution, not a repeat. ").format(
+        bold(best["policy"]), f"{best['rms_vs_exact']:.2g}", others) + link("exact", "oscillator table")
 
 
-def _accuracy_reference(report) -> str | None:
-    per_scene = {s: {p: report.spreads[s][p][_first(report, s)] for p in report.policies[s]}
-                 for s in report.scenes if s in report.spreads}
-    ranking = _ranking(per_scene)
-    if not ranking or not math.isfinite(ranking[0][1]):
+def _accuracy_reference(report) -> Markup | None:
+    per_scene = _per_scene(report, report.spreads, getattr(report, "repeat_deviation", {}))
+    if not any(per_scene.values()):
         return None
-    best, mean, wins = ranking[0]
-    runner = [f"{html.escape(p)} {_x(m)}" for p, m, _ in ranking[1:4]]
-    return (f"<b>{html.escape(best)}</b>: closest to the fine-step reference over all scenes: its deviation (RMS over "
-            f"profiles) is {_x(mean)} the best policy's of each scene, as a geometric mean over the "
-            f"{len(per_scene)} scenes, " + (f"and the lowest on {wins} of them" if wins else
-                                             "though the lowest on none of them alone")
-            + f" (next: {', '.join(runner)}). "
-            + _link("deviation", "deviation table"))
+    return (Markup("the lowest deviation (RMS over profiles) of each scene's first quantity, ties within the spread "
+                   "of repeats: ") + _grouped(per_scene) + Markup(". ") + link("deviation", "deviation table"))
 
 
-CHEAP_TIE = 0.1
+ACCURATE = ("matched", "exact", "fixed-matched", "fixed-exact")
 
 
-def _cost(report) -> str | None:
+def served_shares(counts: dict[str, int]) -> tuple[float, float, float, int]:
+    """(by the mapping, handed to matched, handed to implicit Euler) as shares of the total, and the total."""
+    total = sum(counts.values())
+    if not total:
+        return math.nan, math.nan, math.nan, 0
+    return (counts["by_mapping"] / total, counts["handed_to_matched"] / total,
+            counts["handed_to_implicit_euler"] / total, total)
+
+
+def percent(share: float) -> str:
+    return "-" if not _finite(share) else f"{100 * share:.0f} %"
+
+
+def _served(report) -> Markup | None:
+    served = getattr(report, "served", {})
+    parts = []
+    for scene, by_policy in served.items():
+        pieces = []
+        for policy in (p for p in ("matched", "exact") if p in by_policy):
+            rows, contacts = (served_shares(by_policy[policy][what]) for what in ("rows", "contacts"))
+            said = [f"{percent(share[0])} of its {what}" for what, share in (("rows", rows), ("contacts", contacts))
+                    if share[3]]
+            if said:
+                pieces.append(Markup("{} serves {}").format(policy, " and ".join(said)))
+        if pieces:
+            parts.append(Markup("{}: {}").format(link(scene, scene), _and(pieces)))
+    if not parts:
+        return None
+    return (Markup("the share of row-steps and contacts each accurate mapping served itself (the rest fell back, "
+                   "mostly to implicit Euler): ") + Markup("; ").join(parts) + Markup(". ")
+            + link("served", "served table"))
+
+
+def cost_leaders(costs) -> dict[str, list[str]]:
+    """scene -> the policies (not naive) tied for the cheapest: the cheapest by median ratio, and every other
+    whose range over the benchmark's blocks reaches into the cheapest's."""
+    by_scene: dict[str, dict] = {}
+    for c in costs:
+        if c.policy != "naive" and _finite(c.ratio_median):
+            by_scene.setdefault(c.scene, {})[c.policy] = c
+    out = {}
+    for scene, entries in by_scene.items():
+        best = min(entries, key=lambda p: (entries[p].ratio_median, p))
+        out[scene] = sorted((p for p, c in entries.items() if p == best or c.ratio_low <= entries[best].ratio_high),
+                            key=lambda p: (entries[p].ratio_median, p))
+    return out
+
+
+def _cost(report) -> Markup | None:
     by_policy: dict[str, list[float]] = {}
     overhead: dict[str, list[float]] = {}
     for c in report.costs:
@@ -174,23 +288,17 @@ def _cost(report) -> str | None:
     if not by_policy:
         return None
     medians = {p: statistics.median(v) for p, v in by_policy.items()}
-    order = sorted(medians, key=medians.get)
-    accurate = [p for p in order if p != "naive"]
-    text = ", ".join(f"{html.escape(p)} {_x(medians[p])}" for p in order)
-    cheapest = accurate[0] if accurate else order[0]
-    # Medians within CHEAP_TIE of the cheapest are not told apart by one benchmark run.
-    alike = [p for p in accurate if medians[p] <= medians[cheapest] * (1 + CHEAP_TIE)] or [cheapest]
-    profile = report.costs[0].profile
-    who = " and ".join(f"<b>{html.escape(p)}</b>" for p in alike)
-    library = ", ".join(f"{html.escape(p)} {_x(statistics.median(v))}" for p, v in overhead.items())
-    return (f"{who}: the cheapest {'policy' if len(alike) == 1 else f'policies (within {CHEAP_TIE:.0%})'} whose "
-            f"softness follows the step. Wall time per frame against a program's own loop (one plain ODE step a "
-            f"frame) under {html.escape(profile)} frames, median over scenes: {text}. That is the substeps (steps "
-            f"per frame in the table): against plain ODE taking the same steps, the library itself costs "
-            f"{library}. " + _link("cost", "cost table"))
+    text = _and(f"{p} {_x(medians[p])}" for p in sorted(medians, key=medians.get))
+    library = _and(f"{p} {_x(statistics.median(v))}" for p, v in overhead.items())
+    return (Markup("the cheapest policy that cuts the frame (naive aside), per scene, a tie where the ranges over "
+                   "the benchmark's blocks overlap: {}. Wall time per frame against a program's own loop (one "
+                   "plain ODE step a frame) under {} frames, median over scenes: {}. That is the substeps (steps "
+                   "per frame in the table): against plain ODE taking the same steps, the library itself costs {}. ")
+            .format(_grouped(cost_leaders(report.costs)), report.costs[0].profile, text, library)
+            + link("cost", "cost table"))
 
 
-def _stable(report) -> str | None:
+def _stable(report) -> Markup | None:
     """The policies stable up to the longest steps: best on the worst probed scene, then on the geometric mean over
     the probed scenes; where the others fall short of the best, and where they go further."""
     by_policy: dict[str, dict[str, float]] = {}
@@ -210,52 +318,71 @@ def _stable(report) -> str | None:
     best = [p for p in by_policy if score(p) == best_score]
     reference = by_policy[best[0]]
     worst_scene = min(reference, key=reference.get)
-    text = (" and ".join(f"<b>{html.escape(p)}</b>" for p in best)
-            + f": stable up to the longest steps, {_ms(reference[worst_scene])} on the hardest scene ({worst_scene}), "
-            f"{_ms(best_score[1])} as the geometric mean over the {len(reference)} probed scenes")
+    text = Markup("{}: stable up to the longest steps, {} on the hardest scene ({}), {} as the geometric mean over "
+                  "the {} probed scenes").format(Markup(" and ").join(bold(p) for p in best),
+                                                 _ms(reference[worst_scene]), worst_scene, _ms(best_score[1]),
+                                                 len(reference))
     shortfalls = []
     for policy, values in by_policy.items():
         short = [f"{scene} {_ms(v)} against {_ms(reference[scene])}" for scene, v in values.items()
                  if scene in reference and v < reference[scene]]
         if short and policy not in best:
-            shortfalls.append(f"{html.escape(policy)} is shorter on {', '.join(short)}")
+            shortfalls.append(Markup("{} is shorter on {}").format(policy, ", ".join(short)))
     if shortfalls:
-        text += "; " + "; ".join(shortfalls)
+        text += Markup("; ") + Markup("; ").join(shortfalls)
     # Ranked on the hardest scene and the mean, the best may still be beaten on one scene: say where.
     beaten = []
     for scene, best_value in reference.items():
-        further = [f"{html.escape(p)} {_ms(v[scene])}" for p, v in by_policy.items()
+        further = [f"{p} {_ms(v[scene])}" for p, v in by_policy.items()
                    if p not in best and v.get(scene, 0) > best_value]
         if further:
-            beaten.append(f"on {scene}, {', '.join(further)} against {_ms(best_value)}")
+            beaten.append(Markup("on {}, {} against {}").format(scene, ", ".join(further), _ms(best_value)))
     if beaten:
-        text += "; longer than the best elsewhere: " + "; ".join(beaten)
-    return text + ". " + _link("stable", "largest stable step")
+        text += Markup("; longer than the best elsewhere: ") + Markup("; ").join(beaten)
+    not_probed = getattr(report, "not_probed", [])
+    if not_probed:
+        text += Markup("; not probed: {}").format(", ".join(not_probed))
+    return text + Markup(". ") + link("stable", "largest stable step")
 
 
-def _failures(report) -> str | None:
+def _failures(report) -> Markup:
     failed: dict[str, list[str]] = {}
     for r in report.rows:
         if r.status != "ok":
             failed.setdefault(r.policy, []).append(f"{r.scene} {r.profile} ({r.status})")
     if not failed:
-        return "No run blew up or broke. " + _link("runs", "every run")
-    items = "; ".join(f"<b>{html.escape(p)}</b>: {len(v)} run{'s' if len(v) > 1 else ''} "
-                      f"({html.escape(', '.join(v[:3]))}{', ...' if len(v) > 3 else ''})" for p, v in failed.items())
-    return f"Failed (blew up or broke): {items}. " + _link("runs", "every run")
+        return Markup("No run blew up or broke. ") + link("runs", "every run")
+    items = Markup("; ").join(
+        Markup("{}: {} run{} ({}{})").format(bold(p), len(v), "s" if len(v) > 1 else "", ", ".join(v[:3]),
+                                           ", ..." if len(v) > 3 else "") for p, v in failed.items())
+    return Markup("Failed (blew up or broke): {}. ").format(items) + link("runs", "every run")
 
 
-def recommendation(report) -> str:
-    """The opening section: one line per need, each made from this run's numbers and linked to its evidence."""
+def recommendation(report) -> list[tuple[str, Markup]]:
+    """The opening section's lines: (need, text), each made from this run's numbers and linked to its evidence."""
     lines = [("Same motion at every frame rate", _consistency(report)),
+             ("What cutting the frame gives, what the mapping adds", _cut_and_mapping(report)),
              ("Closest to the exact solution", _accuracy_exact(report)),
              ("Closest to the fine-step reference", _accuracy_reference(report)),
+             ("Where the accurate mappings serve", _served(report)),
              ("Cheapest", _cost(report)),
              ("Largest stable step", _stable(report)),
              ("Avoid", _failures(report))]
-    items = "".join(f"<li><b>{html.escape(need)}:</b> {text}</li>" for need, text in lines if text)
-    return ("<section id='recommendation'><h2>Which policy for which need</h2>"
-            "<p class=small>Every line below is computed from this run's numbers and links to the table that shows "
-            "it.</p>"
-            f"<ul class='answers'>{items}</ul>"
-            "<h3>The policies</h3>" + definitions(runs.policy_names()) + "</section>")
+    return [(need, text) for need, text in lines if text]
+
+
+def per_scene(report) -> list[dict]:
+    """One entry per scene for the table "which policy for which kind of scene": the scene, its kind (the
+    library's description), and the verdicts for consistency (among the policies whose steps follow the frames),
+    deviation and cost, each a winner or a tie."""
+    consistent = _per_scene(report, report.consistency, getattr(report, "repeat_consistency", {}), IDENTICAL,
+                            same_everywhere(report))
+    accurate = _per_scene(report, report.spreads, getattr(report, "repeat_deviation", {}))
+    cheap = cost_leaders(report.costs)
+    return [{"scene": s, "kind": runs.scene_info(s).description, "consistency": consistent.get(s, []),
+             "deviation": accurate.get(s, []), "cost": cheap.get(s, [])} for s in report.scenes]
+
+
+def verdict(tied: list[str]) -> Markup:
+    """A winner in bold, or "tie: ..." (the table cells)."""
+    return _verdict(tied) if tied else Markup("-")

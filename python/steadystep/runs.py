@@ -351,12 +351,14 @@ class Scene:
         parameter sets written (row_writes)."""
         return _as_dict(lib.ssScene_Counters(self._handle()))
 
-    def points(self) -> np.ndarray:
+    def points(self, interpolated: bool = False) -> np.ndarray:
         """The scene's drawing now (ssScene_Points): an (n, 3) array of polyline points in m; (0, 3) when the scene
-        has none (only the chain has one)."""
-        count = lib.ssScene_Points(self._handle(), ffi.NULL, 0)
+        has none (only the chain has one). interpolated: on the poses the stepper gives to draw
+        (ssScene_InterpolatedPoints: under the fixed cut blended between the last two physics states)."""
+        read = lib.ssScene_InterpolatedPoints if interpolated else lib.ssScene_Points
+        count = read(self._handle(), ffi.NULL, 0)
         xyz = ffi.new("double[]", max(1, 3 * count))
-        lib.ssScene_Points(self._handle(), xyz, count)
+        read(self._handle(), xyz, count)
         return np.frombuffer(ffi.buffer(xyz, 3 * count * ffi.sizeof("double")), dtype=np.float64).reshape(count, 3).copy()
 
     def time_frames(self, frames_s, plain: bool = False) -> float:

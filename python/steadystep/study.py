@@ -9,7 +9,9 @@ differ.
 Executors by name (``make_executor``):
 
 - ``local``: a process pool over every core this process may use (the default of ``steadystep compare`` and
-  ``probe``);
+  ``probe``). Its workers start cheaply: they are forked from a server process that imported steadystep's study
+  modules once (multiprocessing's forkserver, WORKER_PRELOAD), instead of each importing them anew, and they hold
+  none of this process's threads or ODE state;
 - ``serial`` (or ``none``): in this process, one unit after the other (debugging, the one-process measurement);
 - ``dask``: a Dask distributed cluster on this machine, one single-threaded worker process per core, shut down
   after;
@@ -33,6 +35,8 @@ DASK_CONNECT_TIMEOUT_S = 10
 DASK_WORKER_TIMEOUT_S = 10
 DASK_EXTRA_HINT = "pip install 'steadystep[dask]'"
 EXECUTOR_NAMES = ("local", "serial", "none", "dask", "dask:ADDRESS")
+# What the local pool's fork server imports once for all its workers: the units of the report's task graph.
+WORKER_PRELOAD = ["steadystep.report_tasks", "steadystep.figures"]
 
 
 class ExecutorUnavailable(RuntimeError):
@@ -108,10 +112,7 @@ def make_executor(spec: str = "local") -> Iterator[concurrent.futures.Executor]:
     if spec in ("serial", "none"):
         yield SerialExecutor()
     elif spec == "local":
-        # spawn: fresh workers that import steadystep themselves, with none of this process's threads or state.
-        import multiprocessing
-
-        pool = concurrent.futures.ProcessPoolExecutor(usable_cores(), multiprocessing.get_context("spawn"),
+        pool = concurrent.futures.ProcessPoolExecutor(usable_cores(), _worker_context(),
                                                       initializer=_ignore_interrupt)
         try:
             yield pool
@@ -125,6 +126,40 @@ def make_executor(spec: str = "local") -> Iterator[concurrent.futures.Executor]:
             yield executor
     else:
         raise ExecutorUnavailable(f"executor = {spec!r}: unknown; use one of {', '.join(EXECUTOR_NAMES)}")
+
+
+def _worker_context():
+    """forkserver where the platform has it (workers forked from a server that preloaded WORKER_PRELOAD: no import
+    per worker, nothing of this process's state), else spawn (fresh interpreters that import steadystep
+    themselves)."""
+    import multiprocessing
+
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(WORKER_PRELOAD)
+    return context
+
+
+def capacity(executor: concurrent.futures.Executor) -> int:
+    """How many units executor runs at once: a process pool's workers, a Dask cluster's threads, else the usable
+    cores."""
+    workers = getattr(executor, "_max_workers", None)
+    if isinstance(workers, int) and workers > 0:
+        return workers
+    client = getattr(executor, "_client", None)
+    if client is not None:
+        try:
+            return max(1, sum(client.nthreads().values()))
+        except Exception:  # noqa: BLE001 - a cluster that cannot say: fall back to this machine's cores
+            pass
+    return usable_cores()
+
+
+def submit(executor: concurrent.futures.Executor, function: Callable, task: Mapping) -> concurrent.futures.Future:
+    """executor.submit(function, **task), the task's names going to function alone (never to an executor's own
+    submit keywords: Dask's key, priority, workers...)."""
+    return executor.submit(_apply, function, dict(task))
 
 
 @contextlib.contextmanager
@@ -241,7 +276,7 @@ def as_completed(function: Callable, tasks: Iterable[Mapping],
                 done(task)
                 yield index, result
             return
-        futures = [executor.submit(_apply, function, task) for task in tasks]
+        futures = [submit(executor, function, task) for task in tasks]
         indices = {future: i for i, future in enumerate(futures)}
         try:
             for future in concurrent.futures.as_completed(futures):
@@ -264,6 +299,9 @@ class _NoBar:
         pass
 
     def set_postfix_str(self, text: str = "", refresh: bool = True) -> None:
+        pass
+
+    def set_description_str(self, text: str = "", refresh: bool = True) -> None:
         pass
 
 

@@ -134,7 +134,7 @@ TEST_F(StepperTest, CreateRefusesBadDefinitionsNamingTheField) {
 }
 
 TEST_F(StepperTest, PoliciesArePresetsOfCutAndMappingNamedByTheLibrary) {
-  ASSERT_EQ(ssPolicyCount(), 7);
+  ASSERT_EQ(ssPolicyCount(), 8);
   for (int i = 0; i < ssPolicyCount(); ++i) {
     ssStepping stepping = TestStepping();
     ASSERT_EQ(ssSteppingForPolicy(ssPolicyNameAt(i), 1.0 / 60, &stepping), SS_OK);
@@ -148,7 +148,14 @@ TEST_F(StepperTest, PoliciesArePresetsOfCutAndMappingNamedByTheLibrary) {
   EXPECT_NE(std::string(ssLastError()).find("smooth"), std::string::npos);
   EXPECT_NE(std::string(ssLastError()).find("fixed-exact"), std::string::npos);  // the known names, listed
   EXPECT_EQ(ssSteppingForPolicy("naive", 0, &stepping), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssSteppingForPolicy("substeps-frozen", 0, &stepping), SS_ERROR_OUT_OF_RANGE);
   EXPECT_EQ(std::memcmp(&before, &stepping, sizeof stepping), 0);
+  // The control: implicit-euler's cut with naive's frozen softness.
+  ssStepping control = TestStepping();
+  ASSERT_EQ(ssSteppingForPolicy("substeps-frozen", 1.0 / 30, &control), SS_OK);
+  EXPECT_EQ(control.cut, SS_CUT_SUBSTEPS);
+  EXPECT_EQ(control.mapping, SS_MAPPING_IMPLICIT_EULER);
+  EXPECT_DOUBLE_EQ(control.frozen_step_s, 1.0 / 30);
   // Every combination of cut and mapping is a valid stepping; whole-frame matched is no preset.
   stepping.cut = SS_CUT_WHOLE_FRAME;
   stepping.mapping = SS_MAPPING_MATCHED;

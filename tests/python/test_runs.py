@@ -14,7 +14,7 @@ def test_scenes_and_policies_come_from_the_library():
     names = [info.name for info in runs.scenes()]
     assert {"oscillator", "buggy", "drop", "chain", "pile"} <= set(names)
     assert runs.scene_info("oscillator").quantities == ("x", "v", "erp", "cfm")
-    assert runs.policy_names() == ["naive", "implicit-euler", "matched", "exact", "fixed", "fixed-matched",
+    assert runs.policy_names() == ["naive", "substeps-frozen", "implicit-euler", "matched", "exact", "fixed", "fixed-matched",
                                    "fixed-exact"]
     assert runs.default_params("oscillator")["spring"] == {"stiffness": 40.0, "damping": 1.0}
 

@@ -138,3 +138,25 @@ def test_program_scenes_are_listed_with_their_units_and_count_their_contacts(sce
     else:
         # every step makes contacts: the tower's boxes on each other, the wall's bricks (276 standing)
         assert contacts["by_mapping"] >= (4 if scene == "stack" else 200) * result.step_count
+
+
+def test_the_drawn_points_are_the_interpolated_poses():
+    """Under fixed, frames of exactly one step end with interpolation 0: the pose drawn is the one before the frame's
+    step, so the drawing after frame n is ODE's after frame n - 1. Under the other cuts it is ODE's own."""
+    step_s = runs.make_stepping("fixed")["fixed_step_s"]
+    scene = runs.Scene("chain", "fixed")
+    try:
+        before = scene.points()
+        for _ in range(5):
+            scene.frame(step_s)
+            np.testing.assert_allclose(scene.points(interpolated=True), before, rtol=0, atol=1e-9)
+            before = scene.points()
+        assert not np.allclose(scene.points(interpolated=True), scene.points())  # it moved: the test can fail
+    finally:
+        scene.close()
+    scene = runs.Scene("chain", "implicit-euler")
+    try:
+        scene.frame(0.025)
+        np.testing.assert_array_equal(scene.points(interpolated=True), scene.points())
+    finally:
+        scene.close()

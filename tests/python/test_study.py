@@ -155,3 +155,18 @@ def test_bad_grid_values_exit_2_with_one_line(tmp_path, args):
                         "--duration", "1", *args)
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert not (tmp_path / "out").exists()
+
+
+def _imported(name: str) -> bool:
+    import sys
+
+    return name in sys.modules
+
+
+def test_the_local_pools_workers_start_with_the_study_modules_already_imported():
+    """Forked from a server that preloaded them: a worker's first unit finds steadystep's units and matplotlib
+    imported (they are not imported by the unit itself: sys.modules.__contains__ imports nothing)."""
+    with study.make_executor("local") as pool:
+        for name in ("steadystep.report_tasks", "matplotlib"):
+            assert pool.submit(_imported, name).result(), name
+    assert study.capacity(study.SerialExecutor()) == study.usable_cores()

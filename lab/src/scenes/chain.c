@@ -110,16 +110,11 @@ static double check(const void* state, char* worst, size_t size) {
 }
 
 /* The pivot, then the far end of each link: the chain as a polyline. */
-static int points(const void* state, double* xyz, int capacity) {
+static int points(const void* state, const ssStepper* drawn_by, double* xyz, int capacity) {
   const Chain* chain = state;
   for (int i = 0; i <= chain->count && i < capacity; ++i) {
-    dVector3 point;
-    if (i == 0) {
-      dBodyGetRelPointPos(chain->links[0], -0.5 * CHAIN_LINK_M, 0, 0, point);
-    } else {
-      dBodyGetRelPointPos(chain->links[i - 1], 0.5 * CHAIN_LINK_M, 0, 0, point);
-    }
-    for (int k = 0; k < 3; ++k) xyz[3 * i + k] = point[k];
+    const double rel[3] = {(i == 0 ? -0.5 : 0.5) * CHAIN_LINK_M, 0, 0};
+    ssScenePointOnBody(drawn_by, chain->links[i == 0 ? 0 : i - 1], rel, &xyz[3 * i]);
   }
   return chain->count + 1;
 }

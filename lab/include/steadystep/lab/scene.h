@@ -206,6 +206,11 @@ SS_LAB_API ssSceneCounters ssScene_Counters(const ssScene* scene);
  *  scene = NULL, capacity < 0 or xyz = NULL with capacity > 0, which record why for ssLastError(). */
 SS_LAB_API int ssScene_Points(const ssScene* scene, double* xyz, int capacity);
 
+/** As ssScene_Points, but each point on the pose the scene's stepper gives to draw (ssStepper_InterpolatedPose,
+ *  interpolation.h): under the fixed cut blended between the last two physics states at the last frame's
+ *  interpolation factor, under the other cuts ODE's pose (the same points as ssScene_Points). Same errors. */
+SS_LAB_API int ssScene_InterpolatedPoints(const ssScene* scene, double* xyz, int capacity);
+
 /** Steps count frames of frames_s[i] seconds and writes the wall-clock seconds they took to *wall_s: through the
  *  scene's stepper (plain = 0, as ssScene_Frame), or (plain = 1) as a program without the library steps, for the
  *  cost benchmark: collide, one dWorldQuickStep (or dWorldStep, per the stepping's solver) of the whole frame and

@@ -1,0 +1,209 @@
+"""report.html: the comparison's page, built with Jinja2 with autoescape on (every value is escaped unless it is a
+markupsafe.Markup, which only page.py, animation.py and the cells below make, their arguments escaped as they go
+in). The templates are in report_templates.py."""
+
+from __future__ import annotations
+
+import base64
+import json
+import math
+import platform
+import time
+from pathlib import Path
+
+from markupsafe import Markup
+
+from steadystep import animation, figures, page, runs
+from steadystep.report_export import swept_axes
+from steadystep.report_model import Report
+from steadystep.report_tasks import NOT_PROBED
+from steadystep.report_templates import ENVIRONMENT
+from steadystep.report_validate import GRID_AXES
+
+
+def number(value, digits: int = 3) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    if isinstance(value, float) and math.isinf(value):
+        return "failed"
+    return f"{value:.{digits}g}"
+
+
+def bad(text: str) -> Markup:
+    return Markup("<span class=bad>{}</span>").format(text)
+
+
+def cell(value, status: str = "ok", digits: int = 3):
+    """A number, or the run's status when the run failed (blew up, ran away, broke)."""
+    return bad(status) if status != "ok" else number(value, digits)
+
+
+def status_cell(status: str):
+    """A run's status: ok, or what went wrong (blow-up, speed limit, broken) in red: a failure either way."""
+    return "ok" if status == "ok" else bad(status)
+
+
+def policy_cell(policy: str) -> Markup:
+    return Markup('<span class="dot" style="background:{}"></span>{}').format(figures.policy_color(policy), policy)
+
+
+def embed(path: Path, anchor: str | None = None) -> Markup:
+    data = base64.b64encode(Path(path).read_bytes()).decode()
+    return Markup('<img{} src="data:image/png;base64,{}" alt="{}">').format(
+        Markup(" id='{}'").format(anchor) if anchor else "", data, Path(path).name)
+
+
+def _all_policies(report: Report) -> list[str]:
+    return list(dict.fromkeys(p for s in report.scenes for p in report.policies[s]))
+
+
+def by_scene(report: Report, values: dict, noise: dict, zero: float = 0.0) -> dict:
+    """A scene x policy table of values[scene][policy][first motion quantity], the leaders of a row (the lowest,
+    and those tied with it within the spread of repeats) in bold, the spread beside each value."""
+    policies = _all_policies(report)
+    rows = []
+    for scene in report.scenes:
+        if scene not in values:
+            continue
+        quantity = runs.motion_quantities(scene)[0]
+        cells = {p: values[scene][p][quantity] for p in report.policies[scene] if p in values[scene]}
+        # At or below zero the numbers are rounding: shown as 0, all of them the best.
+        cells = {p: 0.0 if v is not None and math.isfinite(v) and v <= zero else v for p, v in cells.items()}
+        spread = {p: noise.get(scene, {}).get(p, {}).get(quantity, math.nan) for p in cells}
+        leaders = page.leaders(cells, spread)
+        row = [page.link(scene, scene), quantity]
+        for p in policies:
+            text = number(cells.get(p))
+            if p in cells and math.isfinite(spread.get(p, math.nan)) and spread[p] > 0:
+                text = f"{text} ± {number(spread[p], 2)}"
+            row.append(page.bold(text) if p in leaders else text)
+        rows.append(row)
+    return {"header": ["scene", "quantity"] + [policy_cell(p) for p in policies], "rows": rows}
+
+
+def control_table(report: Report) -> dict:
+    ladders = page.control_ladder(report)
+    policies = [p for p in page.CONTROL_LADDER if any(p == q for ladder in ladders.values() for q, _, _ in ladder)]
+    rows = []
+    for scene, ladder in ladders.items():
+        values = {p: (c, d) for p, c, d in ladder}
+        rows.append([page.link(scene, scene), runs.motion_quantities(scene)[0]]
+                    + [f"{number(values[p][0])} / {number(values[p][1])}" if p in values else "-" for p in policies])
+    return {"header": ["scene", "quantity"] + [policy_cell(p) for p in policies], "rows": rows}
+
+
+def served_table(report: Report) -> dict:
+    rows = []
+    for scene, by_policy in report.served.items():
+        for policy in (p for p in page.ACCURATE if p in by_policy):
+            if not any(sum(by_policy[policy][what].values()) for what in ("rows", "contacts")):
+                continue  # nothing bound and nothing softened through the stepper: nothing to serve
+            row = [page.link(scene, scene), policy_cell(policy)]
+            for what in ("rows", "contacts"):
+                mapped, matched, implicit, total = page.served_shares(by_policy[policy][what])
+                row += [str(total)] + ([page.percent(v) for v in (mapped, matched, implicit)] if total else
+                                       ["-", "-", "-"])
+            rows.append(row)
+    header = ["scene", "policy"] + [f"{what} {column}" for what in ("row-steps", "contacts")
+                                    for column in ("counted", "served by the mapping", "handed to matched",
+                                                   "handed to implicit Euler")]
+    return {"header": header, "rows": rows}
+
+
+def cost_table(report: Report) -> dict:
+    rows = []
+    for c in report.costs:
+        ok = c.status == "ok"
+        rows.append([c.scene, policy_cell(c.policy), number(c.steps_per_frame),
+                     number(c.us_per_frame) if ok else bad(c.status),
+                     f"×{number(c.ratio_median)}" if ok else "-",
+                     f"{number(c.ratio_low)} – {number(c.ratio_high)}" if ok else "-",
+                     f"×{number(c.overhead_median, 4)}" if ok else "-",
+                     f"{number(c.overhead_low, 4)} – {number(c.overhead_high, 4)}" if ok else "-"])
+    return {"header": ["scene", "policy", "steps / frame", "µs / frame", "per frame / program's own (median)",
+                       "range over blocks", "library: / plain ODE at the same steps (median)", "range over blocks"],
+            "rows": rows}
+
+
+def stable_table(report: Report) -> dict:
+    policies = _all_policies(report)
+    rows = []
+    for scene, results in report.probes.items():
+        by_policy = {}
+        for r in results:
+            by_policy.setdefault(r.policy, r)  # a study's grid: its first point
+        cells = [scene]
+        for p in policies:
+            r = by_policy.get(p)
+            if r is None:
+                cells.append("-")
+            elif not math.isfinite(r.unstable_s):
+                cells.append(f"≥ {number(1000 * r.stable_s, 4)}")
+            else:
+                cells.append(Markup("<span title='{}'>{}</span>").format(r.reason or "",
+                                                                         number(1000 * r.stable_s, 4)))
+        rows.append(cells)
+    return {"header": ["scene"] + [policy_cell(p) for p in policies], "rows": rows}
+
+
+def side_by_side_table(report: Report) -> dict:
+    rows = []
+    for e in report.side_by_side:
+        status = e["status"]
+        rows.append([e["profile"], policy_cell(e["policy"]), cell(e["rms_vs_exact"], status),
+                     number(e["decay_rate_per_s"], 4), number(e["true_decay_rate_per_s"], 4),
+                     number(e["angular_frequency_rad_s"], 5), number(e["true_angular_frequency_rad_s"], 5),
+                     status_cell(status)])
+    return {"header": ["profile", "policy", "RMS vs exact / x0", "fitted decay (1/s)", "true decay (1/s)",
+                       "fitted ω (rad/s)", "true ω (rad/s)", "status"], "rows": rows}
+
+
+def scene_section(report: Report, scene: str) -> dict:
+    quantities = runs.motion_quantities(scene)
+    info = runs.scene_info(scene)
+    units = dict(zip(info.quantities, info.units))
+    swept = swept_axes(report)
+    header = (["profile", "policy"] + [f"{a} ({GRID_AXES[a]})" for a in swept]
+              + [f"deviation of {q}" for q in quantities]
+              + (["RMS vs exact / x0"] if scene == "oscillator" else [])
+              + ["steps / frame", "rows served by implicit Euler", "contacts served by implicit Euler", "status"])
+    rows = []
+    for r in (r for r in report.rows if r.scene == scene):
+        fallback = r.policy in page.ACCURATE
+        rows.append([r.profile, policy_cell(r.policy)] + [number(r.grid[a], 6) for a in swept]
+                    + [cell(r.deviations[q], r.status) for q in quantities]
+                    + ([cell(r.rms_vs_exact, r.status)] if scene == "oscillator" else [])
+                    + [number(r.steps_per_frame), str(r.rows_handed_to_implicit_euler) if fallback else "-",
+                       str(r.contacts_handed_to_implicit_euler) if fallback else "-", status_cell(r.status)])
+    return {"scene": scene, "description": info.description, "table": {"header": header, "rows": rows},
+            "units": ", ".join(f"{q} in {units[q]}" for q in quantities),
+            "images": [embed(p) for p in report.figures.get(scene, []) if p.suffix == ".png"]}
+
+
+def as_html(report: Report, command: str, article_paths: list[Path]) -> str:
+    """The whole page."""
+    pngs = [p for p in article_paths if p.suffix == ".png"]
+    return ENVIRONMENT.get_template("report.html").render(
+        report=report, command=command,
+        recommendation=page.recommendation(report),
+        per_scene=[{**entry, "consistency": page.verdict(entry["consistency"]),
+                    "deviation": page.verdict(entry["deviation"]), "cost": page.verdict(entry["cost"])}
+                   for entry in page.per_scene(report)],
+        policies=page.definitions(runs.policy_names()),
+        animation=animation.section(report.animation) if report.animation else None,
+        consistency=by_scene(report, report.consistency, report.repeat_consistency, page.IDENTICAL),
+        deviation=by_scene(report, report.spreads, report.repeat_deviation),
+        control=control_table(report), served=served_table(report) if report.served else None,
+        identical=f"{page.IDENTICAL:g}", repeat_profiles=report.repeat_profiles, repeat_seed=report.seed + 1,
+        side_by_side=side_by_side_table(report) if report.side_by_side else None,
+        cost=cost_table(report) if report.costs else None,
+        cost_profile=report.costs[0].profile if report.costs else "-",
+        cost_repeats=report.costs[0].repeats if report.costs else 0,
+        stable=stable_table(report) if report.probes else None,
+        not_probed=[(scene, NOT_PROBED.get(scene, "")) for scene in report.not_probed],
+        article=embed(pngs[0]) if pngs else None,
+        scenes=[scene_section(report, s) for s in report.scenes],
+        parameters=[[s, Markup("<code>{}</code>").format(json.dumps(p))] for s, p in report.params.items()],
+        stepping_defaults=json.dumps(runs.default_stepping()), reference_stepping=json.dumps(runs.reference_stepping()),
+        reference_profile=runs.REFERENCE_PROFILE, node=platform.node(), machine=platform.machine(),
+        made_at=time.strftime("%Y-%m-%d %H:%M:%S %Z"), phases=report.phases_s)
