@@ -15,6 +15,8 @@
 #include "registry_internal.h"
 #include "steadystep/steadystep.h"
 
+#include "bench_common.h"
+
 enum { kChains = 50, kLinks = 20, kBlock = 10, kMaxRepeats = 32 };
 enum { kConfigs = 8 };
 static const unsigned kDisabled[kConfigs] = {0,
@@ -30,17 +32,9 @@ static const char* const kConfigNames[kConfigs] = {"all on", "-same step", "-by 
 static const ssSpring kLimit = {5.0, 0.05}, kFriction = {0.0, 0.01};
 static const double kFrame_s = 1.0 / 60.0;
 
-static double nowSeconds(void) { /* this thread's CPU time: waiting for a core is not counted */
-  struct timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+static double nowSeconds(void) { return benchCpuSeconds(); }
 
-static void check(ssStatus status, const char* what) {
-  if (status == SS_OK) return;
-  fprintf(stderr, "bench_apply: %s: %s\n", what, ssLastError());
-  exit(1);
-}
+static void check(ssStatus status, const char* what) { benchCheck("bench_apply", status, what); }
 
 typedef struct Scene {
   dWorldID world;

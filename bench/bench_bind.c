@@ -11,23 +11,16 @@
 
 #include <steadystep/steadystep.h>
 
+#include "bench_common.h"
+
 enum { kSizes = 3, kLinks = 50, kMaxRepeats = 64 };
 static const int kRows[kSizes] = {1000, 10000, 100000};
 static const double kTuned_s = 1.0 / 60.0;
 static const ssSpring kLimit = {5.0, 0.05}, kFriction = {0.0, 0.01};
 
-/* CPU time of this thread: time spent waiting for a core on a shared machine is not counted. */
-static double nowSeconds(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+static double nowSeconds(void) { return benchCpuSeconds(); }
 
-static void check(ssStatus status, const char* what) {
-  if (status == SS_OK) return;
-  fprintf(stderr, "bench_bind: %s: %s\n", what, ssLastError());
-  exit(1);
-}
+static void check(ssStatus status, const char* what) { benchCheck("bench_bind", status, what); }
 
 typedef struct World {
   dWorldID world;

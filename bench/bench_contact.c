@@ -15,6 +15,8 @@
 #include <steadystep/lab/profile.h>
 #include <steadystep/steadystep.h>
 
+#include "bench_common.h"
+
 enum { kTowerHeight = 8, kMaxContacts = 4, kBlock = 20, kMaxRepeats = 64 };
 static const double kBoxSide = 0.4, kTowerSpacing = 1.0, kTuned_s = 1.0 / 60.0;
 
@@ -27,17 +29,9 @@ typedef struct Stack {
   long contact_count;
 } Stack;
 
-static double nowSeconds(void) { /* this thread's CPU time: waiting for a core is not counted */
-  struct timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+static double nowSeconds(void) { return benchCpuSeconds(); }
 
-static void check(ssStatus status, const char* what) {
-  if (status == SS_OK) return;
-  fprintf(stderr, "bench_contact: %s: %s\n", what, ssLastError());
-  exit(1);
-}
+static void check(ssStatus status, const char* what) { benchCheck("bench_contact", status, what); }
 
 /* The near callback of both worlds: data is the stack; the adopted one softens every contact. */
 static void nearCallback(void* data, dGeomID g1, dGeomID g2) {

@@ -19,23 +19,17 @@
 #include <steadystep/lab/profile.h>
 #include <steadystep/steadystep.h>
 
+#include "bench_common.h"
+
 enum { kLinks = 10, kBlock = 20, kMaxRepeats = 64, kSizes = 4, kWays = 2 };
 static const int kBodies[kSizes] = {10, 100, 1000, 10000};
 static const ssSpring kLimit = {5.0, 0.05}, kFriction = {0.0, 0.01};
 static const double kFrame_s = 1.0 / 60.0;
 static ssMapping mapping = SS_MAPPING_IMPLICIT_EULER;
 
-static double nowSeconds(void) { /* this thread's CPU time: waiting for a core is not counted */
-  struct timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+static double nowSeconds(void) { return benchCpuSeconds(); }
 
-static void check(ssStatus status, const char* what) {
-  if (status == SS_OK) return;
-  fprintf(stderr, "bench_limit: %s: %s\n", what, ssLastError());
-  exit(1);
-}
+static void check(ssStatus status, const char* what) { benchCheck("bench_limit", status, what); }
 
 typedef struct Scene {
   dWorldID world;

@@ -19,6 +19,8 @@
 #include <steadystep/lab/profile.h>
 #include <steadystep/steadystep.h>
 
+#include "bench_common.h"
+
 enum { kChains = 50, kLinks = 20, kBlock = 20 }; /* 1000 bodies, 1000 hinges, 2000 soft parameter sets with the motors */
 
 static const ssSpring kLimit = {5.0, 0.05}; /* about 6 Hz on a link of 0.0035 kg·m² */
@@ -33,19 +35,9 @@ typedef struct Scene {
   dJointID hinges[kChains * kLinks];
 } Scene;
 
-/* The thread's CPU time, not the wall clock: on a machine shared with other work, the time the thread waits for a
- * core would otherwise land on whichever world happened to be stepping. */
-static double nowSeconds(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+static double nowSeconds(void) { return benchCpuSeconds(); }
 
-static void check(ssStatus status, const char* what) {
-  if (status == SS_OK) return;
-  fprintf(stderr, "bench_stepper: %s: %s\n", what, ssLastError());
-  exit(1);
-}
+static void check(ssStatus status, const char* what) { benchCheck("bench_stepper", status, what); }
 
 /* Chains hang from the static world along x, start horizontal, and swing into their limits. */
 static Scene build(int with_stepper) {
