@@ -204,8 +204,8 @@ def build_parser() -> argparse.ArgumentParser:
                                 f"{MAX_RUN_STEPS:.0e} steps.")
     probe.add_argument("scene", metavar="SCENE", help=", ".join(scene_names()))
     probe.add_argument("--policies", nargs="+", metavar="POLICY", default=default_policies(),
-                       help="default: the policies without a fixed step of their own "
-                       f"({' '.join(default_policies())})")
+                       help=f"default: {' '.join(default_policies())} (the policies without a fixed step of their "
+                       "own)")
     probe.add_argument("--duration", type=_measured_duration, default=3.0, metavar="S",
                        help=f"seconds per trial, at least {MIN_MEASURED_DURATION_S:g} (default 3)")
     probe.add_argument("--low", type=_positive_float, default=0.001, metavar="S",
