@@ -16,59 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "steadystep/lab/scene.h"
-#include "steadystep/steadystep.h"
+#include "recorded_run.h"
 
 namespace {
-
-struct Outcome {
-  ssRunOutcome outcome = SS_RUN_NONE;
-  ssStatus status = SS_OK;
-  std::string message;
-  double bound_use = NAN;
-  int frames = 0;
-  std::vector<double> times;
-  std::vector<std::vector<double>> quantities;
-  std::vector<double> initial;
-};
-
-ssRunDef Def(const char* scene, const char* profile, const char* policy, double duration_s) {
-  ssRunDef def{};
-  def.scene = scene;
-  EXPECT_EQ(ssDefaultSceneParams(scene, &def.params), SS_OK) << ssLastError();
-  EXPECT_EQ(ssLabStepping(policy, &def.stepping), SS_OK) << ssLastError();
-  def.profile = profile;
-  def.seed = 1;
-  def.duration_s = duration_s;
-  return def;
-}
-
-ssRunDef ReferenceDef(const char* scene, double duration_s) {
-  ssRunDef def = Def(scene, "fixed:1000", "implicit-euler", duration_s);
-  def.stepping = ssReferenceStepping(1e-3);
-  return def;
-}
-
-Outcome Execute(const ssRunDef& def) {
-  Outcome out;
-  ssRun* run = nullptr;
-  ssStatus status = ssRun_Execute(&def, &run);
-  EXPECT_EQ(status, SS_OK) << def.scene << " " << def.profile << ": " << ssLastError();
-  if (status != SS_OK) return out;
-  out.outcome = ssRun_Outcome(run);
-  out.status = ssRun_Status(run);
-  out.message = ssRun_Message(run);
-  out.bound_use = ssRun_BoundUse(run);
-  out.frames = ssRun_FrameCount(run);
-  int count = ssRun_StepCount(run);
-  out.times.assign(ssRun_Times(run), ssRun_Times(run) + count);
-  int quantities = ssSceneFind(def.scene)->quantity_count;
-  for (int q = 0; q < quantities; ++q)
-    out.quantities.emplace_back(ssRun_Quantity(run, q), ssRun_Quantity(run, q) + count);
-  out.initial.assign(ssRun_Initial(run), ssRun_Initial(run) + quantities);
-  ssRun_Destroy(run);
-  return out;
-}
 
 // The time a broken run's message names ("t = 1.5 s: ...").
 double MessageTime(const std::string& message) {
@@ -77,7 +27,7 @@ double MessageTime(const std::string& message) {
   return t;
 }
 
-void ExpectBrokenAtItsLastRecord(const Outcome& run, const char* part) {
+void ExpectBrokenAtItsLastRecord(const RecordedRun& run, const char* part) {
   EXPECT_EQ(run.outcome, SS_RUN_BROKEN) << run.message;
   EXPECT_EQ(run.status, SS_OK) << "broken is no error of the library";
   EXPECT_GT(run.bound_use, 1.0);
@@ -92,13 +42,13 @@ void ExpectBrokenAtItsLastRecord(const Outcome& run, const char* part) {
 // Every policy under every profile completes below 0.8 of every sanity bound; prints the largest use of them, and
 // the reference's, and records it as a test property.
 void ExpectRunsBelowTheBounds(const char* scene, const std::vector<const char*>& profiles, double duration_s,
-                              const Outcome& reference) {
+                              const RecordedRun& reference) {
   const char* const policies[] = {"implicit-euler", "matched", "exact", "fixed"};
   double worst = 0;
   std::string worst_run;
   for (const char* policy : policies) {
     for (const char* profile : profiles) {
-      Outcome run = Execute(Def(scene, profile, policy, duration_s));
+      RecordedRun run = Record(LabRunDef(scene, profile, policy, duration_s));
       EXPECT_EQ(run.outcome, SS_RUN_COMPLETED) << scene << " " << policy << " " << profile << ": " << run.message;
       EXPECT_LT(run.bound_use, 0.8) << scene << " " << policy << " " << profile;
       if (run.bound_use > worst) {
@@ -121,7 +71,7 @@ class CorrectRuns : public ::testing::TestWithParam<const char*> {};
 TEST_P(CorrectRuns, NeverReachTheBounds) {
   const char* scene = GetParam();
   const double duration_s = std::string(scene) == "pile" ? 1.0 : 5.0;
-  Outcome reference = Execute(ReferenceDef(scene, duration_s));
+  RecordedRun reference = Record(LabReferenceDef(scene, duration_s));
   EXPECT_EQ(reference.outcome, SS_RUN_COMPLETED) << scene << " reference: " << reference.message;
   EXPECT_EQ(reference.message, "") << scene;
   ExpectRunsBelowTheBounds(scene, {"fixed:30", "uniform:15:45", "jitter:30:3", "hitch:60:30:0.1", "vsync:60:30"},
@@ -140,9 +90,9 @@ class ProgramRuns : public ::testing::TestWithParam<const char*> {};
 TEST_P(ProgramRuns, NeverReachTheBounds) {
   const char* scene = GetParam();
   const double duration_s = std::string(scene) == "wall" ? 2.0 : 5.0;
-  ssRunDef reference_def = Def(scene, "fixed:240", "implicit-euler", duration_s);
+  ssRunDef reference_def = LabRunDef(scene, "fixed:240", "implicit-euler", duration_s);
   reference_def.stepping = ssReferenceStepping(1.0 / 240);
-  Outcome reference = Execute(reference_def);
+  RecordedRun reference = Record(reference_def);
   EXPECT_EQ(reference.outcome, SS_RUN_COMPLETED) << scene << " reference: " << reference.message;
   ExpectRunsBelowTheBounds(scene, {"fixed:60", "fixed:30", "uniform:15:45"}, duration_s, reference);
 }
@@ -153,7 +103,7 @@ INSTANTIATE_TEST_SUITE_P(SanityBounds, ProgramRuns, ::testing::Values("stack", "
 // Issue 10's case: the chain under 2 s frames. Whatever the bound's code says, an end 39 m below a pivot 2.5 m high
 // on a chain 2 m long is a chain that came apart.
 TEST(SanityBounds, ChainUnderTwoSecondFramesIsBrokenAtItsFirstStep) {
-  Outcome run = Execute(Def("chain", "fixed:0.5", "naive", 5.0));
+  RecordedRun run = Record(LabRunDef("chain", "fixed:0.5", "naive", 5.0));
   ExpectBrokenAtItsLastRecord(run, "hinge");
   ASSERT_EQ(run.times.size(), 1u);  // it broke in its first step, and the run ended there
   EXPECT_EQ(run.frames, 1);
@@ -164,7 +114,7 @@ TEST(SanityBounds, ChainUnderTwoSecondFramesIsBrokenAtItsFirstStep) {
 
 // Naive's contacts, frozen soft for 1/30 s, at 30 fps: its deepest box's recorded depth is past the 0.05 m bound.
 TEST(SanityBounds, DropBoxThroughTheFloorIsBroken) {
-  Outcome run = Execute(Def("drop", "fixed:30", "naive", 5.0));
+  RecordedRun run = Record(LabRunDef("drop", "fixed:30", "naive", 5.0));
   ExpectBrokenAtItsLastRecord(run, "box");
   EXPECT_GT(run.quantities[0].back(), 0.05);  // penetration (m) of the step that broke
   for (size_t i = 0; i + 1 < run.times.size(); ++i) EXPECT_LE(run.quantities[0][i], 0.05) << "t = " << run.times[i];
@@ -174,7 +124,7 @@ TEST(SanityBounds, DropBoxThroughTheFloorIsBroken) {
 // stiffer, and the body, released at rest, gains kinetic energy. E from the recorded x and v with the declared k and
 // m passes 2 E0 (E0 = k x0^2 / 2 = 5 J); no step before the last one did.
 TEST(SanityBounds, OscillatorGainingEnergyIsBroken) {
-  Outcome run = Execute(Def("oscillator", "fixed:1000", "naive", 1.0));
+  RecordedRun run = Record(LabRunDef("oscillator", "fixed:1000", "naive", 1.0));
   ExpectBrokenAtItsLastRecord(run, "energy");
   const double k = 40, m = 1, e0 = 0.5 * k * 0.5 * 0.5;
   auto energy = [&](size_t i) {
@@ -189,7 +139,7 @@ TEST(SanityBounds, OscillatorGainingEnergyIsBroken) {
 
 // The buggy under 2 s frames: its chassis' centre ends below the ground.
 TEST(SanityBounds, BuggyThroughTheGroundIsBroken) {
-  Outcome run = Execute(Def("buggy", "fixed:0.5", "naive", 5.0));
+  RecordedRun run = Record(LabRunDef("buggy", "fixed:0.5", "naive", 5.0));
   ExpectBrokenAtItsLastRecord(run, "chassis");
   EXPECT_LT(run.quantities[0].back(), 0.0);
 }

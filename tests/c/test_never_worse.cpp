@@ -18,44 +18,11 @@
 #include <string>
 #include <vector>
 
-#include "steadystep/lab/scene.h"
-#include "steadystep/steadystep.h"
+#include "recorded_run.h"
 
 namespace {
 
 constexpr double kTolerance = 1.05;  // issue 15
-constexpr double kReferenceStepS = 1.0 / 1000;
-
-struct Series {
-  bool completed = false;
-  std::string message;
-  std::vector<double> times;
-  std::vector<std::vector<double>> quantities;
-  ssSceneCounters counters{};
-};
-
-Series Execute(const char* scene, const char* profile, const ssStepping& stepping, double duration_s) {
-  ssRunDef def{};
-  def.scene = scene;
-  EXPECT_EQ(ssDefaultSceneParams(scene, &def.params), SS_OK) << ssLastError();
-  def.stepping = stepping;
-  def.profile = profile;
-  def.seed = 1;
-  def.duration_s = duration_s;
-  Series out;
-  ssRun* run = nullptr;
-  EXPECT_EQ(ssRun_Execute(&def, &run), SS_OK) << scene << " " << profile << ": " << ssLastError();
-  if (run == nullptr) return out;
-  out.completed = ssRun_Outcome(run) == SS_RUN_COMPLETED;
-  out.message = ssRun_Message(run);
-  int count = ssRun_StepCount(run);
-  out.times.assign(ssRun_Times(run), ssRun_Times(run) + count);
-  for (int q = 0; q < ssSceneFind(scene)->quantity_count; ++q)
-    out.quantities.emplace_back(ssRun_Quantity(run, q), ssRun_Quantity(run, q) + count);
-  out.counters = ssRun_Counters(run);
-  ssRun_Destroy(run);
-  return out;
-}
 
 double Interpolate(const std::vector<double>& t, const std::vector<double>& y, double at) {
   auto after = std::upper_bound(t.begin(), t.end(), at);
@@ -67,7 +34,7 @@ double Interpolate(const std::vector<double>& t, const std::vector<double>& y, d
 }
 
 // RMS of (run - reference) at the run's samples within the reference's span, over the reference's max - min.
-double Deviation(const Series& run, const Series& reference, int quantity) {
+double Deviation(const RecordedRun& run, const RecordedRun& reference, int quantity) {
   const std::vector<double>& ref = reference.quantities[quantity];
   double amplitude = *std::max_element(ref.begin(), ref.end()) - *std::min_element(ref.begin(), ref.end());
   double sum = 0;
@@ -110,16 +77,14 @@ TEST_P(NeverWorse, AccurateMappingsWithinToleranceOfImplicitEuler) {
   double duration_s = DurationFor(c.duration_s);
   const ssSceneInfo* info = ssSceneFind(c.scene);
   ASSERT_NE(info, nullptr);
-  Series reference = Execute(c.scene, "fixed:1000", ssReferenceStepping(kReferenceStepS), duration_s);
-  ASSERT_TRUE(reference.completed) << reference.message;
+  RecordedRun reference = Record(LabReferenceDef(c.scene, duration_s));
+  ASSERT_TRUE(reference.completed()) << reference.message;
   for (const char* profile : kProfiles) {
     std::vector<std::vector<double>> deviation(std::size(kPolicies));
     std::vector<ssSceneCounters> counters(std::size(kPolicies));
     for (size_t p = 0; p < std::size(kPolicies); ++p) {
-      ssStepping stepping;
-      ASSERT_EQ(ssLabStepping(kPolicies[p], &stepping), SS_OK) << ssLastError();
-      Series run = Execute(c.scene, profile, stepping, duration_s);
-      ASSERT_TRUE(run.completed) << c.scene << " " << profile << " " << kPolicies[p] << ": " << run.message;
+      RecordedRun run = Record(LabRunDef(c.scene, profile, kPolicies[p], duration_s));
+      ASSERT_TRUE(run.completed()) << c.scene << " " << profile << " " << kPolicies[p] << ": " << run.message;
       for (int q = 0; q < info->quantity_count; ++q) deviation[p].push_back(Deviation(run, reference, q));
       counters[p] = run.counters;
       // every contact softened under an accurate mapping is served by implicit Euler, and counted as handed to it
@@ -166,10 +131,8 @@ INSTANTIATE_TEST_SUITE_P(ProgramScenes, NeverWorse,
 TEST(NeverWorse, TheBuggysSuspensionStaysServed) {
   for (const char* policy : {"matched", "exact", "fixed-matched", "fixed-exact"}) {
     for (const char* profile : kProfiles) {
-      ssStepping stepping;
-      ASSERT_EQ(ssLabStepping(policy, &stepping), SS_OK) << ssLastError();
-      Series run = Execute("buggy", profile, stepping, 1.0);
-      ASSERT_TRUE(run.completed) << run.message;
+      RecordedRun run = Record(LabRunDef("buggy", profile, policy, 1.0));
+      ASSERT_TRUE(run.completed()) << run.message;
       const ssSceneCounters& n = run.counters;
       EXPECT_EQ(n.rows.by_mapping + n.rows.handed_to_matched, 4 * n.steps) << policy << " " << profile;
       EXPECT_EQ(n.rows.handed_to_implicit_euler, n.steps) << policy << " " << profile;

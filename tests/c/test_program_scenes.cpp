@@ -11,44 +11,12 @@
 #include <vector>
 
 #include "precision.h"
-#include "steadystep/lab/scene.h"
-#include "steadystep/steadystep.h"
+#include "recorded_run.h"
 
 namespace {
 
-struct Recorded {
-  ssRunOutcome outcome = SS_RUN_NONE;
-  std::string message;
-  std::vector<double> times;
-  std::vector<std::vector<double>> quantities;
-  ssSceneCounters counters{};
-};
-
-Recorded Execute(const char* scene, const char* profile, const char* policy, double duration_s) {
-  ssRunDef def{};
-  def.scene = scene;
-  EXPECT_EQ(ssDefaultSceneParams(scene, &def.params), SS_OK) << ssLastError();
-  EXPECT_EQ(ssLabStepping(policy, &def.stepping), SS_OK) << ssLastError();
-  def.profile = profile;
-  def.seed = 1;
-  def.duration_s = duration_s;
-  Recorded out;
-  ssRun* run = nullptr;
-  EXPECT_EQ(ssRun_Execute(&def, &run), SS_OK) << scene << " " << profile << " " << policy << ": " << ssLastError();
-  if (run == nullptr) return out;
-  out.outcome = ssRun_Outcome(run);
-  out.message = ssRun_Message(run);
-  int count = ssRun_StepCount(run);
-  out.times.assign(ssRun_Times(run), ssRun_Times(run) + count);
-  for (int q = 0; q < ssSceneFind(scene)->quantity_count; ++q)
-    out.quantities.emplace_back(ssRun_Quantity(run, q), ssRun_Quantity(run, q) + count);
-  out.counters = ssRun_Counters(run);
-  ssRun_Destroy(run);
-  return out;
-}
-
 // The last record at or before t.
-size_t RecordAt(const Recorded& run, double t) {
+size_t RecordAt(const RecordedRun& run, double t) {
   auto after = std::upper_bound(run.times.begin(), run.times.end(), t + 1e-9);
   return after == run.times.begin() ? 0 : static_cast<size_t>(after - run.times.begin()) - 1;
 }
@@ -78,7 +46,7 @@ TEST(ProgramScenes, StackSleepsStandingOnItsSpringsSag) {
   const double top_z_m = height_m - 0.5 * sides_m[5] - sag_m;  // 2.2440 m
   for (const char* policy : kImplicitEulerPolicies) {
     for (const char* profile : kProfiles) {
-      Recorded run = Execute("stack", profile, policy, 8.0);
+      RecordedRun run = Record(LabRunDef("stack", profile, policy, 8.0));
       ASSERT_EQ(run.outcome, SS_RUN_COMPLETED) << policy << " " << profile << ": " << run.message;
       EXPECT_LT(run.quantities[2].back(), 1e-4) << policy << " " << profile << ": still moving";
       // 0.2 mm of the 6 mm of sag: QuickStep's 40 iterations leave the forces of a tower 200 times apart in mass
@@ -99,7 +67,7 @@ TEST(ProgramScenes, WallIsKnockedOverByTheBallWithHundredsOfContactsAStep) {
   const double x0_m = -3, z0_m = 1, vx_m_per_s = 12, vz_m_per_s = 1.5, h_s = 1.0 / 60;
   const double g = 9.81;
   for (const char* policy : {"implicit-euler", "matched", "exact"}) {
-    Recorded run = Execute("wall", "fixed:60", policy, 2.0);
+    RecordedRun run = Record(LabRunDef("wall", "fixed:60", policy, 2.0));
     ASSERT_EQ(run.outcome, SS_RUN_COMPLETED) << policy << ": " << run.message;
     const double ball_reaches_wall_s = (-0.2 - 0.25 - x0_m) / vx_m_per_s;  // the wall's face, less the radius
     for (size_t i = 0; run.times[i] < ball_reaches_wall_s - h_s; ++i) {
@@ -133,7 +101,7 @@ TEST(ProgramScenes, PistonRamIsHeldAtEachStopByTheMotor) {
   const double held_m = stop_m + force_n / params.spring.stiffness;
   for (const char* policy : kImplicitEulerPolicies) {
     for (const char* profile : kProfiles) {
-      Recorded run = Execute("piston", profile, policy, 4.0);
+      RecordedRun run = Record(LabRunDef("piston", profile, policy, 4.0));
       ASSERT_EQ(run.outcome, SS_RUN_COMPLETED) << policy << " " << profile << ": " << run.message;
       // Just before each reversal; 0.1 mm: the arm, still swinging, pushes the ram by a fraction of a newton.
       EXPECT_NEAR(run.quantities[0][RecordAt(run, 0.95)], held_m, 1e-4) << policy << " " << profile;
