@@ -59,7 +59,8 @@ inline RecordedRun Record(const ssRunDef& def) {
   int count = ssRun_StepCount(run);
   out.times.assign(ssRun_Times(run), ssRun_Times(run) + count);
   int quantities = ssSceneFind(def.scene)->quantity_count;
-  for (int q = 0; q < quantities; ++q) out.quantities.emplace_back(ssRun_Quantity(run, q), ssRun_Quantity(run, q) + count);
+  for (int q = 0; q < quantities; ++q)
+    out.quantities.emplace_back(ssRun_Quantity(run, q), ssRun_Quantity(run, q) + count);
   out.initial.assign(ssRun_Initial(run), ssRun_Initial(run) + quantities);
   out.counters = ssRun_Counters(run);
   ssRun_Destroy(run);
