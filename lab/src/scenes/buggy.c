@@ -49,7 +49,7 @@ typedef struct Buggy {
   ssContactRecipe recipe;
 } Buggy;
 
-static dBodyID make_wheel(const ssSceneWorld* world, double x, double y, double z) {
+static dBodyID makeWheel(const ssSceneWorld* world, double x, double y, double z) {
   dBodyID wheel = dBodyCreate(world->world);
   dMass mass;
   dMassSetSphereTotal(&mass, BUGGY_WHEEL_MASS_KG, BUGGY_WHEEL_RADIUS_M);
@@ -60,7 +60,7 @@ static dBodyID make_wheel(const ssSceneWorld* world, double x, double y, double 
   return wheel;
 }
 
-static ssStatus attach_wheel(const ssSceneWorld* world, const ssSceneParams* params, dBodyID chassis,
+static ssStatus attachWheel(const ssSceneWorld* world, const ssSceneParams* params, dBodyID chassis,
                              dBodyID wheel, dJointID* out) {
   const dReal* at = dBodyGetPosition(wheel);
   dJointID joint = dJointCreateHinge2(world->world, 0);
@@ -106,8 +106,8 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
   /* Wheels start touching the ground; the suspension then settles under the car's weight. */
   for (int i = 0; status == SS_OK && i < 4; ++i) {
     double x = (i < 2 ? 1 : -1) * BUGGY_AXLE_X_M, y = (i % 2 == 0 ? 1 : -1) * BUGGY_TRACK_Y_M;
-    buggy->wheels[i] = make_wheel(world, x, y, BUGGY_WHEEL_RADIUS_M);
-    status = attach_wheel(world, params, buggy->chassis, buggy->wheels[i], &buggy->hinges[i]);
+    buggy->wheels[i] = makeWheel(world, x, y, BUGGY_WHEEL_RADIUS_M);
+    status = attachWheel(world, params, buggy->chassis, buggy->wheels[i], &buggy->hinges[i]);
   }
   if (status != SS_OK) {
     free(buggy);
