@@ -384,7 +384,7 @@ void ssProfile_Reset(ssProfile* profile) {
     ssFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to reset");
     return;
   }
-  ssRng_Seed(&profile->rng, profile->seed);
+  ssRngSeed(&profile->rng, profile->seed);
   profile->frame_index = 0;
   profile->on_b = 0;
 }
@@ -410,11 +410,11 @@ double ssProfile_Next(ssProfile* p) {
     case SS_PROFILE_FIXED:
       return p->a_s;
     case SS_PROFILE_UNIFORM:
-      return clamp(p->a_s + (p->b_s - p->a_s) * ssRng_Uniform(&p->rng), p->a_s, p->b_s);
+      return clamp(p->a_s + (p->b_s - p->a_s) * ssRngUniform(&p->rng), p->a_s, p->b_s);
     case SS_PROFILE_JITTER: {
       /* Redrawing outside three deviations keeps the distribution symmetric, so the mean stays 1/FPS. */
       double z;
-      do z = ssRng_Normal(&p->rng);
+      do z = ssRngNormal(&p->rng);
       while (fabs(z) > 3.0);
       return clamp(p->a_s + p->b_s * z, p->a_s - 3.0 * p->b_s, p->a_s + 3.0 * p->b_s);
     }
@@ -422,7 +422,7 @@ double ssProfile_Next(ssProfile* p) {
       return (index + 1) % p->every == 0 ? p->b_s : p->a_s;
     case SS_PROFILE_VSYNC:
       /* The first frame runs at rate A; every later one switches with probability 1/10. */
-      if (index > 0 && ssRng_Uniform(&p->rng) < 0.1) p->on_b = !p->on_b;
+      if (index > 0 && ssRngUniform(&p->rng) < 0.1) p->on_b = !p->on_b;
       return p->on_b ? p->b_s : p->a_s;
     case SS_PROFILE_TRACE:
       return p->trace_s[index % p->trace_count];
@@ -430,7 +430,7 @@ double ssProfile_Next(ssProfile* p) {
   return p->a_s;
 }
 
-double ssProfile_MeanFrame(const ssProfile* p) {
+double ssProfileMeanFrame(const ssProfile* p) {
   switch (p->kind) {
     case SS_PROFILE_FIXED:
     case SS_PROFILE_JITTER:

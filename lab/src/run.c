@@ -136,7 +136,7 @@ static double expectedSteps(const ssStepping* stepping, double duration_s, doubl
 
 /* Refuses, before anything runs, a run that would take more frames or steps than limits.h allows. */
 static ssStatus checkSize(const ssRunDef* def, const ssProfile* profile) {
-  double mean_frame_s = ssProfile_MeanFrame(profile);
+  double mean_frame_s = ssProfileMeanFrame(profile);
   double frames = def->duration_s / mean_frame_s;
   if (frames > SS_MAX_RUN_FRAMES)
     return ssFail(SS_ERROR_OUT_OF_RANGE,
@@ -178,7 +178,7 @@ ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
   if (status == SS_OK) {
     run->quantity_count = info->quantity_count;
     ssScene_Sample(scene, run->initial);
-    ssScene_SetStepObserver(scene, record, run);
+    ssSceneSetStepObserver(scene, record, run);
     status = play(run, scene, profile, def->duration_s);
     run->counters = ssScene_Counters(scene);
   }

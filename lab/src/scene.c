@@ -33,7 +33,7 @@ struct ssScene {
   void* state;
   double time_s;
   unsigned long ode_random_seed; /* this scene's state of ODE's one global generator */
-  ssSceneStepFn* observer;
+  ssSceneStepCallback* observer;
   void* observer_context;
   double bound_use;    /* the largest value/bound ratio of the sanity bounds so far */
   int broken;          /* a step has left a sanity bound: broken_message says which */
@@ -377,7 +377,7 @@ double ssScene_Time(const ssScene* scene) {
   return scene->time_s;
 }
 
-void ssScene_SetStepObserver(ssScene* scene, ssSceneStepFn* observer, void* context) {
+void ssSceneSetStepObserver(ssScene* scene, ssSceneStepCallback* observer, void* context) {
   scene->observer = observer;
   scene->observer_context = context;
 }
