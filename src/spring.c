@@ -40,8 +40,8 @@ static ssStatus implicitEulerSoftness(ssSpring spring, double step_s, ssSoftness
   return SS_OK;
 }
 
-ssStatus ssSoftnessFromSpring(ssSpring spring, double step_s, ssSoftness* out) {
-  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: ssSoftnessFromSpring needs somewhere to write");
+ssStatus ssImplicitEulerSoftness(ssSpring spring, double step_s, ssSoftness* out) {
+  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: ssImplicitEulerSoftness needs somewhere to write");
   return implicitEulerSoftness(spring, step_s, out);
 }
 
@@ -149,7 +149,7 @@ ssStatus ssSoftnessFor(ssMapping mapping, ssSpring spring, double mass, double s
                        ssSoftness* out) {
   if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: ssSoftnessFor needs somewhere to write");
   switch (mapping) {
-    case SS_MAPPING_IMPLICIT_EULER: return ssSoftnessFromSpring(spring, step_s, out);
+    case SS_MAPPING_IMPLICIT_EULER: return ssImplicitEulerSoftness(spring, step_s, out);
     case SS_MAPPING_MATCHED: return ssMatchedSoftness(spring, mass, step_s, out);
     case SS_MAPPING_EXACT: return ssExactSoftness(spring, mass, step_s, previous_step_s, out);
   }

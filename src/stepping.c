@@ -91,9 +91,9 @@ static const Policy policies[] = {
 };
 enum { POLICY_COUNT = sizeof policies / sizeof policies[0] };
 
-int ssPolicyCount(void) { return POLICY_COUNT; }
+int ssSteppingPolicyCount(void) { return POLICY_COUNT; }
 
-const char* ssPolicyNameAt(int index) { return index >= 0 && index < POLICY_COUNT ? policies[index].name : NULL; }
+const char* ssSteppingPolicyNameAt(int index) { return index >= 0 && index < POLICY_COUNT ? policies[index].name : NULL; }
 
 ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssStepping* stepping) {
   if (stepping == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping = NULL: needs somewhere to write the policy");

@@ -84,10 +84,10 @@ SS_API const char* ssFrameCutName(ssFrameCut cut);
  *    fixed           fixed steps, implicit Euler
  *    fixed-matched   fixed steps, matched
  *    fixed-exact     fixed steps, exact */
-SS_API int ssPolicyCount(void);
+SS_API int ssSteppingPolicyCount(void);
 
-/** The name of policy index (0 <= index < ssPolicyCount()), or NULL. */
-SS_API const char* ssPolicyNameAt(int index);
+/** The name of policy index (0 <= index < ssSteppingPolicyCount()), or NULL. */
+SS_API const char* ssSteppingPolicyNameAt(int index);
 
 /** Sets stepping's cut, mapping and frozen step to the policy's (the other fields are kept). reference_step_s (s,
  *  in the step range) is the length naive and substeps-frozen freeze their softness at, e.g. the step a program was tuned for.

@@ -331,7 +331,7 @@ TEST(Scenes, BlowUpEndsTheRunAndIsRecorded) {
 // spread is the RMS over frame-time profiles of each run's RMS deviation from it, relative to its amplitude.
 // Policy naive breaks the chain and the drop under some of these profiles (test_bounds.cpp): a broken run is
 // measured over the records it has, up to the step that broke, which can only flatter naive.
-TEST(Scenes, SpringPolicySpreadIsAtMostHalfOfNaive) {
+TEST(Scenes, ImplicitEulerSpreadIsAtMostHalfOfNaive) {
   const char* const profiles[] = {"fixed:30", "uniform:15:45", "jitter:30:3", "hitch:60:30:0.1", "vsync:60:30"};
   for (const char* scene : {"oscillator", "buggy", "drop", "chain"}) {
     ssRunDef reference_def = Def(scene, "fixed:1000", 3.0);

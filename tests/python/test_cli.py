@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from steadystep.convert import softness_from_spring, spring_from_frequency, spring_from_softness
+from steadystep.convert import implicit_euler_softness, spring_from_frequency, spring_from_softness
 
 SCRIPT = Path(sys.executable).parent / "steadystep"
 COMMAND = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "steadystep.cli"]
@@ -161,7 +161,7 @@ def test_probe_prints_each_policy():
 
 def test_convert_all_three_ways_equal_the_package():
     result = steadystep("convert", "--k", "40", "--c", "1", "--dt", "0.02", "--json")
-    assert json.loads(result.stdout) == softness_from_spring((40, 1), 0.02)._asdict()
+    assert json.loads(result.stdout) == implicit_euler_softness((40, 1), 0.02)._asdict()
     result = steadystep("convert", "--erp", "0.2", "--cfm", "1e-5", "--dt", "0.01", "--json")
     assert json.loads(result.stdout) == spring_from_softness((0.2, 1e-5), 0.01)._asdict()
     result = steadystep("convert", "--frequency", "2", "--damping-ratio", "0.3", "--mass", "1.5")

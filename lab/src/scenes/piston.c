@@ -52,7 +52,7 @@ static void destroy(void* state) { free(state); }
 
 static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, void** state) {
   ssSoftness stop;
-  ssStatus status = ssSoftnessFromSpring(params->spring, SS_PROGRAM_TUNED_STEP_S, &stop);
+  ssStatus status = ssImplicitEulerSoftness(params->spring, SS_PROGRAM_TUNED_STEP_S, &stop);
   if (status != SS_OK) return status;
   Piston* piston = calloc(1, sizeof *piston);
   if (piston == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "piston: out of memory");

@@ -75,7 +75,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
   /* What the program tuned at 60 fps: the contacts' spring as world ERP (which contacts without a soft ERP use)
    * and the contacts' soft CFM. */
   ssSoftness tuned;
-  ssStatus status = ssSoftnessFromSpring(params->spring, SS_PROGRAM_TUNED_STEP_S, &tuned);
+  ssStatus status = ssImplicitEulerSoftness(params->spring, SS_PROGRAM_TUNED_STEP_S, &tuned);
   if (status != SS_OK) {
     destroy(stack);
     *state = NULL;

@@ -97,7 +97,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
   *wall = (Wall){.count = params->body_count, .bricks = bricks, .starts = starts, .gravity = params->gravity};
   *state = wall;
   ssSoftness tuned;
-  ssStatus status = ssSoftnessFromSpring(params->spring, SS_PROGRAM_TUNED_STEP_S, &tuned);
+  ssStatus status = ssImplicitEulerSoftness(params->spring, SS_PROGRAM_TUNED_STEP_S, &tuned);
   if (status != SS_OK) {
     destroy(wall);
     *state = NULL;
