@@ -2,7 +2,7 @@
  *
  * Parsing is strict on purpose: a profile that silently read "fixed:3O" as 3 fps would make a whole report wrong,
  * so every field must be one complete number and every refusal names the spec and the field. Every frame handed
- * out lies in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S] (limits.h): the spec is refused when its frames could leave it.
+ * out lies in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S] (profile.h): the spec is refused when its frames could leave it.
  * Specs, paths and trace lines are quoted in messages with every byte outside printable ASCII written as \xNN, so
  * a message is ASCII whatever bytes came in (Python decodes it as text). */
 #include "steadystep/lab/profile.h"
@@ -20,7 +20,6 @@
 #include "error.h"
 #include "profile_internal.h"
 #include "rng.h"
-#include "steadystep/limits.h"
 
 typedef enum ssProfileKind {
   SS_PROFILE_FIXED,

@@ -5,7 +5,7 @@
  * The state before the first step is kept apart (initial), so that records and steps stay one to one. The last frame
  * is shortened so that every run ends at duration_s of frame time exactly. A run ends early at the first step that
  * blows up (the stepper's error) or leaves one of the scene's sanity bounds (broken: that step is recorded, the ones
- * after it in its frame are not). A run is bounded (limits.h): its duration, the frames it is expected to take
+ * after it in its frame are not). A run is bounded (scene.h): its duration, the frames it is expected to take
  * (refused before it starts) and the frames and steps it does take (stopped with an error when an unlucky random
  * profile reaches them). */
 #include <math.h>
@@ -17,7 +17,6 @@
 #include "error.h"
 #include "profile_internal.h"
 #include "scene_internal.h"
-#include "steadystep/limits.h"
 #include "steadystep/lab/profile.h"
 #include "steadystep/stepper.h"
 
@@ -134,7 +133,7 @@ static double expectedSteps(const ssStepping* stepping, double duration_s, doubl
   return frames * fmax(ceil(mean_frame_s / stepping->max_step_s), 1.0);
 }
 
-/* Refuses, before anything runs, a run that would take more frames or steps than limits.h allows. */
+/* Refuses, before anything runs, a run that would take more frames or steps than scene.h allows. */
 static ssStatus checkSize(const ssRunDef* def, const ssProfile* profile) {
   double mean_frame_s = ssProfileMeanFrame(profile);
   double frames = def->duration_s / mean_frame_s;

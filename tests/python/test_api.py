@@ -75,7 +75,7 @@ def test_the_stepping_defaults_and_presets_are_the_librarys():
 
 def test_the_run_bound_is_the_c_librarys():
     from steadystep.limits import MAX_RUN_FRAMES, MAX_RUN_STEPS
-    header = (Path(ss.__file__).parent / "_native" / "include" / "steadystep" / "limits.h").read_text()
+    header = (Path(ss.__file__).parent / "_native" / "include" / "steadystep" / "lab" / "scene.h").read_text()
     assert f"#define SS_MAX_RUN_STEPS {MAX_RUN_STEPS}\n" in header
     assert f"#define SS_MAX_RUN_FRAMES {MAX_RUN_FRAMES}\n" in header
 

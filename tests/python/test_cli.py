@@ -221,10 +221,12 @@ def test_version_is_the_one_in_cmakelists():
     assert result.stdout.strip() == f"steadystep {version}"
 
 
-def test_the_old_policy_name_spring_is_refused_naming_its_new_name():
-    result = steadystep("run", "oscillator", "--policy", "spring", "--profile", "fixed:30", "--duration", "1")
+def test_an_unknown_policy_is_refused_naming_the_known_ones():
+    from steadystep.runs import policy_names
+    result = steadystep("run", "oscillator", "--policy", "smooth", "--profile", "fixed:30", "--duration", "1")
     assert result.returncode == 2 and result.stdout == ""
-    assert '"spring" is now called implicit-euler' in result.stderr and "Traceback" not in result.stderr
+    assert f'policy "smooth": unknown ({", ".join(policy_names())})' in result.stderr
+    assert "Traceback" not in result.stderr
 
 
 def test_the_help_lists_are_the_librarys():
