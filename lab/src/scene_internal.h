@@ -119,8 +119,6 @@ typedef struct ssBoxes {
   ssContactRecipe recipe;
 } ssBoxes;
 
-/* The sanity bound of a scene of boxes on the floor (scene.h): the largest ratio of a box's lowest corner below the
- * floor to the bound, of_half_side times the box's half side; writes the deepest box into worst. */
 /* A check's line into worst (printf format), or nothing when worst is NULL. */
 void ssBoundMessage(char* worst, size_t size, const char* format, ...)
 #if defined(__GNUC__)
@@ -128,6 +126,8 @@ void ssBoundMessage(char* worst, size_t size, const char* format, ...)
 #endif
     ;
 
+/* The sanity bound of a scene of boxes on the floor (scene.h): the largest ratio of a box's lowest corner below the
+ * floor to the bound, of_half_side times the box's half side; writes the deepest box into worst. */
 double ssBoxesCheck(const ssBoxes* boxes, double side_m, double of_half_side, char* worst, size_t size);
 /* How far the lowest corner of a box of side_m (m) is below z = 0 (m; negative when above). */
 double ssBoxDepth(dBodyID box, double side_m);

@@ -1,6 +1,6 @@
 // Scenes and runs on real ODE: every scene runs, every bad input is refused by name, runs are reproducible, the
 // oscillator under the article's mapping follows implicit Euler step by step, and the article's claim holds in
-// every scene with soft constraints: the spring policy stays much closer to the fine-step reference across frame
+// every scene with soft constraints: the implicit-euler policy stays much closer to the fine-step reference across frame
 // time profiles than fixed ERP/CFM (naive) does.
 #include <gtest/gtest.h>
 
@@ -422,7 +422,7 @@ TEST(Scenes, ValuesOutsideOdesRangeAreRefusedByName) {
   EXPECT_GT(run.frames, 0);  // stepped (here the speed limit stops it at once): ODE did not abort
 }
 
-// Runs have a bound (limits.h): one that would never end, or grow without limit, is refused before it starts.
+// Runs have a bound (scene.h): one that would never end, or grow without limit, is refused before it starts.
 TEST(Scenes, RunsAboveTheirBoundsAreRefusedNamingTheValue) {
   ssRunDef def = Def("oscillator", "fixed:60", 1e9);
   ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, "duration_s = 1e+09");

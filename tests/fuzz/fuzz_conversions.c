@@ -44,7 +44,7 @@ static void require_valid_spring(ssSpring spring, const char* what) {
 #define SS_MAX_CFM 1e20
 #endif
 
-/* A softness returned OK: finite, cfm in (0, SS_MAX_CFM], |erp| <= SS_MAX_ERP; the spring mapping's erp in [0, 1]. */
+/* A softness returned OK: finite, cfm in (0, SS_MAX_CFM], |erp| <= SS_MAX_ERP; implicit Euler's erp in [0, 1]. */
 static void require_valid_softness(ssSoftness softness, const char* what, ssSpring spring, double mass, double h,
                                    double previous, int spring_mapping) {
   FUZZ_REQUIRE(isfinite(softness.erp) && fabs(softness.erp) <= SS_MAX_ERP && isfinite(softness.cfm) &&

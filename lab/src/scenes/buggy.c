@@ -3,8 +3,8 @@
  * Each wheel hangs on a hinge-2 joint: axis 1 vertical (steering, and the suspension slides along it), axis 2 the
  * wheel's spin axis, driven by a motor. Steering is locked with lo = hi = 0 stops on axis 1. Every soft thing is
  * bound: the suspension to the scene's spring, the ground contacts to a stiff spring, and the world's ERP/CFM
- * (the hinge-2 rigid rows) to a stiff spring too, so that policy naive freezes all of them and policy spring maps
- * all of them; nothing is left with a fixed ERP/CFM that would blur the comparison. */
+ * (the hinge-2 rigid rows) to a stiff spring too, so that policy naive freezes all of them and policy implicit-euler
+ * maps all of them; nothing is left with a fixed ERP/CFM that would blur the comparison. */
 #include <math.h>
 #include <stdlib.h>
 
