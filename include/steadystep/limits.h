@@ -1,5 +1,5 @@
-/* steadystep: the ranges of values the library hands to ODE. (The lab's bounds on its profiles and runs are the
- * lab's: lab/include/steadystep/lab/profile.h and scene.h.)
+/* steadystep: the ranges of values the library hands to ODE. (The lab's bounds on its profiles and runs are in
+ * lab/include/steadystep/lab/profile.h and scene.h.)
  *
  * ODE has no error return for a bad number. Debian's libode8 2:0.16.2 (double precision, built with its internal
  * checks on) aborts the process (SIGABRT in `dxNormalize4` or `dMassCheck`) when a value overflows inside a step;
