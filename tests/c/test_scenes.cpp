@@ -1,7 +1,7 @@
 // Scenes and runs on real ODE: every scene runs, every bad input is refused by name, runs are reproducible, the
 // oscillator under the article's mapping follows implicit Euler step by step, and the article's claim holds in
-// every scene with soft constraints: the implicit-euler policy stays much closer to the fine-step reference across frame
-// time profiles than fixed ERP/CFM (naive) does.
+// every scene with soft constraints: the implicit-euler policy stays much closer to the fine-step reference across
+// frame time profiles than fixed ERP/CFM (naive) does.
 #include <gtest/gtest.h>
 
 #include <algorithm>

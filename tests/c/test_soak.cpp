@@ -168,7 +168,8 @@ std::string PairName(const ::testing::TestParamInfo<Soak::ParamType>& info) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryScenePolicy, Soak,
-                         ::testing::Combine(::testing::Range(0, ssSceneCount()), ::testing::Range(0, ssSteppingPolicyCount())),
+                         ::testing::Combine(::testing::Range(0, ssSceneCount()),
+                                            ::testing::Range(0, ssSteppingPolicyCount())),
                          PairName);
 
 }  // namespace

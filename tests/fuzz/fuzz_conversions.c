@@ -76,8 +76,8 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   switch (which % 9) {
     case 0: {
       fill_canary(&softness, sizeof softness);
-      check_softness(ssImplicitEulerSoftness(spring, a, &softness), &softness, "ssImplicitEulerSoftness", spring, 0, a, 0,
-                     1);
+      check_softness(ssImplicitEulerSoftness(spring, a, &softness), &softness, "ssImplicitEulerSoftness", spring, 0,
+                     a, 0, 1);
       break;
     }
     case 1: {
