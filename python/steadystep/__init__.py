@@ -14,8 +14,8 @@ parses nothing (the cffi declarations were prepared from the headers when the pa
 """
 
 from steadystep._native import InvalidValue, SimulationFailure, SteadystepError
-from steadystep.convert import (Softness, Spring, exact_softness, frequency_from_spring, matched_softness,
-                                softness_for, implicit_euler_softness, spring_from_frequency, spring_from_softness)
+from steadystep.convert import (Softness, Spring, exact_softness, frequency_from_spring, implicit_euler_softness,
+                                matched_softness, softness_for, spring_from_frequency, spring_from_softness)
 from steadystep.enums import FrameCut, JointParam, Mapping, Solver, Status
 from steadystep.profiles import Profile, frame_times
 from steadystep.registry import (AdoptReport, ApplyReport, Registry, ServedCounts, contact_soften,
@@ -28,8 +28,8 @@ __all__ = [
     "AdoptReport", "ApplyReport", "FrameCut", "FrameReport", "InvalidValue", "JointParam", "Mapping", "Profile",
     "Registry", "ServedCounts", "SimulationFailure", "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper",
     "SteadystepError", "Stepping", "contact_soften",
-    "exact_softness", "frame_times", "frequency_from_spring", "grid", "joint_effective_mass", "joint_supports",
-    "make_executor", "matched_softness", "policy_names", "softness_for", "implicit_euler_softness",
+    "exact_softness", "frame_times", "frequency_from_spring", "grid", "implicit_euler_softness",
+    "joint_effective_mass", "joint_supports", "make_executor", "matched_softness", "policy_names", "softness_for",
     "spring_from_frequency", "spring_from_softness", "sweep",
 ]
 
