@@ -46,8 +46,8 @@ static Scene build(int with_stepper) {
   dWorldSetQuickStepNumIterations(scene.world, 20);
   scene.registry = ssRegistry_Create(scene.world);
   ssSoftness limit, friction;
-  check(ssSoftnessFromSpring(kLimit, kFrame_s, &limit), "limit");
-  check(ssSoftnessFromSpring(kFriction, kFrame_s, &friction), "friction");
+  check(ssImplicitEulerSoftness(kLimit, kFrame_s, &limit), "limit");
+  check(ssImplicitEulerSoftness(kFriction, kFrame_s, &friction), "friction");
   for (int chain = 0; chain < kChains; ++chain) {
     dBodyID previous = 0;
     for (int link = 0; link < kLinks; ++link) {

@@ -322,7 +322,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       if (!(fabs(correction) <= SS_MAX_FORCE_N)) {
         /* an accurate softness this far from the spring's static stiffness cannot carry the load: implicit Euler,
          * whose static stiffness is k itself, serves the row (as for every row an accurate mapping cannot) */
-        status = ssSoftnessFromSpring(*spring, step_s, &binding->pending);
+        status = ssImplicitEulerSoftness(*spring, step_s, &binding->pending);
         if (status != SS_OK) return failBinding(status, binding);
         /* counted once: moved from who was to serve it */
         if (binding->computed_fallback.exact_to_matched) counts->rows.handed_to_matched -= 1;
@@ -367,7 +367,7 @@ static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* s
   for (int j = 0; j < registry->law_count; ++j) {
     const ssRowLaw* law = &registry->laws[j];
     if (!law->hard && step_s != law->tuned_step_s) { /* at its tuned step, a law gives its tuned numbers back */
-      /* ssSoftnessFromSpring's arithmetic without its checks, which every bound law passed for every step length
+      /* ssImplicitEulerSoftness's arithmetic without its checks, which every bound law passed for every step length
        * (ssCheckLawForEveryStep at bind time): cfm within ODE's range is all that is left to see */
       double hk_plus_c = step_s * law->spring.stiffness + law->spring.damping;
       softness[j] = (ssSoftness){.erp = step_s * law->spring.stiffness / hk_plus_c, .cfm = 1.0 / hk_plus_c};

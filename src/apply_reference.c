@@ -58,7 +58,7 @@ static ssStatus computeRow(const ssJointRowBinding* row, ssMapping mapping, doub
       out->correction = correction;
     } else { /* no accurate softness that carries the load: implicit Euler, whose static stiffness is k */
       fallback = (ssRowFallback){0, 1};
-      status = ssSoftnessFromSpring(*spring, step_s, &out->softness);
+      status = ssImplicitEulerSoftness(*spring, step_s, &out->softness);
       if (status != SS_OK) return status;
     }
   }

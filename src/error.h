@@ -8,7 +8,7 @@
  * `if (bad) return ssFail(SS_ERROR_OUT_OF_RANGE, "k = %g N/m: must not be negative", k);` */
 ssStatus ssFail(ssStatus status, const char* format, ...) __attribute__((format(printf, 2, 3)));
 
-/* Checks that value is finite and, unless allow_zero / allow_negative, positive; names it in the message. */
+/* Check that value is finite and positive, finite and >= 0, or finite; the message names it (name = value unit). */
 ssStatus ssCheckPositive(const char* name, const char* unit, double value);
 ssStatus ssCheckNonNegative(const char* name, const char* unit, double value);
 ssStatus ssCheckFinite(const char* name, const char* unit, double value);

@@ -59,7 +59,7 @@ static ssStatus make(ssPoseHistory** out) {
   return SS_OK;
 }
 
-ssStatus ssPoseHistory_BeginFrame(ssPoseHistory** out, const dBodyID* bodies, int count) {
+ssStatus ssPoseHistoryBeginFrame(ssPoseHistory** out, const dBodyID* bodies, int count) {
   ssStatus status = make(out);
   if (status != SS_OK) return status;
   ssPoseHistory* history = *out;
@@ -98,12 +98,12 @@ ssStatus ssPoseHistory_BeginFrame(ssPoseHistory** out, const dBodyID* bodies, in
   return SS_OK;
 }
 
-void ssPoseHistory_BeforeLastStep(ssPoseHistory* history) {
+void ssPoseHistoryBeforeLastStep(ssPoseHistory* history) {
   if (history == NULL || history->off) return;
   for (int i = 0; i < history->count; ++i) poseNow(history->bodies[i].body, &history->bodies[i].previous);
 }
 
-void ssPoseHistory_EndFrame(ssPoseHistory* history, int steps, double interpolation) {
+void ssPoseHistoryEndFrame(ssPoseHistory* history, int steps, double interpolation) {
   if (history == NULL || history->off) return;
   history->interpolation = interpolation;
   if (steps > 0) {
@@ -122,7 +122,7 @@ void ssPoseHistory_EndFrame(ssPoseHistory* history, int steps, double interpolat
   }
 }
 
-void ssPoseHistory_ForgetBody(ssPoseHistory* history, dBodyID body) {
+void ssPoseHistoryForgetBody(ssPoseHistory* history, dBodyID body) {
   if (history == NULL || history->count == 0) return;
   History* found = bsearch(body, history->bodies, (size_t)history->count, sizeof *history->bodies, compareBody);
   if (found == NULL) return;
@@ -132,11 +132,11 @@ void ssPoseHistory_ForgetBody(ssPoseHistory* history, dBodyID body) {
   history->count -= 1;
 }
 
-void ssPoseHistory_Forget(ssPoseHistory* history) {
+void ssPoseHistoryForget(ssPoseHistory* history) {
   if (history != NULL) history->restart = 1;
 }
 
-void ssPoseHistory_Destroy(ssPoseHistory* history) {
+void ssPoseHistoryDestroy(ssPoseHistory* history) {
   if (history == NULL) return;
   free(history->bodies);
   free(history->ids);
@@ -165,7 +165,7 @@ void ssSlerp(const double from[4], const double to[4], double a, double out[4]) 
   for (int i = 0; i < 4; ++i) out[i] /= norm;
 }
 
-ssStatus ssPoseHistory_Pose(const ssPoseHistory* history, dBodyID body, double position[3], double quaternion[4]) {
+ssStatus ssPoseHistoryPose(const ssPoseHistory* history, dBodyID body, double position[3], double quaternion[4]) {
   const History* h = history != NULL && history->count > 0
                          ? bsearch(body, history->bodies, (size_t)history->count, sizeof *history->bodies,
                                    compareBody)
@@ -195,7 +195,7 @@ ssStatus ssStepper_InterpolatedPose(const ssStepper* stepper, dBodyID body, doub
     memcpy(quaternion, now.quaternion, sizeof now.quaternion);
     return SS_OK;
   }
-  return ssPoseHistory_Pose(history, body, position, quaternion);
+  return ssPoseHistoryPose(history, body, position, quaternion);
 }
 
 ssStatus ssStepper_SetInterpolation(ssStepper* stepper, int on) {

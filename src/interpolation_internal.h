@@ -13,25 +13,25 @@ typedef struct ssPoseHistory ssPoseHistory;
 
 /** Before a fixed frame: follows the known bodies (bodies: sorted by address, count of them; *history made on the
  *  first call), a body new to it starting from its pose now. Errors: SS_ERROR_OUT_OF_MEMORY, *history kept. */
-ssStatus ssPoseHistory_BeginFrame(ssPoseHistory** history, const dBodyID* bodies, int count);
+ssStatus ssPoseHistoryBeginFrame(ssPoseHistory** history, const dBodyID* bodies, int count);
 
 /** Just before the frame's last physics step: every body's pose now is its previous state. */
-void ssPoseHistory_BeforeLastStep(ssPoseHistory* history);
+void ssPoseHistoryBeforeLastStep(ssPoseHistory* history);
 
 /** After the frame: steps > 0, every body's pose now is its current state; steps = 0, a body whose pose is not its
  *  current state (the program set it between frames) starts again from there. interpolation: the frame's factor. */
-void ssPoseHistory_EndFrame(ssPoseHistory* history, int steps, double interpolation);
+void ssPoseHistoryEndFrame(ssPoseHistory* history, int steps, double interpolation);
 
 /** A body the stepper destroys (ssStepper_DestroyBody, from a callback too): never read again. */
-void ssPoseHistory_ForgetBody(ssPoseHistory* history, dBodyID body);
+void ssPoseHistoryForgetBody(ssPoseHistory* history, dBodyID body);
 
 /** Every body starts again from its pose at the next frame (ssStepper_Reset, ssStepper_SetStepping). */
-void ssPoseHistory_Forget(ssPoseHistory* history);
+void ssPoseHistoryForget(ssPoseHistory* history);
 
 /** The blended pose of body (interpolation.h); SS_ERROR_NOT_FOUND when the history does not hold it. */
-ssStatus ssPoseHistory_Pose(const ssPoseHistory* history, dBodyID body, double position[3], double quaternion[4]);
+ssStatus ssPoseHistoryPose(const ssPoseHistory* history, dBodyID body, double position[3], double quaternion[4]);
 
-void ssPoseHistory_Destroy(ssPoseHistory* history);
+void ssPoseHistoryDestroy(ssPoseHistory* history);
 
 /** stepper.c: where the stepper keeps its history (NULL until its first fixed frame or SetInterpolation). */
 ssPoseHistory** ssStepperPoseSlot(ssStepper* stepper);

@@ -5,7 +5,7 @@
 
 #include "error.h"
 
-static ssStatus check_range(const char* name, const char* unit, double value, double low, double high) {
+static ssStatus checkRange(const char* name, const char* unit, double value, double low, double high) {
   if (!isfinite(value)) return ssFail(SS_ERROR_NOT_FINITE, "%s = %g%s: must be finite", name, value, unit);
   if (!(value >= low && value <= high))
     return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = %g%s: must be in [%g, %g]%s for ODE", name, value, unit, low, high,
@@ -14,7 +14,7 @@ static ssStatus check_range(const char* name, const char* unit, double value, do
 }
 
 ssStatus ssCheckStepLength(const char* name, double step_s) {
-  return check_range(name, " s", step_s, SS_MIN_STEP_S, SS_MAX_STEP_S);
+  return checkRange(name, " s", step_s, SS_MIN_STEP_S, SS_MAX_STEP_S);
 }
 
 ssStatus ssCheckSoftnessForOde(const char* name, double erp, double cfm) {
@@ -38,5 +38,5 @@ ssStatus ssCheckComputedSoftness(const char* name, ssSoftness softness) {
 }
 
 ssStatus ssCheckMass(const char* name, double mass_kg) {
-  return check_range(name, " kg", mass_kg, SS_MIN_MASS_KG, SS_MAX_MASS_KG);
+  return checkRange(name, " kg", mass_kg, SS_MIN_MASS_KG, SS_MAX_MASS_KG);
 }

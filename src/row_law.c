@@ -62,7 +62,7 @@ static ssStatus implicitEuler(const ssRowLaw* law, double step_s, ssSoftness* ou
     *out = (ssSoftness){.erp = isinf(rate_h) ? 1.0 : rate_h / (rate_h + 1.0), .cfm = 0};
     return SS_OK;
   }
-  return ssSoftnessFromSpring(law->spring, step_s, out);
+  return ssImplicitEulerSoftness(law->spring, step_s, out);
 }
 
 /* When an accurate mapping may serve a row: the rule that keeps matched and exact from losing to implicit Euler.

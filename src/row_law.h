@@ -49,7 +49,7 @@ ssStatus ssCheckLawForEveryStep(const char* what, const ssRowLaw* law);
  * fallback->to_implicit_euler says so: no mass, c = 0, natural frequency above the step's Nyquist frequency, no
  * finite softness, or (the rule of ssKeepsStaticResponse) a static response so far from the law's that an
  * undeclared load would rest elsewhere than under the spring. fallback may be NULL. Errors: those of
- * ssSoftnessFromSpring. */
+ * ssImplicitEulerSoftness. */
 ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,
                        int load_declared, ssRowFallback* fallback, ssSoftness* out);
 

@@ -21,7 +21,7 @@ ssStatus ssValidateSpring(ssSpring spring) {
 }
 
 /* The article's mapping without touching *out: every conversion checks its result before it writes. */
-static ssStatus softness_from_spring(ssSpring spring, double step_s, ssSoftness* result) {
+static ssStatus implicitEulerSoftness(ssSpring spring, double step_s, ssSoftness* result) {
   ssStatus status = ssValidateSpring(spring);
   if (status == SS_OK) status = ssCheckStepLength("step_s", step_s);
   if (status != SS_OK) return status;
@@ -40,9 +40,9 @@ static ssStatus softness_from_spring(ssSpring spring, double step_s, ssSoftness*
   return SS_OK;
 }
 
-ssStatus ssSoftnessFromSpring(ssSpring spring, double step_s, ssSoftness* out) {
-  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: ssSoftnessFromSpring needs somewhere to write");
-  return softness_from_spring(spring, step_s, out);
+ssStatus ssImplicitEulerSoftness(ssSpring spring, double step_s, ssSoftness* out) {
+  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: ssImplicitEulerSoftness needs somewhere to write");
+  return implicitEulerSoftness(spring, step_s, out);
 }
 
 ssStatus ssSpringFromSoftness(ssSoftness softness, double step_s, ssSpring* out) {
@@ -63,7 +63,7 @@ ssStatus ssSpringFromSoftness(ssSoftness softness, double step_s, ssSpring* out)
    * softness at this step is a result. */
   ssSoftness back;
   if (!(isfinite(spring.stiffness) && isfinite(spring.damping)) || ssValidateSpring(spring) != SS_OK ||
-      softness_from_spring(spring, step_s, &back) != SS_OK)
+      implicitEulerSoftness(spring, step_s, &back) != SS_OK)
     return ssFail(SS_ERROR_NO_FINITE_MAPPING,
                   "erp = %g, cfm = %g at step_s = %g s: the spring (k = %g N/m, c = %g N*s/m) is not representable",
                   softness.erp, softness.cfm, step_s, spring.stiffness, spring.damping);
@@ -75,7 +75,7 @@ ssStatus ssSpringFromSoftness(ssSoftness softness, double step_s, ssSpring* out)
  * does, so they are formed in long double (x86-64: 15-bit exponent) and rounded once. A result counts only when
  * every number is 0 or normal (a subnormal has lost its digits) and it converts back: a round trip at the edge of
  * the double range can round into a subnormal, and then neither direction answers. */
-static int spring_from_frequency(double frequency_hz, double damping_ratio, double mass, ssSpring* spring) {
+static int springFromFrequency(double frequency_hz, double damping_ratio, double mass, ssSpring* spring) {
   long double omega = 2.0L * 3.14159265358979323846264338327950288L * frequency_hz;
   double k = (double)((long double)mass * omega * omega);
   double c = (double)(2.0L * damping_ratio * mass * omega);
@@ -85,7 +85,7 @@ static int spring_from_frequency(double frequency_hz, double damping_ratio, doub
   return 1;
 }
 
-static int frequency_from_spring(ssSpring spring, double mass, double* frequency_hz, double* damping_ratio) {
+static int frequencyFromSpring(ssSpring spring, double mass, double* frequency_hz, double* damping_ratio) {
   if (!isnormal(spring.stiffness) || !isnormal(mass) || (spring.damping != 0 && !isnormal(spring.damping))) return 0;
   long double omega = sqrtl((long double)spring.stiffness / mass);
   double hz = (double)(omega / (2.0L * 3.14159265358979323846264338327950288L));
@@ -104,8 +104,8 @@ ssStatus ssSpringFromFrequency(double frequency_hz, double damping_ratio, double
   if (status != SS_OK) return status;
   ssSpring spring;
   double hz_back, ratio_back;
-  if (!spring_from_frequency(frequency_hz, damping_ratio, mass, &spring) ||
-      !frequency_from_spring(spring, mass, &hz_back, &ratio_back))
+  if (!springFromFrequency(frequency_hz, damping_ratio, mass, &spring) ||
+      !frequencyFromSpring(spring, mass, &hz_back, &ratio_back))
     return ssFail(SS_ERROR_NO_FINITE_MAPPING,
                   "frequency_hz = %g Hz, damping_ratio = %g, mass = %g kg: k = m*w^2 or c = 2*zeta*m*w is not "
                   "representable as a normal double",
@@ -126,7 +126,7 @@ ssStatus ssFrequencyFromSpring(ssSpring spring, double mass, double* frequency_h
                   "k = 0 N/m: a pure damper has no natural frequency (its damping ratio would be infinite)");
   double hz, ratio;
   ssSpring back;
-  if (!frequency_from_spring(spring, mass, &hz, &ratio) || !spring_from_frequency(hz, ratio, mass, &back))
+  if (!frequencyFromSpring(spring, mass, &hz, &ratio) || !springFromFrequency(hz, ratio, mass, &back))
     return ssFail(SS_ERROR_NO_FINITE_MAPPING,
                   "k = %g N/m, c = %g N*s/m, mass = %g kg: the frequency or damping ratio is not representable as a "
                   "normal double",
@@ -149,7 +149,7 @@ ssStatus ssSoftnessFor(ssMapping mapping, ssSpring spring, double mass, double s
                        ssSoftness* out) {
   if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: ssSoftnessFor needs somewhere to write");
   switch (mapping) {
-    case SS_MAPPING_IMPLICIT_EULER: return ssSoftnessFromSpring(spring, step_s, out);
+    case SS_MAPPING_IMPLICIT_EULER: return ssImplicitEulerSoftness(spring, step_s, out);
     case SS_MAPPING_MATCHED: return ssMatchedSoftness(spring, mass, step_s, out);
     case SS_MAPPING_EXACT: return ssExactSoftness(spring, mass, step_s, previous_step_s, out);
   }

@@ -155,7 +155,7 @@ void ssStepper_Destroy(ssStepper* stepper) {
   free(stepper->watched);
   ssKnownFree(&stepper->known);
   free(stepper->spaces);
-  ssPoseHistory_Destroy(stepper->poses);
+  ssPoseHistoryDestroy(stepper->poses);
   free(stepper);
 }
 
@@ -210,7 +210,7 @@ ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body) {
     }
   }
   ssKnownForget(&stepper->known, body); /* at once: inside a frame, the next check must not read it */
-  ssPoseHistory_ForgetBody(stepper->poses, body);
+  ssPoseHistoryForgetBody(stepper->poses, body);
   dBodyDestroy(body);
   return SS_OK;
 }
@@ -248,7 +248,7 @@ void ssStepper_Reset(ssStepper* stepper) {
   stepper->accumulator_s = 0;
   stepper->short_frame_s = 0;
   forgetCarried(stepper);
-  ssPoseHistory_Forget(stepper->poses);
+  ssPoseHistoryForget(stepper->poses);
   describeNextStep(stepper);
 }
 
@@ -264,7 +264,7 @@ ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping) {
   stepper->previous_step_s = 0;
   stepper->accumulator_s = 0;
   stepper->short_frame_s = 0;
-  ssPoseHistory_Forget(stepper->poses);
+  ssPoseHistoryForget(stepper->poses);
   describeNextStep(stepper);
   return SS_OK;
 }
@@ -516,7 +516,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     if ((status = refreshKnown(stepper)) != SS_OK ||
         (called_back && (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
-    if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistory_BeforeLastStep(stepper->poses);
+    if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistoryBeforeLastStep(stepper->poses);
     int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, step_s)
                                                       : dWorldQuickStep(def->world, step_s);
     if (def->contact_group) dJointGroupEmpty(def->contact_group);
@@ -565,7 +565,7 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
 static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
   double step_s = stepping->fixed_step_s;
-  ssStatus status = ssPoseHistory_BeginFrame(&stepper->poses, stepper->known.ids, stepper->known.count);
+  ssStatus status = ssPoseHistoryBeginFrame(&stepper->poses, stepper->known.ids, stepper->known.count);
   if (status != SS_OK) return status;
   double accumulator_s = stepper->accumulator_s + frame_s;
   double due = floor(accumulator_s / step_s + kStepCountSlack);
@@ -584,7 +584,7 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
   stepper->accumulator_s = fmax(accumulator_s - report->steps * step_s, 0);
   report->carried_s = stepper->accumulator_s;
   report->interpolation = fmin(stepper->accumulator_s / step_s, nextafter(1.0, 0.0));
-  ssPoseHistory_EndFrame(stepper->poses, report->steps, report->interpolation);
+  ssPoseHistoryEndFrame(stepper->poses, report->steps, report->interpolation);
   return status;
 }
 

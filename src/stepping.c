@@ -1,4 +1,4 @@
-/* Stepping as data: defaults, the one validator, and the lab's named presets. */
+/* Stepping as data: defaults, the one validator, and the stepping policies (named presets). */
 #include "steadystep/stepping.h"
 
 #include <stddef.h>
@@ -91,9 +91,9 @@ static const Policy policies[] = {
 };
 enum { POLICY_COUNT = sizeof policies / sizeof policies[0] };
 
-int ssPolicyCount(void) { return POLICY_COUNT; }
+int ssSteppingPolicyCount(void) { return POLICY_COUNT; }
 
-const char* ssPolicyNameAt(int index) { return index >= 0 && index < POLICY_COUNT ? policies[index].name : NULL; }
+const char* ssSteppingPolicyNameAt(int index) { return index >= 0 && index < POLICY_COUNT ? policies[index].name : NULL; }
 
 ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssStepping* stepping) {
   if (stepping == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping = NULL: needs somewhere to write the policy");
@@ -113,9 +113,7 @@ ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssSteppi
     strncat(known, i ? ", " : "", sizeof known - strlen(known) - 1);
     strncat(known, policies[i].name, sizeof known - strlen(known) - 1);
   }
-  /* The article's policy was called "spring" in 0.1.0: say where it went rather than only that it is gone. */
-  const char* renamed = name && strcmp(name, "spring") == 0 ? "; \"spring\" is now called implicit-euler" : "";
-  return ssFail(SS_ERROR_PARSE, "policy \"%.64s\": unknown (%s)%s", name ? name : "(null)", known, renamed);
+  return ssFail(SS_ERROR_PARSE, "policy \"%.64s\": unknown (%s)", name ? name : "(null)", known);
 }
 
 const char* ssSteppingPolicyName(const ssStepping* stepping) {

@@ -1,4 +1,5 @@
-/* steadystep: the ranges of values the library hands to ODE, and the bounds of the lab's profiles and runs.
+/* steadystep: the ranges of values the library hands to ODE. (The lab's bounds on its profiles and runs are in
+ * lab/include/steadystep/lab/profile.h and scene.h.)
  *
  * ODE has no error return for a bad number. Debian's libode8 2:0.16.2 (double precision, built with its internal
  * checks on) aborts the process (SIGABRT in `dxNormalize4` or `dMassCheck`) when a value overflows inside a step;
@@ -60,8 +61,7 @@
 
 /** The shortest step (s) the library hands to dWorldStep or dWorldQuickStep: a nanosecond, in both precisions.
  *  ODE aborts below about 1e-155 s in double (where (1/h)² overflows) and goes non-finite below about 1e-20 s in
- *  single. A frame shorter than this is carried over, never stepped. (stepper.h defines the same macro with the
- *  same tokens, which C allows; one of the two should go.) */
+ *  single. A frame shorter than this is carried over, never stepped. */
 #define SS_MIN_STEP_S 1e-9
 
 /** The longest step (s): an hour, the longest frame the stepper takes (SS_MAX_FRAME_S in stepper.h), which the
@@ -158,19 +158,5 @@
  *  than this turn per step, before and after every step, with half of ODE's edge as the margin for the step that
  *  follows. */
 #define SS_MAX_GEAR_TURN_RAD 1.5707963267948966
-
-/** The shortest and longest frame (s) a lab profile hands out (profile.h): 1e-12 s to SS_MAX_STEP_S. Frames
- *  shorter than SS_MIN_STEP_S are allowed on purpose, to exercise carrying a frame over. */
-#define SS_MIN_PROFILE_FRAME_S 1e-12
-#define SS_MAX_PROFILE_FRAME_S SS_MAX_STEP_S
-
-/** A lab run (scene.h) takes at most this many frames and this many physics steps: 10^7 each. A run records 2 + 4
- *  doubles per step, so the largest run holds about 480 MB. A run expected to need more is refused before it
- *  starts; one that reaches the bound (a random profile's unlucky draw) stops with SS_ERROR_OUT_OF_RANGE. */
-#define SS_MAX_RUN_FRAMES 10000000
-#define SS_MAX_RUN_STEPS 10000000
-
-/** The longest simulated duration (s) of a lab run: 10^6 s (about 11.6 days). */
-#define SS_MAX_RUN_DURATION_S 1e6
 
 #endif

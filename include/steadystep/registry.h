@@ -159,7 +159,7 @@ SS_API ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axi
  *  which exists only while it penetrates (docs/exact-mappings.md); body1, body2 (either may be 0 for the static
  *  world) and previous_step_s are therefore not read. Call it in the near callback that ssStepper hands the step
  *  length to.
- *  Errors: those of ssSoftnessFromSpring; SS_ERROR_OUT_OF_RANGE (contact NULL, step_s or previous_step_s),
+ *  Errors: those of ssImplicitEulerSoftness; SS_ERROR_OUT_OF_RANGE (contact NULL, step_s or previous_step_s),
  *  SS_ERROR_UNSUPPORTED (unknown mapping). On error contact is unchanged. */
 SS_API ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpring spring, ssMapping mapping,
                                 double step_s, double previous_step_s);

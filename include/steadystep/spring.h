@@ -53,11 +53,11 @@ typedef enum ssMapping {
  *  Errors (out untouched): SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (k < 0, c < 0, step_s outside its range,
  *  out = NULL), SS_ERROR_NO_SPRING (k = c = 0), SS_ERROR_NO_FINITE_MAPPING (h·k + c overflows, or is below
  *  1/SS_MAX_CFM so that cfm would exceed SS_MAX_CFM). */
-SS_API ssStatus ssSoftnessFromSpring(ssSpring spring, double step_s, ssSoftness* out);
+SS_API ssStatus ssImplicitEulerSoftness(ssSpring spring, double step_s, ssSoftness* out);
 
 /** The inverse: the spring that erp, cfm tuned at a fixed step step_s stand for: k = erp/(h·cfm), c = (1-erp)/cfm.
  *  erp in [0, 1] (0 is a pure damper: k = 0, c = 1/cfm), cfm in (0, SS_MAX_CFM], step_s in [SS_MIN_STEP_S,
- *  SS_MAX_STEP_S]. On success k and c are finite, not both 0, and ssSoftnessFromSpring(result, step_s) gives
+ *  SS_MAX_STEP_S]. On success k and c are finite, not both 0, and ssImplicitEulerSoftness(result, step_s) gives
  *  erp, cfm back.
  *  Errors (out untouched): SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (erp, cfm or step_s outside those ranges,
  *  out = NULL), SS_ERROR_NO_FINITE_MAPPING (extreme values whose k or c over- or underflows). */
@@ -81,7 +81,7 @@ SS_API ssStatus ssFrequencyFromSpring(ssSpring spring, double mass, double* freq
  *  z1, z2 = exp(s1·h), exp(s2·h): P = z1·z2 = exp(-c·h/m), S = z1 + z2, erp = (1 + P - S)/(1 - P),
  *  cfm = h·P/(m·(1 - P)). Under-, critically and over-damped springs are all handled.
  *  On success erp and cfm are finite, |erp| <= SS_MAX_ERP and 0 < cfm <= SS_MAX_CFM (limits.h).
- *  Errors (out untouched): as ssSoftnessFromSpring, SS_ERROR_OUT_OF_RANGE for mass <= 0,
+ *  Errors (out untouched): as ssImplicitEulerSoftness, SS_ERROR_OUT_OF_RANGE for mass <= 0,
  *  SS_ERROR_NO_FINITE_MAPPING for c = 0 (an undamped spring has poles on the unit circle: cfm would be infinite)
  *  and for springs whose erp or cfm falls outside that range at this step. */
 SS_API ssStatus ssMatchedSoftness(ssSpring spring, double mass, double step_s, ssSoftness* out);
@@ -104,7 +104,7 @@ SS_API ssStatus ssSoftnessFor(ssMapping mapping, ssSpring spring, double mass, d
 /** The mapping's name: "implicit-euler", "matched", "exact"; NULL for an unknown value. */
 SS_API const char* ssMappingName(ssMapping mapping);
 
-/** Checks a spring: finite, k >= 0, c >= 0, not both 0. Errors as ssSoftnessFromSpring. */
+/** Checks a spring: finite, k >= 0, c >= 0, not both 0. Errors as ssImplicitEulerSoftness. */
 SS_API ssStatus ssValidateSpring(ssSpring spring);
 
 #ifdef __cplusplus

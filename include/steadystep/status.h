@@ -3,6 +3,10 @@
  * Every fallible function returns an ssStatus. On failure nothing was changed (no output written, no ODE state
  * touched) and ssLastError() returns one line that names the offending value, e.g.
  * "step_s = -0.01 s: must be positive". The message is kept per thread until the next failure on that thread.
+ *
+ * One status for the core and the lab (lab/include/steadystep/lab), which reports through the same ssLastError:
+ * a caller (and Python's SteadystepError.code) reads one set of values whichever part failed. SS_ERROR_IO is the
+ * lab's alone (a profile's trace file); the core reads and writes no file.
  */
 #ifndef STEADYSTEP_STATUS_H
 #define STEADYSTEP_STATUS_H
@@ -21,7 +25,7 @@ typedef enum ssStatus {
   SS_ERROR_NO_FINITE_MAPPING = 4, /* the mapping does not exist for these values (matched with c = 0, ...) */
   SS_ERROR_UNSUPPORTED = 5,       /* the joint type has no such parameter or axis, or an unknown enum value */
   SS_ERROR_NOT_FOUND = 6,         /* nothing is bound to that joint or body */
-  SS_ERROR_IO = 7,                /* a file could not be opened or read */
+  SS_ERROR_IO = 7,                /* lab only: a file could not be opened or read */
   SS_ERROR_PARSE = 8,             /* a file or a text specification is malformed */
   SS_ERROR_BLOWUP = 9,            /* a body's state became NaN or infinite */
   SS_ERROR_SPEED_LIMIT = 10,      /* a body moved faster than the configured limit */

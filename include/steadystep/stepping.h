@@ -6,7 +6,9 @@
  *    max_step_s; or constant steps of fixed_step_s from an accumulator, "fix your timestep");
  *  - the mapping: how each bound spring becomes ODE's ERP/CFM for a step (spring.h: implicit Euler, matched,
  *    exact), for the step's own length, or frozen at one length as ODE programs usually do.
- * Every combination works. The lab's policies are named presets of these (ssSteppingForPolicy).
+ * Every combination works. Eight of them have names, the stepping policies (ssSteppingForPolicy): a feature of the
+ * core, for a program or tool that lets its user choose a way of stepping by name (the examples' --policy flag, a
+ * settings file), and the names under which the lab reports its comparisons.
  */
 #ifndef STEADYSTEP_STEPPING_H
 #define STEADYSTEP_STEPPING_H
@@ -75,8 +77,9 @@ SS_API ssStatus ssValidateStepping(const ssStepping* stepping);
 /** The cut's name: "whole-frame", "substeps", "fixed"; NULL for an unknown value. */
 SS_API const char* ssFrameCutName(ssFrameCut cut);
 
-/** The lab's policies, named presets of (cut, mapping, frozen step), in the order the lab reports them:
- *    naive           whole frame, implicit Euler frozen at the reference step: the problem the article fixes
+/** The stepping policies: named presets of (cut, mapping, frozen step), in this order (the lab reports in it):
+ *    naive           whole frame, implicit Euler frozen at the reference step: an ODE program as it is usually
+ *                    written, the problem the article fixes
  *    substeps-frozen substeps, implicit Euler frozen at the reference step: the control (what the cut alone gives)
  *    implicit-euler  substeps, implicit Euler at each step's length: the article's method
  *    matched         substeps, matched
@@ -84,10 +87,10 @@ SS_API const char* ssFrameCutName(ssFrameCut cut);
  *    fixed           fixed steps, implicit Euler
  *    fixed-matched   fixed steps, matched
  *    fixed-exact     fixed steps, exact */
-SS_API int ssPolicyCount(void);
+SS_API int ssSteppingPolicyCount(void);
 
-/** The name of policy index (0 <= index < ssPolicyCount()), or NULL. */
-SS_API const char* ssPolicyNameAt(int index);
+/** The name of policy index (0 <= index < ssSteppingPolicyCount()), or NULL. */
+SS_API const char* ssSteppingPolicyNameAt(int index);
 
 /** Sets stepping's cut, mapping and frozen step to the policy's (the other fields are kept). reference_step_s (s,
  *  in the step range) is the length naive and substeps-frozen freeze their softness at, e.g. the step a program was tuned for.

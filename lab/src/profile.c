@@ -2,7 +2,7 @@
  *
  * Parsing is strict on purpose: a profile that silently read "fixed:3O" as 3 fps would make a whole report wrong,
  * so every field must be one complete number and every refusal names the spec and the field. Every frame handed
- * out lies in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S] (limits.h): the spec is refused when its frames could leave it.
+ * out lies in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S] (profile.h): the spec is refused when its frames could leave it.
  * Specs, paths and trace lines are quoted in messages with every byte outside printable ASCII written as \xNN, so
  * a message is ASCII whatever bytes came in (Python decodes it as text). */
 #include "steadystep/lab/profile.h"
@@ -20,7 +20,6 @@
 #include "error.h"
 #include "profile_internal.h"
 #include "rng.h"
-#include "steadystep/limits.h"
 
 typedef enum ssProfileKind {
   SS_PROFILE_FIXED,
@@ -87,7 +86,7 @@ static const char* escaped(const char* text, size_t length, char* out, size_t ou
 #define SPEC_TEXT(spec, buffer) escaped((spec), strlen(spec), (buffer), sizeof(buffer))
 
 /* A whole token as a number: "" , "3x", "3 " are malformed; nan and inf parse but are not finite. */
-static ssStatus parse_number(const char* raw_spec, const char* field, const char* token, double* out) {
+static ssStatus parseNumber(const char* raw_spec, const char* field, const char* token, double* out) {
   char spec[96], token_text[96];
   SPEC_TEXT(raw_spec, spec);
   escaped(token, strlen(token), token_text, sizeof token_text);
@@ -103,7 +102,7 @@ static ssStatus parse_number(const char* raw_spec, const char* field, const char
   return SS_OK;
 }
 
-static ssStatus check_positive(const char* raw_spec, const char* field, double value) {
+static ssStatus checkPositive(const char* raw_spec, const char* field, double value) {
   char spec[96];
   if (value <= 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": %s = %g: must be positive", SPEC_TEXT(raw_spec, spec),
@@ -112,7 +111,7 @@ static ssStatus check_positive(const char* raw_spec, const char* field, double v
 }
 
 /* A frame length (s) the field stands for: inside [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S], or the field is refused. */
-static ssStatus check_frame(const char* raw_spec, const char* field, double field_value, double frame_s) {
+static ssStatus checkFrame(const char* raw_spec, const char* field, double field_value, double frame_s) {
   char spec[96];
   if (!(frame_s >= SS_MIN_PROFILE_FRAME_S && frame_s <= SS_MAX_PROFILE_FRAME_S))
     return ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": %s = %g gives frames of %g s, outside [%g, %g] s",
@@ -121,15 +120,15 @@ static ssStatus check_frame(const char* raw_spec, const char* field, double fiel
 }
 
 /* A rate (frames per second) whose frames 1/rate must lie in the frame range. */
-static ssStatus check_rate(const char* spec, const char* field, double rate) {
-  ssStatus status = check_positive(spec, field, rate);
-  if (status == SS_OK) status = check_frame(spec, field, rate, 1.0 / rate);
+static ssStatus checkRate(const char* spec, const char* field, double rate) {
+  ssStatus status = checkPositive(spec, field, rate);
+  if (status == SS_OK) status = checkFrame(spec, field, rate, 1.0 / rate);
   return status;
 }
 
 /* Reads at most SS_MAX_TRACE_BYTES + 1 bytes of a regular file into a NUL-terminated buffer: a device (/dev/zero),
  * a pipe or a file that keeps growing is refused, never read forever. */
-static ssStatus read_bounded(const char* path_text, const char* raw_path, char** text_out, size_t* length_out) {
+static ssStatus readBounded(const char* path_text, const char* raw_path, char** text_out, size_t* length_out) {
   /* Non-blocking, so that opening a FIFO without a writer returns at once instead of waiting for one. */
   int fd = open(raw_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return ssFail(SS_ERROR_IO, "trace \"%s\" cannot be opened: %s", path_text, strerror(errno));
@@ -179,7 +178,7 @@ static ssStatus read_bounded(const char* path_text, const char* raw_path, char**
 }
 
 /* One line's duration, or SS_OK with *has_value = 0 for a blank or comment line. line is NUL-terminated. */
-static ssStatus parse_trace_line(const char* path_text, long number, char* line, size_t length, double* value,
+static ssStatus parseTraceLine(const char* path_text, long number, char* line, size_t length, double* value,
                                  int* has_value) {
   char line_text[96];
   *has_value = 0;
@@ -207,12 +206,12 @@ static ssStatus parse_trace_line(const char* path_text, long number, char* line,
 
 /* Reads a trace file: one duration (s) per line, blank lines and # comments skipped; the last line may lack its
  * newline. Bounded in bytes, line length and frames (profile.h). */
-static ssStatus read_trace(const char* raw_path, double** values_out, long* count_out) {
+static ssStatus readTrace(const char* raw_path, double** values_out, long* count_out) {
   char path_text[128];
   escaped(raw_path, strlen(raw_path), path_text, sizeof path_text);
   char* text = NULL;
   size_t length = 0;
-  ssStatus status = read_bounded(path_text, raw_path, &text, &length);
+  ssStatus status = readBounded(path_text, raw_path, &text, &length);
   if (status != SS_OK) return status;
   double* values = NULL;
   long count = 0, capacity = 0, line_number = 0;
@@ -223,7 +222,7 @@ static ssStatus read_trace(const char* raw_path, double** values_out, long* coun
     ++line_number;
     double value = 0;
     int has_value = 0;
-    status = parse_trace_line(path_text, line_number, text + start, stop - start, &value, &has_value);
+    status = parseTraceLine(path_text, line_number, text + start, stop - start, &value, &has_value);
     start = stop + 1;
     if (status != SS_OK || !has_value) continue;
     if (count == SS_MAX_TRACE_FRAMES) {
@@ -256,25 +255,25 @@ static ssStatus read_trace(const char* raw_path, double** values_out, long* coun
 }
 
 /* Checks the numeric fields of a kind and fills the profile's parameters; nothing is converted before its check. */
-static ssStatus set_parameters(ssProfile* p, const char* raw_spec, const ssKindDesc* kind, const double* v) {
+static ssStatus setParameters(ssProfile* p, const char* raw_spec, const ssKindDesc* kind, const double* v) {
   char spec[96];
   SPEC_TEXT(raw_spec, spec);
   ssStatus status = SS_OK;
   switch (kind->kind) {
     case SS_PROFILE_FIXED:
-      status = check_rate(raw_spec, "FPS", v[0]);
+      status = checkRate(raw_spec, "FPS", v[0]);
       p->a_s = 1.0 / v[0];
       break;
     case SS_PROFILE_UNIFORM:
-      status = check_rate(raw_spec, "MINFPS", v[0]);
-      if (status == SS_OK) status = check_rate(raw_spec, "MAXFPS", v[1]);
+      status = checkRate(raw_spec, "MINFPS", v[0]);
+      if (status == SS_OK) status = checkRate(raw_spec, "MAXFPS", v[1]);
       if (status == SS_OK && v[0] > v[1])
         status = ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": MINFPS = %g is above MAXFPS = %g", spec, v[0], v[1]);
       p->a_s = 1.0 / v[1];
       p->b_s = 1.0 / v[0];
       break;
     case SS_PROFILE_JITTER:
-      status = check_rate(raw_spec, "FPS", v[0]);
+      status = checkRate(raw_spec, "FPS", v[0]);
       if (status == SS_OK && v[1] < 0)
         status = ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": SPREAD_MS = %g: must not be negative", spec, v[1]);
       if (status == SS_OK && 3.0 * v[1] >= 1000.0 / v[0])
@@ -283,24 +282,24 @@ static ssStatus set_parameters(ssProfile* p, const char* raw_spec, const ssKindD
                         v[1], 1000.0 / v[0]);
       p->a_s = 1.0 / v[0];
       p->b_s = v[1] / 1000.0;
-      if (status == SS_OK) status = check_frame(raw_spec, "SPREAD_MS", v[1], p->a_s - 3.0 * p->b_s);
-      if (status == SS_OK) status = check_frame(raw_spec, "SPREAD_MS", v[1], p->a_s + 3.0 * p->b_s);
+      if (status == SS_OK) status = checkFrame(raw_spec, "SPREAD_MS", v[1], p->a_s - 3.0 * p->b_s);
+      if (status == SS_OK) status = checkFrame(raw_spec, "SPREAD_MS", v[1], p->a_s + 3.0 * p->b_s);
       break;
     case SS_PROFILE_HITCH:
-      status = check_rate(raw_spec, "FPS", v[0]);
+      status = checkRate(raw_spec, "FPS", v[0]);
       if (status == SS_OK && !(v[1] >= 1 && v[1] <= 1e9 && v[1] == floor(v[1])))
         status = ssFail(SS_ERROR_OUT_OF_RANGE,
                         "profile \"%s\": EVERY = %g: must be a whole number of frames in [1, 1e9]", spec, v[1]);
-      if (status == SS_OK) status = check_positive(raw_spec, "SECONDS", v[2]);
-      if (status == SS_OK) status = check_frame(raw_spec, "SECONDS", v[2], v[2]);
+      if (status == SS_OK) status = checkPositive(raw_spec, "SECONDS", v[2]);
+      if (status == SS_OK) status = checkFrame(raw_spec, "SECONDS", v[2], v[2]);
       if (status != SS_OK) break;
       p->a_s = 1.0 / v[0];
       p->every = (long)v[1];
       p->b_s = v[2];
       break;
     case SS_PROFILE_VSYNC:
-      status = check_rate(raw_spec, "FPS_A", v[0]);
-      if (status == SS_OK) status = check_rate(raw_spec, "FPS_B", v[1]);
+      status = checkRate(raw_spec, "FPS_A", v[0]);
+      if (status == SS_OK) status = checkRate(raw_spec, "FPS_B", v[1]);
       p->a_s = 1.0 / v[0];
       p->b_s = 1.0 / v[1];
       break;
@@ -331,7 +330,7 @@ ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out) {
     /* The path is the rest of the spec: it may itself contain colons. */
     const char* path = colon + 1;
     if (*path == '\0') return ssFail(SS_ERROR_PARSE, "profile \"%s\": FILE is empty", spec_text);
-    ssStatus status = read_trace(path, &profile.trace_s, &profile.trace_count);
+    ssStatus status = readTrace(path, &profile.trace_s, &profile.trace_count);
     if (status != SS_OK) return status;
   } else {
     double values[SS_MAX_FIELDS] = {0};
@@ -344,7 +343,7 @@ ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out) {
         return ssFail(SS_ERROR_PARSE, "profile \"%s\": %s is too long", spec_text, kind->fields[i]);
       memcpy(token, field_start, length);
       token[length] = '\0';
-      ssStatus status = parse_number(spec, kind->fields[i], token, &values[i]);
+      ssStatus status = parseNumber(spec, kind->fields[i], token, &values[i]);
       if (status != SS_OK) return status;
       if (i + 1 < kind->field_count && field_end == NULL)
         return ssFail(SS_ERROR_PARSE, "profile \"%s\": missing field %s", spec_text, kind->fields[i + 1]);
@@ -352,7 +351,7 @@ ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out) {
         return ssFail(SS_ERROR_PARSE, "profile \"%s\": extra field after %s", spec_text, kind->fields[i]);
       field_start = field_end ? field_end + 1 : NULL;
     }
-    ssStatus status = set_parameters(&profile, spec, kind, values);
+    ssStatus status = setParameters(&profile, spec, kind, values);
     if (status != SS_OK) return status;
   }
 
@@ -384,7 +383,7 @@ void ssProfile_Reset(ssProfile* profile) {
     ssFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to reset");
     return;
   }
-  ssRng_Seed(&profile->rng, profile->seed);
+  ssRngSeed(&profile->rng, profile->seed);
   profile->frame_index = 0;
   profile->on_b = 0;
 }
@@ -410,11 +409,11 @@ double ssProfile_Next(ssProfile* p) {
     case SS_PROFILE_FIXED:
       return p->a_s;
     case SS_PROFILE_UNIFORM:
-      return clamp(p->a_s + (p->b_s - p->a_s) * ssRng_Uniform(&p->rng), p->a_s, p->b_s);
+      return clamp(p->a_s + (p->b_s - p->a_s) * ssRngUniform(&p->rng), p->a_s, p->b_s);
     case SS_PROFILE_JITTER: {
       /* Redrawing outside three deviations keeps the distribution symmetric, so the mean stays 1/FPS. */
       double z;
-      do z = ssRng_Normal(&p->rng);
+      do z = ssRngNormal(&p->rng);
       while (fabs(z) > 3.0);
       return clamp(p->a_s + p->b_s * z, p->a_s - 3.0 * p->b_s, p->a_s + 3.0 * p->b_s);
     }
@@ -422,7 +421,7 @@ double ssProfile_Next(ssProfile* p) {
       return (index + 1) % p->every == 0 ? p->b_s : p->a_s;
     case SS_PROFILE_VSYNC:
       /* The first frame runs at rate A; every later one switches with probability 1/10. */
-      if (index > 0 && ssRng_Uniform(&p->rng) < 0.1) p->on_b = !p->on_b;
+      if (index > 0 && ssRngUniform(&p->rng) < 0.1) p->on_b = !p->on_b;
       return p->on_b ? p->b_s : p->a_s;
     case SS_PROFILE_TRACE:
       return p->trace_s[index % p->trace_count];
@@ -430,7 +429,7 @@ double ssProfile_Next(ssProfile* p) {
   return p->a_s;
 }
 
-double ssProfile_MeanFrame(const ssProfile* p) {
+double ssProfileMeanFrame(const ssProfile* p) {
   switch (p->kind) {
     case SS_PROFILE_FIXED:
     case SS_PROFILE_JITTER:

@@ -6,6 +6,6 @@
 
 /* The expected frame length (s) of the profile (its mean over a long run), for bounding a run's frame count before
  * it starts. profile must not be NULL. */
-double ssProfile_MeanFrame(const ssProfile* profile);
+double ssProfileMeanFrame(const ssProfile* profile);
 
 #endif

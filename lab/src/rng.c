@@ -13,12 +13,12 @@ static uint64_t splitmix64(uint64_t* x) {
 
 static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
 
-void ssRng_Seed(ssRng* rng, uint64_t seed) {
+void ssRngSeed(ssRng* rng, uint64_t seed) {
   uint64_t x = seed;
   for (int i = 0; i < 4; ++i) rng->state[i] = splitmix64(&x);
 }
 
-uint64_t ssRng_Next(ssRng* rng) {
+uint64_t ssRngNext(ssRng* rng) {
   uint64_t* s = rng->state;
   uint64_t result = rotl(s[1] * 5, 7) * 9;
   uint64_t t = s[1] << 17;
@@ -31,12 +31,12 @@ uint64_t ssRng_Next(ssRng* rng) {
   return result;
 }
 
-double ssRng_Uniform(ssRng* rng) { return (double)(ssRng_Next(rng) >> 11) * 0x1.0p-53; }
+double ssRngUniform(ssRng* rng) { return (double)(ssRngNext(rng) >> 11) * 0x1.0p-53; }
 
-double ssRng_Normal(ssRng* rng) {
+double ssRngNormal(ssRng* rng) {
   for (;;) {
-    double u = 2.0 * ssRng_Uniform(rng) - 1.0;
-    double v = 2.0 * ssRng_Uniform(rng) - 1.0;
+    double u = 2.0 * ssRngUniform(rng) - 1.0;
+    double v = 2.0 * ssRngUniform(rng) - 1.0;
     double s = u * u + v * v;
     if (s > 0.0 && s < 1.0) return u * sqrt(-2.0 * log(s) / s);
   }

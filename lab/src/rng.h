@@ -11,15 +11,15 @@ typedef struct ssRng {
 } ssRng;
 
 /* Seeds the generator; every seed (0 included) gives a full-period state. */
-void ssRng_Seed(ssRng* rng, uint64_t seed);
+void ssRngSeed(ssRng* rng, uint64_t seed);
 
 /* The next 64 random bits. */
-uint64_t ssRng_Next(ssRng* rng);
+uint64_t ssRngNext(ssRng* rng);
 
 /* Uniform in [0, 1), 53 random bits. */
-double ssRng_Uniform(ssRng* rng);
+double ssRngUniform(ssRng* rng);
 
 /* Standard normal (mean 0, deviation 1), Marsaglia's polar method: no trigonometry, so the same on every libm. */
-double ssRng_Normal(ssRng* rng);
+double ssRngNormal(ssRng* rng);
 
 #endif

@@ -5,7 +5,7 @@
  * The state before the first step is kept apart (initial), so that records and steps stay one to one. The last frame
  * is shortened so that every run ends at duration_s of frame time exactly. A run ends early at the first step that
  * blows up (the stepper's error) or leaves one of the scene's sanity bounds (broken: that step is recorded, the ones
- * after it in its frame are not). A run is bounded (limits.h): its duration, the frames it is expected to take
+ * after it in its frame are not). A run is bounded (scene.h): its duration, the frames it is expected to take
  * (refused before it starts) and the frames and steps it does take (stopped with an error when an unlucky random
  * profile reaches them). */
 #include <math.h>
@@ -17,7 +17,6 @@
 #include "error.h"
 #include "profile_internal.h"
 #include "scene_internal.h"
-#include "steadystep/limits.h"
 #include "steadystep/lab/profile.h"
 #include "steadystep/stepper.h"
 
@@ -88,7 +87,7 @@ static void record(void* context, const ssScene* scene, double step_s) {
   }
 }
 
-static double now_s(void) {
+static double nowSeconds(void) {
   struct timespec now;
   clock_gettime(CLOCK_MONOTONIC, &now);
   return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
@@ -104,9 +103,9 @@ static ssStatus play(ssRun* run, ssScene* scene, ssProfile* profile, double dura
       return ssFail(SS_ERROR_OUT_OF_RANGE, "run: %d frames and %g of duration_s = %g s left: a run takes at most %d frames",
                     run->frame_count, duration_s - elapsed_s, duration_s, SS_MAX_RUN_FRAMES);
     double frame_s = fmin(ssProfile_Next(profile), duration_s - elapsed_s);
-    double start_s = now_s();
+    double start_s = nowSeconds();
     ssStatus status = ssScene_Frame(scene, frame_s, NULL);
-    run->wall_s += now_s() - start_s;
+    run->wall_s += nowSeconds() - start_s;
     ++run->frame_count;
     elapsed_s += frame_s;
     run->bound_use = ssScene_BoundUse(scene);
@@ -128,21 +127,21 @@ static ssStatus play(ssRun* run, ssScene* scene, ssProfile* profile, double dura
 
 /* The physics steps a run of frames of mean_frame_s will take, roughly: one per frame, more when a policy cuts
  * frames into substeps, duration / fixed_step_s under the accumulator. */
-static double expected_steps(const ssStepping* stepping, double duration_s, double frames, double mean_frame_s) {
+static double expectedSteps(const ssStepping* stepping, double duration_s, double frames, double mean_frame_s) {
   if (stepping->cut == SS_CUT_FIXED) return duration_s / stepping->fixed_step_s;
   if (stepping->cut == SS_CUT_WHOLE_FRAME) return frames;
   return frames * fmax(ceil(mean_frame_s / stepping->max_step_s), 1.0);
 }
 
-/* Refuses, before anything runs, a run that would take more frames or steps than limits.h allows. */
-static ssStatus check_size(const ssRunDef* def, const ssProfile* profile) {
-  double mean_frame_s = ssProfile_MeanFrame(profile);
+/* Refuses, before anything runs, a run that would take more frames or steps than scene.h allows. */
+static ssStatus checkSize(const ssRunDef* def, const ssProfile* profile) {
+  double mean_frame_s = ssProfileMeanFrame(profile);
   double frames = def->duration_s / mean_frame_s;
   if (frames > SS_MAX_RUN_FRAMES)
     return ssFail(SS_ERROR_OUT_OF_RANGE,
                   "duration_s = %g s: profile \"%s\" (mean frame %g s) needs about %.3g frames, a run takes at most %d",
                   def->duration_s, ssProfile_Spec(profile), mean_frame_s, frames, SS_MAX_RUN_FRAMES);
-  double steps = expected_steps(&def->stepping, def->duration_s, frames, mean_frame_s);
+  double steps = expectedSteps(&def->stepping, def->duration_s, frames, mean_frame_s);
   if (steps > SS_MAX_RUN_STEPS)
     return ssFail(SS_ERROR_OUT_OF_RANGE,
                   "duration_s = %g s: cut %s with max_step_s = %g s, fixed_step_s = %g s needs about %.3g steps, "
@@ -172,13 +171,13 @@ ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
   if (status != SS_OK) return status;
   ssScene* scene = NULL;
   status = ssScene_Create(def->scene, &def->params, &def->stepping, &scene);
-  if (status == SS_OK) status = check_size(def, profile); /* after the scene has checked the stepping's fields */
+  if (status == SS_OK) status = checkSize(def, profile); /* after the scene has checked the stepping's fields */
   ssRun* run = status == SS_OK ? calloc(1, sizeof *run) : NULL;
   if (status == SS_OK && run == NULL) status = ssFail(SS_ERROR_OUT_OF_MEMORY, "run: out of memory");
   if (status == SS_OK) {
     run->quantity_count = info->quantity_count;
     ssScene_Sample(scene, run->initial);
-    ssScene_SetStepObserver(scene, record, run);
+    ssSceneSetStepObserver(scene, record, run);
     status = play(run, scene, profile, def->duration_s);
     run->counters = ssScene_Counters(scene);
   }
@@ -193,29 +192,29 @@ ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
 }
 
 /* The accessors of a NULL run record why and answer with nothing: 0, NULL, or an error status. */
-static int null_run(const ssRun* run, const char* what) {
+static int nullRun(const ssRun* run, const char* what) {
   if (run != NULL) return 0;
   ssFail(SS_ERROR_OUT_OF_RANGE, "run = NULL: no run to read %s from", what);
   return 1;
 }
 
-int ssRun_StepCount(const ssRun* run) { return null_run(run, "a step count") ? 0 : run->count; }
-const double* ssRun_Times(const ssRun* run) { return null_run(run, "times") ? NULL : run->times_s; }
-const double* ssRun_StepLengths(const ssRun* run) { return null_run(run, "step lengths") ? NULL : run->steps_s; }
+int ssRun_StepCount(const ssRun* run) { return nullRun(run, "a step count") ? 0 : run->count; }
+const double* ssRun_Times(const ssRun* run) { return nullRun(run, "times") ? NULL : run->times_s; }
+const double* ssRun_StepLengths(const ssRun* run) { return nullRun(run, "step lengths") ? NULL : run->steps_s; }
 
 const double* ssRun_Quantity(const ssRun* run, int index) {
-  if (null_run(run, "a quantity") || index < 0 || index >= run->quantity_count) return NULL;
+  if (nullRun(run, "a quantity") || index < 0 || index >= run->quantity_count) return NULL;
   return run->quantities[index];
 }
 
-const double* ssRun_Initial(const ssRun* run) { return null_run(run, "an initial state") ? NULL : run->initial; }
+const double* ssRun_Initial(const ssRun* run) { return nullRun(run, "an initial state") ? NULL : run->initial; }
 
-int ssRun_FrameCount(const ssRun* run) { return null_run(run, "a frame count") ? 0 : run->frame_count; }
-double ssRun_WallSeconds(const ssRun* run) { return null_run(run, "wall seconds") ? 0 : run->wall_s; }
-ssStatus ssRun_Status(const ssRun* run) { return null_run(run, "a status") ? SS_ERROR_OUT_OF_RANGE : run->status; }
-ssRunOutcome ssRun_Outcome(const ssRun* run) { return null_run(run, "an outcome") ? SS_RUN_NONE : run->outcome; }
-double ssRun_BoundUse(const ssRun* run) { return null_run(run, "a bound use") ? NAN : run->bound_use; }
-const char* ssRun_Message(const ssRun* run) { return null_run(run, "a message") ? "" : run->message; }
+int ssRun_FrameCount(const ssRun* run) { return nullRun(run, "a frame count") ? 0 : run->frame_count; }
+double ssRun_WallSeconds(const ssRun* run) { return nullRun(run, "wall seconds") ? 0 : run->wall_s; }
+ssStatus ssRun_Status(const ssRun* run) { return nullRun(run, "a status") ? SS_ERROR_OUT_OF_RANGE : run->status; }
+ssRunOutcome ssRun_Outcome(const ssRun* run) { return nullRun(run, "an outcome") ? SS_RUN_NONE : run->outcome; }
+double ssRun_BoundUse(const ssRun* run) { return nullRun(run, "a bound use") ? NAN : run->bound_use; }
+const char* ssRun_Message(const ssRun* run) { return nullRun(run, "a message") ? "" : run->message; }
 ssSceneCounters ssRun_Counters(const ssRun* run) {
-  return null_run(run, "counters") ? (ssSceneCounters){0} : run->counters;
+  return nullRun(run, "counters") ? (ssSceneCounters){0} : run->counters;
 }

@@ -33,7 +33,7 @@ struct ssScene {
   void* state;
   double time_s;
   unsigned long ode_random_seed; /* this scene's state of ODE's one global generator */
-  ssSceneStepFn* observer;
+  ssSceneStepCallback* observer;
   void* observer_context;
   double bound_use;    /* the largest value/bound ratio of the sanity bounds so far */
   int broken;          /* a step has left a sanity bound: broken_message says which */
@@ -45,10 +45,10 @@ struct ssScene {
 static pthread_once_t ode_once = PTHREAD_ONCE_INIT;
 static _Thread_local int ode_thread_ready;
 
-static void init_ode(void) { dInitODE2(0); }
+static void initOde(void) { dInitODE2(0); }
 
 void ssEnsureOde(void) {
-  pthread_once(&ode_once, init_ode);
+  pthread_once(&ode_once, initOde);
   /* An ODE built with thread-local collision data needs this on every thread that collides. */
   if (!ode_thread_ready) ode_thread_ready = dAllocateODEDataForThread(dAllocateMaskAll);
 }
@@ -60,7 +60,7 @@ const ssSceneInfo* ssSceneInfoAt(int index) {
   return &scenes[index]->info;
 }
 
-static const ssSceneDesc* find_desc(const char* name) {
+static const ssSceneDesc* findDesc(const char* name) {
   if (name == NULL) return NULL;
   for (int i = 0; i < SCENE_COUNT; ++i)
     if (strcmp(scenes[i]->info.name, name) == 0) return scenes[i];
@@ -68,13 +68,13 @@ static const ssSceneDesc* find_desc(const char* name) {
 }
 
 const ssSceneInfo* ssSceneFind(const char* name) {
-  const ssSceneDesc* desc = find_desc(name);
+  const ssSceneDesc* desc = findDesc(name);
   return desc != NULL ? &desc->info : NULL;
 }
 
-static ssStatus find_or_fail(const char* name, const ssSceneDesc** out) {
+static ssStatus findOrFail(const char* name, const ssSceneDesc** out) {
   if (name == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "name = NULL: needs a scene name (oscillator, buggy, ...)");
-  *out = find_desc(name);
+  *out = findDesc(name);
   if (*out != NULL) return SS_OK;
   char known[128] = ""; /* the table's names, so that a new scene is one line */
   for (int i = 0; i < SCENE_COUNT; ++i) {
@@ -86,7 +86,7 @@ static ssStatus find_or_fail(const char* name, const ssSceneDesc** out) {
 
 ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out) {
   const ssSceneDesc* desc;
-  ssStatus status = find_or_fail(name, &desc);
+  ssStatus status = findOrFail(name, &desc);
   if (status != SS_OK) return status;
   if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the parameters");
   *out = desc->defaults;
@@ -112,7 +112,7 @@ ssStepping ssReferenceStepping(double step_s) {
   return stepping;
 }
 
-static ssStatus validate_params(const ssSceneDesc* desc, const ssSceneParams* params) {
+static ssStatus validateParams(const ssSceneDesc* desc, const ssSceneParams* params) {
   ssStatus status = ssValidateSpring(params->spring);
   if (status == SS_OK) status = ssCheckMass("mass", params->mass);
   if (status == SS_OK) status = ssCheckFinite("x0", "m", params->x0);
@@ -141,7 +141,7 @@ void ssBoundMessage(char* worst, size_t size, const char* format, ...) {
   va_end(arguments);
 }
 
-static void check_bounds(ssScene* scene) {
+static void checkBounds(ssScene* scene) {
   if (scene->desc->check == NULL || scene->timing) return;
   double use = scene->desc->check(scene->state, NULL, 0);
   if (use > scene->bound_use) scene->bound_use = use;
@@ -154,14 +154,14 @@ static void check_bounds(ssScene* scene) {
   }
 }
 
-static void scene_step_done(void* context, double step_s) {
+static void sceneStepDone(void* context, double step_s) {
   ssScene* scene = context;
   scene->time_s += step_s;
-  check_bounds(scene);
+  checkBounds(scene);
   if (scene->observer != NULL) scene->observer(scene->observer_context, scene, step_s);
 }
 
-static void free_world(ssSceneWorld* parts) {
+static void freeWorld(ssSceneWorld* parts) {
   ssStepper_Destroy(parts->stepper);
   ssRegistry_Destroy(parts->registry);
   if (parts->contacts != 0) dJointGroupDestroy(parts->contacts);
@@ -169,7 +169,7 @@ static void free_world(ssSceneWorld* parts) {
   if (parts->world != 0) dWorldDestroy(parts->world);
 }
 
-static ssStatus make_stepper(ssScene* scene, const ssStepping* stepping) {
+static ssStatus makeStepper(ssScene* scene, const ssStepping* stepping) {
   ssStepperDef def = ssDefaultStepperDef();
   def.world = scene->parts.world;
   def.registry = scene->parts.registry;
@@ -180,7 +180,7 @@ static ssStatus make_stepper(ssScene* scene, const ssStepping* stepping) {
   def.before_step_context = scene->state;
   def.collide = scene->desc->collide;
   def.collide_context = scene->state;
-  def.step_done = scene_step_done;
+  def.step_done = sceneStepDone;
   def.step_done_context = scene;
   def.contact_group = scene->parts.contacts;
   ssStatus status = ssStepper_Create(&def, &scene->parts.stepper);
@@ -191,12 +191,12 @@ static ssStatus make_stepper(ssScene* scene, const ssStepping* stepping) {
 
 ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssStepping* stepping, ssScene** out) {
   const ssSceneDesc* desc;
-  ssStatus status = find_or_fail(name, &desc);
+  ssStatus status = findOrFail(name, &desc);
   if (status != SS_OK) return status;
   if (params == NULL || stepping == NULL || out == NULL)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_Create needs params, stepping and out",
                   params == NULL ? "params" : stepping == NULL ? "stepping" : "out");
-  status = validate_params(desc, params);
+  status = validateParams(desc, params);
   if (status == SS_OK) status = ssValidateStepping(stepping);
   if (status != SS_OK) return status;
 
@@ -216,10 +216,10 @@ ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssS
   } else {
     status = desc->build(&scene->parts, &resolved, &scene->state);
   }
-  if (status == SS_OK) status = make_stepper(scene, stepping);
+  if (status == SS_OK) status = makeStepper(scene, stepping);
   if (status != SS_OK) {
     if (scene->state != NULL) desc->destroy(scene->state);
-    free_world(&scene->parts);
+    freeWorld(&scene->parts);
     free(scene);
     return status;
   }
@@ -232,7 +232,7 @@ void ssScene_Destroy(ssScene* scene) {
   ssStepper_Destroy(scene->parts.stepper);
   scene->parts.stepper = NULL;
   scene->desc->destroy(scene->state);
-  free_world(&scene->parts);
+  freeWorld(&scene->parts);
   free(scene);
 }
 
@@ -304,7 +304,7 @@ void ssScenePointOnBody(const ssStepper* drawn_by, dBodyID body, const double re
   for (int k = 0; k < 3; ++k) out[k] = position[k] + r[k][0] * rel[0] + r[k][1] * rel[1] + r[k][2] * rel[2];
 }
 
-static double now_s(void) {
+static double nowSeconds(void) {
   struct timespec now;
   clock_gettime(CLOCK_MONOTONIC, &now);
   return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
@@ -312,7 +312,7 @@ static double now_s(void) {
 
 /* What a program without the library does each frame: collide, one step of the whole frame, empty the contacts.
  * Softness stays as the stepper last wrote it; the contacts are softened as for the stepper's last step. */
-static ssStatus plain_frame(ssScene* scene, double frame_s) {
+static ssStatus plainFrame(ssScene* scene, double frame_s) {
   const ssSceneWorld* parts = &scene->parts;
   if (scene->desc->collide != NULL) scene->desc->collide(scene->state, parts->stepper);
   if (ssStepper_Stepping(parts->stepper).solver == SS_SOLVER_STEP) {
@@ -346,17 +346,17 @@ ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, int count, i
                     frames_s[i], SS_MIN_STEP_S, SS_MAX_STEP_S);
   ssEnsureOde();
   ssStatus status = SS_OK;
-  double start_s = now_s();
+  double start_s = nowSeconds();
   if (plain) {
     dRandSetSeed(scene->ode_random_seed);
-    for (int i = 0; status == SS_OK && i < count; ++i) status = plain_frame(scene, frames_s[i]);
+    for (int i = 0; status == SS_OK && i < count; ++i) status = plainFrame(scene, frames_s[i]);
     scene->ode_random_seed = dRandGetSeed();
   } else {
     scene->timing = 1;
     for (int i = 0; status == SS_OK && i < count; ++i) status = ssScene_Frame(scene, frames_s[i], NULL);
     scene->timing = 0;
   }
-  *wall_s = now_s() - start_s;
+  *wall_s = nowSeconds() - start_s;
   return status;
 }
 
@@ -377,7 +377,7 @@ double ssScene_Time(const ssScene* scene) {
   return scene->time_s;
 }
 
-void ssScene_SetStepObserver(ssScene* scene, ssSceneStepFn* observer, void* context) {
+void ssSceneSetStepObserver(ssScene* scene, ssSceneStepCallback* observer, void* context) {
   scene->observer = observer;
   scene->observer_context = context;
 }

@@ -9,7 +9,7 @@
 #include "error.h"
 #include "scene_internal.h"
 
-ssStatus ssBoxes_Create(const ssSceneWorld* world, const ssSceneParams* params, const char* scene, ssBoxes** out) {
+ssStatus ssBoxesCreate(const ssSceneWorld* world, const ssSceneParams* params, const char* scene, ssBoxes** out) {
   ssBoxes* boxes = calloc(1, sizeof *boxes);
   dBodyID* bodies = calloc((size_t)params->body_count, sizeof *bodies);
   if (boxes == NULL || bodies == NULL) {
@@ -31,7 +31,7 @@ ssStatus ssBoxes_Create(const ssSceneWorld* world, const ssSceneParams* params, 
   return SS_OK;
 }
 
-void ssBoxes_Add(ssBoxes* boxes, const ssSceneWorld* world, double mass_kg, double side_m, double x, double y,
+void ssBoxesAdd(ssBoxes* boxes, const ssSceneWorld* world, double mass_kg, double side_m, double x, double y,
                  double z) {
   dBodyID box = dBodyCreate(world->world);
   dMass mass;
@@ -43,7 +43,7 @@ void ssBoxes_Add(ssBoxes* boxes, const ssSceneWorld* world, double mass_kg, doub
   boxes->bodies[boxes->count++] = box;
 }
 
-ssStatus ssBoxes_Watch(void* state, ssStepper* stepper) {
+ssStatus ssBoxesWatch(void* state, ssStepper* stepper) {
   ssBoxes* boxes = state;
   for (int i = 0; i < boxes->count; ++i) {
     ssStatus status = ssStepper_WatchBody(stepper, boxes->bodies[i]);
@@ -52,12 +52,12 @@ ssStatus ssBoxes_Watch(void* state, ssStepper* stepper) {
   return SS_OK;
 }
 
-void ssBoxes_Collide(void* context, ssStepper* stepper) {
+void ssBoxesCollide(void* context, ssStepper* stepper) {
   ssBoxes* boxes = context;
   ssContactCollide(&boxes->recipe, stepper);
 }
 
-void ssBoxes_Destroy(void* state) {
+void ssBoxesDestroy(void* state) {
   ssBoxes* boxes = state;
   free(boxes->bodies);
   free(boxes);
@@ -70,7 +70,7 @@ double ssBoxDepth(dBodyID box, double side_m) {
   return 0.5 * side_m * (fabs(rotation[8]) + fabs(rotation[9]) + fabs(rotation[10])) - position[2];
 }
 
-double ssBoxes_Check(const ssBoxes* boxes, double side_m, double of_half_side, char* worst, size_t size) {
+double ssBoxesCheck(const ssBoxes* boxes, double side_m, double of_half_side, char* worst, size_t size) {
   const double bound_m = of_half_side * 0.5 * side_m;
   double deepest_m = -INFINITY;
   int deepest = 0;

@@ -8,7 +8,7 @@ typedef struct CollideCall {
   ssStepInfo step;
 } CollideCall;
 
-static void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
+static void nearCallback(void* data, dGeomID geom1, dGeomID geom2) {
   CollideCall* call = data;
   ssContactRecipe* recipe = call->recipe;
   dBodyID body1 = dGeomGetBody(geom1), body2 = dGeomGetBody(geom2);
@@ -38,7 +38,7 @@ void ssContactCollide(ssContactRecipe* recipe, const ssStepper* stepper) {
   recipe->deepest_m = 0;
   recipe->contact_count = 0;
   CollideCall call = {recipe, ssStepper_CurrentStep(stepper)};
-  dSpaceCollide(recipe->space, &call, near_callback);
+  dSpaceCollide(recipe->space, &call, nearCallback);
 }
 
 /* The near callback of the scenes written as ODE programs: the surface as the program tuned it at 60 fps, then
@@ -48,7 +48,7 @@ typedef struct TunedCall {
   ssStepper* stepper;
 } TunedCall;
 
-static void tuned_near_callback(void* data, dGeomID geom1, dGeomID geom2) {
+static void tunedNearCallback(void* data, dGeomID geom1, dGeomID geom2) {
   TunedCall* call = data;
   ssTunedContacts* recipe = call->recipe;
   dBodyID body1 = dGeomGetBody(geom1), body2 = dGeomGetBody(geom2);
@@ -70,5 +70,5 @@ static void tuned_near_callback(void* data, dGeomID geom1, dGeomID geom2) {
 
 void ssTunedContactsCollide(ssTunedContacts* recipe, ssStepper* stepper) {
   TunedCall call = {recipe, stepper};
-  dSpaceCollide(recipe->space, &call, tuned_near_callback);
+  dSpaceCollide(recipe->space, &call, tunedNearCallback);
 }

@@ -75,8 +75,8 @@ extern const ssSceneDesc ssPistonScene;
 #define SS_PROGRAM_TUNED_STEP_S (1.0 / 60.0)
 
 /* Called after every physics step of the scene, after its time has advanced; run.c records with it. */
-typedef void ssSceneStepFn(void* context, const ssScene* scene, double step_s);
-void ssScene_SetStepObserver(ssScene* scene, ssSceneStepFn* observer, void* context);
+typedef void ssSceneStepCallback(void* context, const ssScene* scene, double step_s);
+void ssSceneSetStepObserver(ssScene* scene, ssSceneStepCallback* observer, void* context);
 
 /* Contacts against everything in a space, softened with one spring: the near callback the contact scenes share.
  * Pairs of bodies joined by a joint do not collide. deepest_m receives the deepest contact depth of this step. */
@@ -119,8 +119,6 @@ typedef struct ssBoxes {
   ssContactRecipe recipe;
 } ssBoxes;
 
-/* The sanity bound of a scene of boxes on the floor (scene.h): the largest ratio of a box's lowest corner below the
- * floor to the bound, of_half_side times the box's half side; writes the deepest box into worst. */
 /* A check's line into worst (printf format), or nothing when worst is NULL. */
 void ssBoundMessage(char* worst, size_t size, const char* format, ...)
 #if defined(__GNUC__)
@@ -128,20 +126,22 @@ void ssBoundMessage(char* worst, size_t size, const char* format, ...)
 #endif
     ;
 
-double ssBoxes_Check(const ssBoxes* boxes, double side_m, double of_half_side, char* worst, size_t size);
+/* The sanity bound of a scene of boxes on the floor (scene.h): the largest ratio of a box's lowest corner below the
+ * floor to the bound, of_half_side times the box's half side; writes the deepest box into worst. */
+double ssBoxesCheck(const ssBoxes* boxes, double side_m, double of_half_side, char* worst, size_t size);
 /* How far the lowest corner of a box of side_m (m) is below z = 0 (m; negative when above). */
 double ssBoxDepth(dBodyID box, double side_m);
 
 /* Allocates room for params->body_count boxes, sets gravity along -z and makes the ground. scene names the scene
  * in the out-of-memory message. */
-ssStatus ssBoxes_Create(const ssSceneWorld* world, const ssSceneParams* params, const char* scene, ssBoxes** out);
+ssStatus ssBoxesCreate(const ssSceneWorld* world, const ssSceneParams* params, const char* scene, ssBoxes** out);
 /* Adds one box of side_m (m) and mass_kg (kg) centred at (x, y, z). */
-void ssBoxes_Add(ssBoxes* boxes, const ssSceneWorld* world, double mass_kg, double side_m, double x, double y,
+void ssBoxesAdd(ssBoxes* boxes, const ssSceneWorld* world, double mass_kg, double side_m, double x, double y,
                  double z);
 /* The ssSceneDesc callbacks of a scene whose state is an ssBoxes. */
-ssStatus ssBoxes_Watch(void* state, ssStepper* stepper);
-void ssBoxes_Collide(void* context, ssStepper* stepper);
-void ssBoxes_Destroy(void* state);
+ssStatus ssBoxesWatch(void* state, ssStepper* stepper);
+void ssBoxesCollide(void* context, ssStepper* stepper);
+void ssBoxesDestroy(void* state);
 
 /* Calls dInitODE2 once per process and allocates ODE's per-thread data once per thread; never dCloseODE. */
 void ssEnsureOde(void);

@@ -3,7 +3,7 @@
 On a program's own ODE world (built with odepy, PyPI ode-python): ``Registry`` (bind springs, adopt what the program
 tuned), ``Stepper`` (one call per frame: substeps, mappings, forces kept over the frame, failures refused until
 reset), ``Stepper.soften_contact`` in the near callback, and ``Stepping`` for how frames become steps. The
-conversions (``softness_from_spring`` ..., scalars or numpy arrays), the lab's profiles and runs on built-in scenes
+conversions (``implicit_euler_softness`` ..., scalars or numpy arrays), the lab's profiles and runs on built-in scenes
 (``steadystep.runs``, ``steadystep.profiles``), the article's model (``steadystep.article``), metrics, ``sweep`` of
 independent runs over any ``concurrent.futures.Executor`` (``make_executor``: a process pool, Dask); figures and
 the HTML report need the ``report`` extra (``pip install steadystep[report]``). Every failure raises
@@ -14,8 +14,8 @@ parses nothing (the cffi declarations were prepared from the headers when the pa
 """
 
 from steadystep._native import InvalidValue, SimulationFailure, SteadystepError
-from steadystep.convert import (Softness, Spring, exact_softness, frequency_from_spring, matched_softness,
-                                softness_for, softness_from_spring, spring_from_frequency, spring_from_softness)
+from steadystep.convert import (Softness, Spring, exact_softness, frequency_from_spring, implicit_euler_softness,
+                                matched_softness, softness_for, spring_from_frequency, spring_from_softness)
 from steadystep.enums import FrameCut, JointParam, Mapping, Solver, Status
 from steadystep.profiles import Profile, frame_times
 from steadystep.registry import (AdoptReport, ApplyReport, Registry, ServedCounts, contact_soften,
@@ -28,8 +28,8 @@ __all__ = [
     "AdoptReport", "ApplyReport", "FrameCut", "FrameReport", "InvalidValue", "JointParam", "Mapping", "Profile",
     "Registry", "ServedCounts", "SimulationFailure", "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper",
     "SteadystepError", "Stepping", "contact_soften",
-    "exact_softness", "frame_times", "frequency_from_spring", "grid", "joint_effective_mass", "joint_supports",
-    "make_executor", "matched_softness", "policy_names", "softness_for", "softness_from_spring",
+    "exact_softness", "frame_times", "frequency_from_spring", "grid", "implicit_euler_softness",
+    "joint_effective_mass", "joint_supports", "make_executor", "matched_softness", "policy_names", "softness_for",
     "spring_from_frequency", "spring_from_softness", "sweep",
 ]
 

@@ -21,8 +21,9 @@ from pathlib import Path
 # the stepper's settings, so the lab and Python share the one struct and its validator.
 _LAB_AND_SETTINGS = (("core", "status.h"), ("core", "spring.h"), ("core", "stepping.h"), ("lab", "profile.h"),
                      ("lab", "scene.h"))
-# The core for a program's own ODE world (registry, adoption, stepper). limits.h brings the integer bounds
-# (SS_MAX_RUN_STEPS ...); its floating-point #defines are not kept (cffi's ABI mode takes integer constants only).
+# The core for a program's own ODE world (registry, adoption, stepper). Only integer #defines are kept (cffi's ABI
+# mode takes integer constants only): the run bounds (SS_MAX_RUN_STEPS ...) come from scene.h, and of
+# limits.h only SS_MAX_AVERAGE_SAMPLES is kept (its ranges are floating point).
 _OWN_WORLD = (("core", "limits.h"), ("core", "registry.h"), ("core", "adopt.h"), ("core", "stepper.h"),
               ("core", "interpolation.h"))
 

@@ -393,7 +393,7 @@ def _conversions(args, given: set[str]) -> dict[str, float]:
             raise _UsageError("steadystep convert: --k and --c need --dt H (or --mass M)")
         spring = (args.k, args.c)
         if args.dt is not None:
-            out.update(convert.softness_from_spring(spring, args.dt)._asdict())
+            out.update(convert.implicit_euler_softness(spring, args.dt)._asdict())
         if args.mass is not None:
             out["frequency_hz"], out["damping_ratio"] = convert.frequency_from_spring(spring, args.mass)
             if args.dt is not None:
@@ -405,7 +405,7 @@ def _conversions(args, given: set[str]) -> dict[str, float]:
         spring = convert.spring_from_frequency(args.frequency, args.damping_ratio, args.mass)
         out.update(spring._asdict())
         if args.dt is not None:
-            out.update(convert.softness_from_spring(spring, args.dt)._asdict())
+            out.update(convert.implicit_euler_softness(spring, args.dt)._asdict())
     else:
         raise _UsageError("steadystep convert: give --k K --c C --dt H, or --erp E --cfm F --dt H, or "
                           "--frequency HZ --damping-ratio Z --mass M (see steadystep convert --help)")

@@ -64,12 +64,12 @@ def _checked(what: str, inputs: dict, status: int, outputs) -> None:
                                   f"{_given(what, inputs)}: {name} = {value}: the result is not finite")
 
 
-def _softness_from_spring(spring: Spring | tuple[float, float], step_s: float) -> Softness:
+def _implicit_euler_softness(spring: Spring | tuple[float, float], step_s: float) -> Softness:
     """The article's mapping at step step_s (s): erp = hk/(hk+c), cfm = 1/(hk+c)."""
     spring, step_s = _spring(spring), number("step_s", step_s, "s")
     out = ffi.new("ssSoftness*")
-    _checked("softness_from_spring", {"k": spring["stiffness"], "c": spring["damping"], "step_s": step_s},
-             lib.ssSoftnessFromSpring(spring, step_s, out), lambda: {"erp": out.erp, "cfm": out.cfm})
+    _checked("implicit_euler_softness", {"k": spring["stiffness"], "c": spring["damping"], "step_s": step_s},
+             lib.ssImplicitEulerSoftness(spring, step_s, out), lambda: {"erp": out.erp, "cfm": out.cfm})
     return Softness(out.erp, out.cfm)
 
 
@@ -191,12 +191,12 @@ def _pair(value, what: str, names: str):
     return first, second
 
 
-def softness_from_spring(spring: Spring | tuple[float, float], step_s: float) -> Softness:
+def implicit_euler_softness(spring: Spring | tuple[float, float], step_s: float) -> Softness:
     """The article's mapping at step step_s (s): erp = hk/(hk+c), cfm = 1/(hk+c); spring is (k N/m, c N·s/m)."""
     if isinstance(spring, (str, bytes)):
-        return _softness_from_spring(spring, step_s)
+        return _implicit_euler_softness(spring, step_s)
     k, c = _pair(spring, "spring", "k N/m, c N·s/m")
-    return _elementwise(lambda k, c, h: _softness_from_spring((k, c), h), Softness, ("k", "c", "step_s"),
+    return _elementwise(lambda k, c, h: _implicit_euler_softness((k, c), h), Softness, ("k", "c", "step_s"),
                         k, c, step_s)
 
 

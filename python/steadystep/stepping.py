@@ -24,7 +24,7 @@ _INT_RANGE = (-2**31, 2**31 - 1)
 
 def policy_names() -> list[str]:
     """The library's named presets (naive, implicit-euler, matched, exact, fixed, fixed-matched, fixed-exact)."""
-    return [text(lib.ssPolicyNameAt(i)) for i in range(lib.ssPolicyCount())]
+    return [text(lib.ssSteppingPolicyNameAt(i)) for i in range(lib.ssSteppingPolicyCount())]
 
 
 @dataclass(frozen=True)

@@ -21,7 +21,7 @@ inline bool KeepsStaticResponse(ssSpring spring, double mass, double step_s) {
 inline ssStatus ServedSoftness(ssMapping mapping, ssSpring spring, double mass, double step_s, double previous_s,
                                ssSoftness* out) {
   if (mapping != SS_MAPPING_IMPLICIT_EULER && !KeepsStaticResponse(spring, mass, step_s))
-    return ssSoftnessFromSpring(spring, step_s, out);
+    return ssImplicitEulerSoftness(spring, step_s, out);
   if (mapping == SS_MAPPING_EXACT && spring.stiffness == 0) mapping = SS_MAPPING_MATCHED;
   ssStatus status = ssSoftnessFor(mapping, spring, mass, step_s, mapping == SS_MAPPING_EXACT ? previous_s : 0, out);
   if (status == SS_ERROR_NO_FINITE_MAPPING && mapping == SS_MAPPING_EXACT)

@@ -25,7 +25,7 @@ void OneStepPerFrame(OscillatorRig& rig, const char* policy, ssSolver solver) {
   rig.def.stepping.max_step_s = 1.0 / 15.0;
 }
 
-TEST_F(Oscillator, SpringFollowsImplicitEulerAtFixedAndVariableSteps) {
+TEST_F(Oscillator, ImplicitEulerFollowsTheRecurrenceAtFixedAndVariableSteps) {
   struct Case {
     const char* profile;
     ssSolver solver;
@@ -167,8 +167,8 @@ double RmsAgainst(const OscillatorRig& variable, const OscillatorRig& fixed) {
 
 // The article's claim: with the implicit-Euler mapping a run at 15-45 fps stays with the run at 30 fps; with ERP/CFM
 // frozen at their 30 fps values it does not.
-TEST_F(Oscillator, SpringIsConsistentAcrossFrameRatesAndNaiveIsNot) {
-  double spring_sum = 0, naive_sum = 0;
+TEST_F(Oscillator, ImplicitEulerIsConsistentAcrossFrameRatesAndNaiveIsNot) {
+  double implicit_euler_sum = 0, naive_sum = 0;
   const int seeds = 8;
   for (int seed = 0; seed < seeds; ++seed) {
     double rms[2];
@@ -184,14 +184,14 @@ TEST_F(Oscillator, SpringIsConsistentAcrossFrameRatesAndNaiveIsNot) {
       rms[which] = RmsAgainst(variable, fixed);
     }
     EXPECT_LE(rms[0], 0.05) << "seed " << seed;
-    spring_sum += rms[0];
+    implicit_euler_sum += rms[0];
     naive_sum += rms[1];
   }
-  double spring = spring_sum / seeds, naive = naive_sum / seeds;
-  std::printf("RMS(15-45 fps vs 30 fps)/x0 over %d seeds: spring %.4f, naive %.4f (ratio %.1f)\n", seeds, spring,
-              naive, naive / spring);
-  EXPECT_LE(spring, 0.05);
-  EXPECT_GE(naive, 2 * spring);
+  double implicit_euler = implicit_euler_sum / seeds, naive = naive_sum / seeds;
+  std::printf("RMS(15-45 fps vs 30 fps)/x0 over %d seeds: implicit-euler %.4f, naive %.4f (ratio %.1f)\n", seeds,
+              implicit_euler, naive, naive / implicit_euler);
+  EXPECT_LE(implicit_euler, 0.05);
+  EXPECT_GE(naive, 2 * implicit_euler);
 }
 
 // Fits x_(n+1) = a1 x_n + a2 x_(n-1), which a damped sinusoid sampled at a constant step obeys exactly:
@@ -296,7 +296,7 @@ TEST_F(Oscillator, LoadsAreRefusedWhereTheyHaveNoMeaning) {
   EXPECT_EQ(ssRegistry_SetJointLoad(rig.registry, ball, SS_PARAM_JOINT, 1, -9.81), SS_ERROR_UNSUPPORTED);
 }
 
-TEST_F(Oscillator, UndampedSpringUnderMatchedGetsTheSpringMappingCounted) {
+TEST_F(Oscillator, UndampedSpringUnderMatchedIsHandedToImplicitEulerAndCounted) {
   OscillatorRig rig;
   rig.spring = {40.0, 0.0};  // poles on the unit circle: no finite matched softness
   ssSteppingForPolicy("matched", 1.0 / 30, &rig.def.stepping);
@@ -307,7 +307,7 @@ TEST_F(Oscillator, UndampedSpringUnderMatchedGetsTheSpringMappingCounted) {
   EXPECT_EQ(report.rows.handed_to_implicit_euler, 2);  // one row, two steps
   EXPECT_EQ(report.rows.by_mapping, 0);
   ssSoftness spring;
-  ASSERT_EQ(ssSoftnessFromSpring(rig.spring, 1.0 / 60.0, &spring), SS_OK);
+  ASSERT_EQ(ssImplicitEulerSoftness(rig.spring, 1.0 / 60.0, &spring), SS_OK);
   EXPECT_EQ(dJointGetSliderParam(rig.slider, dParamStopERP), spring.erp);
   EXPECT_EQ(dJointGetSliderParam(rig.slider, dParamStopCFM), spring.cfm);
 }

@@ -13,7 +13,6 @@
 
 #include <random>
 
-#include "steadystep/limits.h"
 #include "steadystep/lab/profile.h"
 
 namespace {

@@ -113,7 +113,7 @@ TEST_F(RegistryTest, EveryJointTypeAndParameterIsWrittenForEachStepLength) {
     EXPECT_EQ(report.rows.by_mapping, bound);
     EXPECT_EQ(report.row_writes, bound);  // every row's softness changed with the step
     ssSoftness expected;
-    ASSERT_EQ(ssSoftnessFromSpring(kSpring, step_s, &expected), SS_OK);
+    ASSERT_EQ(ssImplicitEulerSoftness(kSpring, step_s, &expected), SS_OK);
     for (const JointCase& c : cases)
       for (const Row& row : c.rows) {
         SCOPED_TRACE(std::string(c.name) + " param " + std::to_string(row.param) + " axis " +
@@ -522,7 +522,7 @@ TEST_F(RegistryTest, ContactSoftenFillsTheSurface) {
   contact.geom.pos[2] = 0;
   ASSERT_EQ(ssContactSoften(&contact, a, nullptr, kSpring, SS_MAPPING_IMPLICIT_EULER, 0.02, 0), SS_OK);
   ssSoftness expected;
-  ssSoftnessFromSpring(kSpring, 0.02, &expected);
+  ssImplicitEulerSoftness(kSpring, 0.02, &expected);
   EXPECT_TRUE(contact.surface.mode & dContactSoftERP);
   EXPECT_TRUE(contact.surface.mode & dContactSoftCFM);
   EXPECT_DOUBLE_EQ(contact.surface.soft_erp, AsDReal(expected.erp));

@@ -1,7 +1,7 @@
 // Scenes and runs on real ODE: every scene runs, every bad input is refused by name, runs are reproducible, the
 // oscillator under the article's mapping follows implicit Euler step by step, and the article's claim holds in
-// every scene with soft constraints: the spring policy stays much closer to the fine-step reference across frame
-// time profiles than fixed ERP/CFM (naive) does.
+// every scene with soft constraints: the implicit-euler policy stays much closer to the fine-step reference across
+// frame time profiles than fixed ERP/CFM (naive) does.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -331,7 +331,7 @@ TEST(Scenes, BlowUpEndsTheRunAndIsRecorded) {
 // spread is the RMS over frame-time profiles of each run's RMS deviation from it, relative to its amplitude.
 // Policy naive breaks the chain and the drop under some of these profiles (test_bounds.cpp): a broken run is
 // measured over the records it has, up to the step that broke, which can only flatter naive.
-TEST(Scenes, SpringPolicySpreadIsAtMostHalfOfNaive) {
+TEST(Scenes, ImplicitEulerSpreadIsAtMostHalfOfNaive) {
   const char* const profiles[] = {"fixed:30", "uniform:15:45", "jitter:30:3", "hitch:60:30:0.1", "vsync:60:30"};
   for (const char* scene : {"oscillator", "buggy", "drop", "chain"}) {
     ssRunDef reference_def = Def(scene, "fixed:1000", 3.0);
@@ -422,7 +422,7 @@ TEST(Scenes, ValuesOutsideOdesRangeAreRefusedByName) {
   EXPECT_GT(run.frames, 0);  // stepped (here the speed limit stops it at once): ODE did not abort
 }
 
-// Runs have a bound (limits.h): one that would never end, or grow without limit, is refused before it starts.
+// Runs have a bound (scene.h): one that would never end, or grow without limit, is refused before it starts.
 TEST(Scenes, RunsAboveTheirBoundsAreRefusedNamingTheValue) {
   ssRunDef def = Def("oscillator", "fixed:60", 1e9);
   ExpectRunRefused(def, SS_ERROR_OUT_OF_RANGE, "duration_s = 1e+09");

@@ -155,20 +155,21 @@ class Soak : public ::testing::TestWithParam<std::tuple<int, int>> {};
 
 // An abort or a broken promise in the child fails here, with the child's stderr.
 TEST_P(Soak, HostileFramesNeverAbortAndNeverLie) {
-  EXPECT_EXIT(SoakChild(ssSceneInfoAt(std::get<0>(GetParam()))->name, ssPolicyNameAt(std::get<1>(GetParam()))),
+  EXPECT_EXIT(SoakChild(ssSceneInfoAt(std::get<0>(GetParam()))->name, ssSteppingPolicyNameAt(std::get<1>(GetParam()))),
               ::testing::ExitedWithCode(0), "");
 }
 
 std::string PairName(const ::testing::TestParamInfo<Soak::ParamType>& info) {
   std::string name = std::string(ssSceneInfoAt(std::get<0>(info.param))->name) + "_" +
-                     ssPolicyNameAt(std::get<1>(info.param));
+                     ssSteppingPolicyNameAt(std::get<1>(info.param));
   for (char& c : name)
     if (c == '-') c = '_';  // test names allow letters, digits and underscores only
   return name;
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryScenePolicy, Soak,
-                         ::testing::Combine(::testing::Range(0, ssSceneCount()), ::testing::Range(0, ssPolicyCount())),
+                         ::testing::Combine(::testing::Range(0, ssSceneCount()),
+                                            ::testing::Range(0, ssSteppingPolicyCount())),
                          PairName);
 
 }  // namespace

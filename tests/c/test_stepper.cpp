@@ -41,7 +41,7 @@ TEST_F(StepperTest, NaiveTakesOneStepWithSoftnessFrozenAtTheReference) {
   ssSteppingForPolicy("naive", 1.0 / 30, &rig.def.stepping);
   ASSERT_EQ(rig.Build(), SS_OK);
   ssSoftness reference;
-  ASSERT_EQ(ssSoftnessFromSpring(rig.spring, 1.0 / 30.0, &reference), SS_OK);
+  ASSERT_EQ(ssImplicitEulerSoftness(rig.spring, 1.0 / 30.0, &reference), SS_OK);
   for (double frame_s : {1.0 / 15.0, 1.0 / 45.0}) {
     ssFrameReport report;
     ASSERT_EQ(ssStepper_Step(rig.stepper, frame_s, &report), SS_OK);
@@ -134,14 +134,14 @@ TEST_F(StepperTest, CreateRefusesBadDefinitionsNamingTheField) {
 }
 
 TEST_F(StepperTest, PoliciesArePresetsOfCutAndMappingNamedByTheLibrary) {
-  ASSERT_EQ(ssPolicyCount(), 8);
-  for (int i = 0; i < ssPolicyCount(); ++i) {
+  ASSERT_EQ(ssSteppingPolicyCount(), 8);
+  for (int i = 0; i < ssSteppingPolicyCount(); ++i) {
     ssStepping stepping = TestStepping();
-    ASSERT_EQ(ssSteppingForPolicy(ssPolicyNameAt(i), 1.0 / 60, &stepping), SS_OK);
-    EXPECT_STREQ(ssSteppingPolicyName(&stepping), ssPolicyNameAt(i));
+    ASSERT_EQ(ssSteppingForPolicy(ssSteppingPolicyNameAt(i), 1.0 / 60, &stepping), SS_OK);
+    EXPECT_STREQ(ssSteppingPolicyName(&stepping), ssSteppingPolicyNameAt(i));
     EXPECT_EQ(ssValidateStepping(&stepping), SS_OK);
   }
-  EXPECT_EQ(ssPolicyNameAt(ssPolicyCount()), nullptr);
+  EXPECT_EQ(ssSteppingPolicyNameAt(ssSteppingPolicyCount()), nullptr);
   ssStepping stepping = TestStepping();
   const ssStepping before = stepping;
   EXPECT_EQ(ssSteppingForPolicy("smooth", 1.0 / 60, &stepping), SS_ERROR_PARSE);

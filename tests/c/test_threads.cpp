@@ -65,7 +65,7 @@ void Build(Pile& pile, bool own_threading) {
   pile.contacts = dJointGroupCreate(0);
   dCreatePlane(pile.space, 0, 0, 1, 0);
   // The contact is the spring of the ground, converted once for this step length by the library.
-  ASSERT_EQ(ssSoftnessFromSpring(ssSpring{2e4, 300}, kStep, &pile.contact_softness), SS_OK) << ssLastError();
+  ASSERT_EQ(ssImplicitEulerSoftness(ssSpring{2e4, 300}, kStep, &pile.contact_softness), SS_OK) << ssLastError();
   for (int i = 0; i < kBoxes; ++i) {
     dBodyID body = dBodyCreate(pile.world);
     dMass mass;

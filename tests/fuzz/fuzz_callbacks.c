@@ -188,7 +188,7 @@ static void fire(Program* p, ssStepper* stepper, const Action* a) {
     }
     case REENTER_SET_STEPPING: {
       ssStepping stepping = w->stepping;
-      const char* name = ssPolicyNameAt(a->policy % (ssPolicyCount() + 1));
+      const char* name = ssSteppingPolicyNameAt(a->policy % (ssSteppingPolicyCount() + 1));
       if (ssSteppingForPolicy(name, 1.0 / 60, &stepping) != SS_OK) break;
       ssStatus status = ssStepper_SetStepping(stepper, &stepping);
       if (verbose) fprintf(stderr, "    = %s %s\n", ssStatusName(status), status == SS_OK ? "" : ssLastError());
@@ -389,7 +389,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         break;
       case 7: {
         ssStepping stepping = w->stepping;
-        const char* name = ssPolicyNameAt(fuzz_byte(&in) % (ssPolicyCount() + 1));
+        const char* name = ssSteppingPolicyNameAt(fuzz_byte(&in) % (ssSteppingPolicyCount() + 1));
         if (ssSteppingForPolicy(name, fuzz_double(&in), &stepping) != SS_OK) break;
         ssStatus status = ssStepper_SetStepping(w->stepper, &stepping);
         check_status(status, "ssStepper_SetStepping");

@@ -44,7 +44,7 @@ static void require_valid_spring(ssSpring spring, const char* what) {
 #define SS_MAX_CFM 1e20
 #endif
 
-/* A softness returned OK: finite, cfm in (0, SS_MAX_CFM], |erp| <= SS_MAX_ERP; the spring mapping's erp in [0, 1]. */
+/* A softness returned OK: finite, cfm in (0, SS_MAX_CFM], |erp| <= SS_MAX_ERP; implicit Euler's erp in [0, 1]. */
 static void require_valid_softness(ssSoftness softness, const char* what, ssSpring spring, double mass, double h,
                                    double previous, int spring_mapping) {
   FUZZ_REQUIRE(isfinite(softness.erp) && fabs(softness.erp) <= SS_MAX_ERP && isfinite(softness.cfm) &&
@@ -76,8 +76,8 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   switch (which % 9) {
     case 0: {
       fill_canary(&softness, sizeof softness);
-      check_softness(ssSoftnessFromSpring(spring, a, &softness), &softness, "ssSoftnessFromSpring", spring, 0, a, 0,
-                     1);
+      check_softness(ssImplicitEulerSoftness(spring, a, &softness), &softness, "ssImplicitEulerSoftness", spring, 0,
+                     a, 0, 1);
       break;
     }
     case 1: {
@@ -147,13 +147,13 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     case 8: {
       /* A round trip: a spring accepted, turned into softness at h and back, is a valid spring again. */
       fill_canary(&softness, sizeof softness);
-      ssStatus status = ssSoftnessFromSpring(spring, a, &softness);
-      check_softness(status, &softness, "ssSoftnessFromSpring", spring, 0, a, 0, 1);
+      ssStatus status = ssImplicitEulerSoftness(spring, a, &softness);
+      check_softness(status, &softness, "ssImplicitEulerSoftness", spring, 0, a, 0, 1);
       if (status == SS_OK && softness.erp > 0) {
         fill_canary(&spring_out, sizeof spring_out);
         status = ssSpringFromSoftness(softness, a, &spring_out);
         if (status == SS_OK)
-          require_valid_spring(spring_out, "ssSpringFromSoftness(ssSoftnessFromSpring)");
+          require_valid_spring(spring_out, "ssSpringFromSoftness(ssImplicitEulerSoftness)");
         else
           require_refused_cleanly(status, &spring_out, sizeof spring_out, "ssSpringFromSoftness");
       }

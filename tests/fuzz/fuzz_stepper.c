@@ -159,7 +159,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         uint8_t which = fuzz_byte(&in);
         ssStepping stepping = w.stepping;
         if (!(which & 0x80)) {
-          const char* name = ssPolicyNameAt(which % (ssPolicyCount() + 1)); /* one past the end: NULL */
+          const char* name = ssSteppingPolicyNameAt(which % (ssSteppingPolicyCount() + 1)); /* one past the end: NULL */
           ssStatus status = ssSteppingForPolicy(name, fuzz_double(&in), &stepping);
           if (status != SS_OK) {
             FUZZ_REQUIRE(ssLastError()[0] != '\0' && holds_stepping(&stepping, &w.stepping),

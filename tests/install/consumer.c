@@ -5,7 +5,7 @@
 
 int main(void) {
   ssSoftness softness;
-  if (ssSoftnessFromSpring((ssSpring){40.0, 1.0}, 1.0 / 30.0, &softness) != SS_OK) return 1;
+  if (ssImplicitEulerSoftness((ssSpring){40.0, 1.0}, 1.0 / 30.0, &softness) != SS_OK) return 1;
   printf("erp %.6f cfm %.6f\n", softness.erp, softness.cfm);
   return 0;
 }

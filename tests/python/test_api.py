@@ -75,7 +75,7 @@ def test_the_stepping_defaults_and_presets_are_the_librarys():
 
 def test_the_run_bound_is_the_c_librarys():
     from steadystep.limits import MAX_RUN_FRAMES, MAX_RUN_STEPS
-    header = (Path(ss.__file__).parent / "_native" / "include" / "steadystep" / "limits.h").read_text()
+    header = (Path(ss.__file__).parent / "_native" / "include" / "steadystep" / "lab" / "scene.h").read_text()
     assert f"#define SS_MAX_RUN_STEPS {MAX_RUN_STEPS}\n" in header
     assert f"#define SS_MAX_RUN_FRAMES {MAX_RUN_FRAMES}\n" in header
 
@@ -102,7 +102,7 @@ def test_importing_the_package_changes_no_global_state():
 def test_conversions_work_elementwise_on_numpy_arrays():
     k = np.array([10.0, 40.0, 1e3])
     h = np.array([[1 / 30], [1 / 60]])
-    erp, cfm = ss.softness_from_spring((k, 1.0), h)
+    erp, cfm = ss.implicit_euler_softness((k, 1.0), h)
     assert erp.shape == cfm.shape == (2, 3)
     assert np.allclose(erp, h * k / (h * k + 1.0), rtol=1e-14) and np.allclose(cfm, 1 / (h * k + 1.0), rtol=1e-14)
     back = ss.spring_from_softness((erp, cfm), h)
@@ -114,12 +114,12 @@ def test_conversions_work_elementwise_on_numpy_arrays():
         many = ss.softness_for(mapping, (k, 1.0), 1.0, 1 / 60)
         one = [ss.softness_for(mapping, (value, 1.0), 1.0, 1 / 60) for value in k]
         assert list(many.erp) == [s.erp for s in one] and list(many.cfm) == [s.cfm for s in one]
-    scalar = ss.softness_from_spring((40.0, 1.0), 1 / 30)
+    scalar = ss.implicit_euler_softness((40.0, 1.0), 1 / 30)
     assert isinstance(scalar.erp, float)
     with pytest.raises(ss.SteadystepError, match=r"at index \(1,\): .*k = -1"):
-        ss.softness_from_spring((np.array([1.0, -1.0]), 1.0), 0.1)
+        ss.implicit_euler_softness((np.array([1.0, -1.0]), 1.0), 0.1)
     with pytest.raises(ss.SteadystepError, match="cannot be broadcast"):
-        ss.softness_from_spring((np.ones(2), np.ones(3)), 0.1)
+        ss.implicit_euler_softness((np.ones(2), np.ones(3)), 0.1)
 
 
 @pytest.mark.parametrize("command", [["figure", "--out", "unused"], ["compare", "--out", "unused"]])

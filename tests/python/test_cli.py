@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from steadystep.convert import softness_from_spring, spring_from_frequency, spring_from_softness
+from steadystep.convert import implicit_euler_softness, spring_from_frequency, spring_from_softness
 
 SCRIPT = Path(sys.executable).parent / "steadystep"
 COMMAND = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "steadystep.cli"]
@@ -161,7 +161,7 @@ def test_probe_prints_each_policy():
 
 def test_convert_all_three_ways_equal_the_package():
     result = steadystep("convert", "--k", "40", "--c", "1", "--dt", "0.02", "--json")
-    assert json.loads(result.stdout) == softness_from_spring((40, 1), 0.02)._asdict()
+    assert json.loads(result.stdout) == implicit_euler_softness((40, 1), 0.02)._asdict()
     result = steadystep("convert", "--erp", "0.2", "--cfm", "1e-5", "--dt", "0.01", "--json")
     assert json.loads(result.stdout) == spring_from_softness((0.2, 1e-5), 0.01)._asdict()
     result = steadystep("convert", "--frequency", "2", "--damping-ratio", "0.3", "--mass", "1.5")
@@ -221,10 +221,12 @@ def test_version_is_the_one_in_cmakelists():
     assert result.stdout.strip() == f"steadystep {version}"
 
 
-def test_the_old_policy_name_spring_is_refused_naming_its_new_name():
-    result = steadystep("run", "oscillator", "--policy", "spring", "--profile", "fixed:30", "--duration", "1")
+def test_an_unknown_policy_is_refused_naming_the_known_ones():
+    from steadystep.runs import policy_names
+    result = steadystep("run", "oscillator", "--policy", "smooth", "--profile", "fixed:30", "--duration", "1")
     assert result.returncode == 2 and result.stdout == ""
-    assert '"spring" is now called implicit-euler' in result.stderr and "Traceback" not in result.stderr
+    assert f'policy "smooth": unknown ({", ".join(policy_names())})' in result.stderr
+    assert "Traceback" not in result.stderr
 
 
 def test_the_help_lists_are_the_librarys():

@@ -8,15 +8,15 @@ import pytest
 
 from steadystep import SteadystepError
 from steadystep._native import ffi, lib
-from steadystep.convert import (exact_softness, frequency_from_spring, matched_softness, softness_for,
-                                softness_from_spring, spring_from_frequency, spring_from_softness)
+from steadystep.convert import (exact_softness, frequency_from_spring, implicit_euler_softness, matched_softness,
+                                softness_for, spring_from_frequency, spring_from_softness)
 
 
 def test_softness_equals_c_and_the_articles_formula():
     for k, c, h in ((40.0, 1.0, 1 / 30), (1e4, 50.0, 1 / 144), (0.0, 2.0, 0.1), (3.0, 0.0, 0.02)):
-        erp, cfm = softness_from_spring((k, c), h)
+        erp, cfm = implicit_euler_softness((k, c), h)
         direct = ffi.new("ssSoftness*")
-        assert lib.ssSoftnessFromSpring({"stiffness": k, "damping": c}, h, direct) == lib.SS_OK
+        assert lib.ssImplicitEulerSoftness({"stiffness": k, "damping": c}, h, direct) == lib.SS_OK
         assert (erp, cfm) == (direct.erp, direct.cfm)
         assert erp == pytest.approx(h * k / (h * k + c), rel=1e-15)
         assert cfm == pytest.approx(1.0 / (h * k + c), rel=1e-15)
@@ -26,7 +26,7 @@ def test_round_trips():
     rng = np.random.default_rng(7)
     for _ in range(200):
         k, c, h = 10 ** rng.uniform(-2, 5), 10 ** rng.uniform(-3, 3), 10 ** rng.uniform(-4, -0.5)
-        back = spring_from_softness(softness_from_spring((k, c), h), h)
+        back = spring_from_softness(implicit_euler_softness((k, c), h), h)
         assert back.stiffness == pytest.approx(k, rel=1e-9)
         assert back.damping == pytest.approx(c, rel=1e-9)
         f, zeta = frequency_from_spring((k, c), 2.0)
@@ -52,15 +52,15 @@ def test_matched_and_exact_equal_c_and_agree_without_history():
     p = math.exp(-1.0 * h / mass)
     assert matched.cfm == pytest.approx(h * p / (mass * (1 - p)), rel=1e-12)
     assert softness_for("matched", spring, mass, h) == matched
-    assert softness_for("implicit-euler", spring, mass, h) == softness_from_spring(spring, h)
+    assert softness_for("implicit-euler", spring, mass, h) == implicit_euler_softness(spring, h)
     assert softness_for("exact", spring, mass, h, 1 / 20) == exact_softness(spring, mass, h, 1 / 20)
 
 
 @pytest.mark.parametrize("call, named, status", [
-    (lambda: softness_from_spring((-1.0, 1.0), 0.1), "k", "out of range"),
-    (lambda: softness_from_spring((1.0, 1.0), 0.0), "step_s", "out of range"),
-    (lambda: softness_from_spring((0.0, 0.0), 0.1), "", "no spring"),
-    (lambda: softness_from_spring((math.nan, 1.0), 0.1), "k", "not finite"),
+    (lambda: implicit_euler_softness((-1.0, 1.0), 0.1), "k", "out of range"),
+    (lambda: implicit_euler_softness((1.0, 1.0), 0.0), "step_s", "out of range"),
+    (lambda: implicit_euler_softness((0.0, 0.0), 0.1), "", "no spring"),
+    (lambda: implicit_euler_softness((math.nan, 1.0), 0.1), "k", "not finite"),
     (lambda: spring_from_softness((1.5, 0.1), 0.1), "erp", "out of range"),
     (lambda: matched_softness((40.0, 0.0), 1.0, 0.1), "", "no finite mapping"),
     (lambda: matched_softness((40.0, 1.0), -1.0, 0.1), "mass", "out of range"),

@@ -125,9 +125,9 @@ def out_of_memory_in_a_child_process():
 
 
 CASES = {
-    S.NOT_FINITE: lambda: ss.softness_from_spring((math.nan, 1.0), 0.1),
-    S.OUT_OF_RANGE: lambda: ss.softness_from_spring((-1.0, 1.0), 0.1),
-    S.NO_SPRING: lambda: ss.softness_from_spring((0.0, 0.0), 0.1),
+    S.NOT_FINITE: lambda: ss.implicit_euler_softness((math.nan, 1.0), 0.1),
+    S.OUT_OF_RANGE: lambda: ss.implicit_euler_softness((-1.0, 1.0), 0.1),
+    S.NO_SPRING: lambda: ss.implicit_euler_softness((0.0, 0.0), 0.1),
     S.NO_FINITE_MAPPING: lambda: ss.matched_softness((40.0, 0.0), 1.0, 0.1),
     S.UNSUPPORTED: slider_unsupported_axis,
     S.NOT_FOUND: unbind_what_was_never_bound,

@@ -79,8 +79,8 @@ def test_names_and_specs_of_the_wrong_kind_raise_steadystep_error():
         (lambda: runs.run("oscillator", "fixed:30", "implicit-euler", 0.1, params={"spring": 5}), "params.spring = 5"),
         (lambda: runs.run("oscillator", "fixed:30", "implicit-euler", 0.1, params=[1]), "params = [1]"),
         (lambda: runs.Scene("oscillator").frame("long"), "frame_s = 'long'"),
-        (lambda: convert.softness_from_spring("ab", 0.1), "k = 'a'"),
-        (lambda: convert.softness_from_spring((1, 2, 3), 0.1), "spring = (1, 2, 3)"),
+        (lambda: convert.implicit_euler_softness("ab", 0.1), "k = 'a'"),
+        (lambda: convert.implicit_euler_softness((1, 2, 3), 0.1), "spring = (1, 2, 3)"),
         (lambda: convert.spring_from_softness(None, 0.1), "softness = None"),
         (lambda: convert.softness_for(5, (40, 1), 1, 0.1), "mapping = 5"),
         (lambda: convert.matched_softness((40, 1), [], 0.1), "mass = []"),
@@ -105,7 +105,7 @@ def test_an_internal_error_is_one_line_with_its_own_exit_code(capsys, monkeypatc
     def broken(*args):
         raise ZeroDivisionError("float division by zero")
 
-    monkeypatch.setattr(convert, "softness_from_spring", broken)
+    monkeypatch.setattr(convert, "implicit_euler_softness", broken)
     code, out, err = run_cli(capsys, "convert", "--k", "40", "--c", "1", "--dt", "0.02")
     assert code == EXIT_INTERNAL and code not in (0, 1, 2)
     assert err.splitlines() == ["steadystep: internal error: ZeroDivisionError: float division by zero (please "
@@ -135,7 +135,7 @@ def test_convert_json_is_strict_and_equals_the_package(capsys):
 def test_a_conversion_without_a_finite_result_is_refused_by_name(capsys):
     # k = 1e308, h = 10: h·k overflows and erp = hk/(hk + c) is NaN. Refused, whether by the library or by Python.
     with pytest.raises(SteadystepError) as error:
-        convert.softness_from_spring((1e308, 1.0), 10.0)
+        convert.implicit_euler_softness((1e308, 1.0), 10.0)
     assert "k = 1e+308" in error.value.message
     for json_flag in ([], ["--json"]):
         code, out, err = run_cli(capsys, "convert", "--k", "1e308", "--c", "1", "--dt", "10", *json_flag)

@@ -76,7 +76,7 @@ def test_bad_run_input_is_refused():
         runs.run("oscillator", "fixed:30", "bogus", 1.0)
 
 
-def test_spring_halves_the_spread_of_naive_in_every_soft_scene():
+def test_implicit_euler_halves_the_spread_of_naive_in_every_soft_scene():
     soft_scenes = ["oscillator", "buggy", "drop", "chain"]
     result = report.compare(soft_scenes, ["fixed:30", "uniform:15:45", "hitch:60:30:0.1", "vsync:60:30"],
                             ["naive", "implicit-euler"], duration_s=2.0, seed=1, progress=False)

@@ -3,8 +3,8 @@
  * Each wheel hangs on a hinge-2 joint: axis 1 vertical (steering, and the suspension slides along it), axis 2 the
  * wheel's spin axis, driven by a motor. Steering is locked with lo = hi = 0 stops on axis 1. Every soft thing is
  * bound: the suspension to the scene's spring, the ground contacts to a stiff spring, and the world's ERP/CFM
- * (the hinge-2 rigid rows) to a stiff spring too, so that policy naive freezes all of them and policy spring maps
- * all of them; nothing is left with a fixed ERP/CFM that would blur the comparison. */
+ * (the hinge-2 rigid rows) to a stiff spring too, so that policy naive freezes all of them and policy implicit-euler
+ * maps all of them; nothing is left with a fixed ERP/CFM that would blur the comparison. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -49,7 +49,7 @@ typedef struct Buggy {
   ssContactRecipe recipe;
 } Buggy;
 
-static dBodyID make_wheel(const ssSceneWorld* world, double x, double y, double z) {
+static dBodyID makeWheel(const ssSceneWorld* world, double x, double y, double z) {
   dBodyID wheel = dBodyCreate(world->world);
   dMass mass;
   dMassSetSphereTotal(&mass, BUGGY_WHEEL_MASS_KG, BUGGY_WHEEL_RADIUS_M);
@@ -60,7 +60,7 @@ static dBodyID make_wheel(const ssSceneWorld* world, double x, double y, double 
   return wheel;
 }
 
-static ssStatus attach_wheel(const ssSceneWorld* world, const ssSceneParams* params, dBodyID chassis,
+static ssStatus attachWheel(const ssSceneWorld* world, const ssSceneParams* params, dBodyID chassis,
                              dBodyID wheel, dJointID* out) {
   const dReal* at = dBodyGetPosition(wheel);
   dJointID joint = dJointCreateHinge2(world->world, 0);
@@ -106,8 +106,8 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
   /* Wheels start touching the ground; the suspension then settles under the car's weight. */
   for (int i = 0; status == SS_OK && i < 4; ++i) {
     double x = (i < 2 ? 1 : -1) * BUGGY_AXLE_X_M, y = (i % 2 == 0 ? 1 : -1) * BUGGY_TRACK_Y_M;
-    buggy->wheels[i] = make_wheel(world, x, y, BUGGY_WHEEL_RADIUS_M);
-    status = attach_wheel(world, params, buggy->chassis, buggy->wheels[i], &buggy->hinges[i]);
+    buggy->wheels[i] = makeWheel(world, x, y, BUGGY_WHEEL_RADIUS_M);
+    status = attachWheel(world, params, buggy->chassis, buggy->wheels[i], &buggy->hinges[i]);
   }
   if (status != SS_OK) {
     free(buggy);

@@ -14,11 +14,11 @@
 
 static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, void** state) {
   ssBoxes* boxes;
-  ssStatus status = ssBoxes_Create(world, params, "drop", &boxes);
+  ssStatus status = ssBoxesCreate(world, params, "drop", &boxes);
   if (status != SS_OK) return status;
   for (int i = 0; i < params->body_count; ++i) {
     double bottom_m = DROP_LOWEST_GAP_M + DROP_GAP_STEP_M * i;
-    ssBoxes_Add(boxes, world, params->mass, DROP_SIDE_M, DROP_SPACING_M * i, 0, bottom_m + 0.5 * DROP_SIDE_M);
+    ssBoxesAdd(boxes, world, params->mass, DROP_SIDE_M, DROP_SPACING_M * i, 0, bottom_m + 0.5 * DROP_SIDE_M);
   }
   *state = boxes;
   return SS_OK;
@@ -40,7 +40,7 @@ static void sample(const void* state, double* out) {
 #define DROP_MAX_DEPTH_OF_HALF_SIDE 0.5
 
 static double check(const void* state, char* worst, size_t size) {
-  return ssBoxes_Check(state, DROP_SIDE_M, DROP_MAX_DEPTH_OF_HALF_SIDE, worst, size);
+  return ssBoxesCheck(state, DROP_SIDE_M, DROP_MAX_DEPTH_OF_HALF_SIDE, worst, size);
 }
 
 const ssSceneDesc ssDropScene = {
@@ -53,9 +53,9 @@ const ssSceneDesc ssDropScene = {
     .defaults = {.spring = {.stiffness = 2500, .damping = 20}, .mass = 1, .x0 = 0, .gravity = 9.81, .body_count = 4},
     .max_body_count = 1000,
     .build = build,
-    .watch = ssBoxes_Watch,
-    .collide = ssBoxes_Collide,
+    .watch = ssBoxesWatch,
+    .collide = ssBoxesCollide,
     .sample = sample,
     .check = check,
-    .destroy = ssBoxes_Destroy,
+    .destroy = ssBoxesDestroy,
 };

@@ -11,13 +11,13 @@
 
 static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, void** state) {
   ssBoxes* boxes;
-  ssStatus status = ssBoxes_Create(world, params, "pile", &boxes);
+  ssStatus status = ssBoxesCreate(world, params, "pile", &boxes);
   if (status != SS_OK) return status;
   const int per_layer = PILE_PER_ROW * PILE_PER_ROW;
   for (int i = 0; i < params->body_count; ++i) {
     int layer = i / per_layer, row = (i % per_layer) / PILE_PER_ROW, column = i % PILE_PER_ROW;
     double shift_m = (layer % 2) * 0.5 * PILE_CELL_M;
-    ssBoxes_Add(boxes, world, params->mass, PILE_SIDE_M, column * PILE_CELL_M + shift_m, row * PILE_CELL_M + shift_m,
+    ssBoxesAdd(boxes, world, params->mass, PILE_SIDE_M, column * PILE_CELL_M + shift_m, row * PILE_CELL_M + shift_m,
                 0.5 * PILE_SIDE_M + 0.05 + layer * PILE_LAYER_M);
   }
   *state = boxes;
@@ -39,7 +39,7 @@ static void sample(const void* state, double* out) {
 #define PILE_MAX_DEPTH_OF_HALF_SIDE 1.0
 
 static double check(const void* state, char* worst, size_t size) {
-  return ssBoxes_Check(state, PILE_SIDE_M, PILE_MAX_DEPTH_OF_HALF_SIDE, worst, size);
+  return ssBoxesCheck(state, PILE_SIDE_M, PILE_MAX_DEPTH_OF_HALF_SIDE, worst, size);
 }
 
 const ssSceneDesc ssPileScene = {
@@ -53,9 +53,9 @@ const ssSceneDesc ssPileScene = {
                  .body_count = 500},
     .max_body_count = 100000,
     .build = build,
-    .watch = ssBoxes_Watch,
-    .collide = ssBoxes_Collide,
+    .watch = ssBoxesWatch,
+    .collide = ssBoxesCollide,
     .sample = sample,
     .check = check,
-    .destroy = ssBoxes_Destroy,
+    .destroy = ssBoxesDestroy,
 };

@@ -52,7 +52,7 @@ static void destroy(void* state) { free(state); }
 
 static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, void** state) {
   ssSoftness stop;
-  ssStatus status = ssSoftnessFromSpring(params->spring, SS_PROGRAM_TUNED_STEP_S, &stop);
+  ssStatus status = ssImplicitEulerSoftness(params->spring, SS_PROGRAM_TUNED_STEP_S, &stop);
   if (status != SS_OK) return status;
   Piston* piston = calloc(1, sizeof *piston);
   if (piston == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "piston: out of memory");
@@ -101,7 +101,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
 }
 
 /* Before every step: the motor's direction for the time the step starts, then that time moves on by the step. */
-static void before_step(void* context, ssStepper* stepper) {
+static void beforeStep(void* context, ssStepper* stepper) {
   Piston* piston = context;
   int forward = (int)floor(piston->time_s / PISTON_REVERSE_S) % 2 == 0;
   dJointSetSliderParam(piston->slider, dParamVel, forward ? PISTON_SPEED_M_PER_S : -PISTON_SPEED_M_PER_S);
@@ -157,7 +157,7 @@ const ssSceneDesc ssPistonScene = {
                  .body_count = 0},
     .max_body_count = 0,
     .build = build,
-    .before_step = before_step,
+    .before_step = beforeStep,
     .sample = sample,
     .check = check,
     .destroy = destroy,

@@ -75,7 +75,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
   /* What the program tuned at 60 fps: the contacts' spring as world ERP (which contacts without a soft ERP use)
    * and the contacts' soft CFM. */
   ssSoftness tuned;
-  ssStatus status = ssSoftnessFromSpring(params->spring, SS_PROGRAM_TUNED_STEP_S, &tuned);
+  ssStatus status = ssImplicitEulerSoftness(params->spring, SS_PROGRAM_TUNED_STEP_S, &tuned);
   if (status != SS_OK) {
     destroy(stack);
     *state = NULL;
@@ -123,7 +123,7 @@ static void collide(void* context, ssStepper* stepper) {
 }
 
 /* Before every step: the push on the top box at the time the step starts, then that time moves on by the step. */
-static void before_step(void* context, ssStepper* stepper) {
+static void beforeStep(void* context, ssStepper* stepper) {
   Stack* stack = context;
   if (stack->time_s < STACK_PUSH_UNTIL_S)
     dBodyAddForce(stack->boxes[stack->count - 1],
@@ -132,7 +132,7 @@ static void before_step(void* context, ssStepper* stepper) {
 }
 
 /* How far above its centre a box reaches along world z (m): its half extents projected on z. */
-static double half_height(dBodyID box, double side_m) {
+static double halfHeight(dBodyID box, double side_m) {
   const dReal* rotation = dBodyGetRotation(box);
   return 0.5 * side_m * (fabs(rotation[8]) + fabs(rotation[9]) + fabs(rotation[10]));
 }
@@ -161,8 +161,8 @@ static double check(const void* state, char* worst, size_t size) {
   for (int i = 1; i < stack->count; ++i) {
     const dReal* lower = dBodyGetPosition(stack->boxes[i - 1]);
     const dReal* upper = dBodyGetPosition(stack->boxes[i]);
-    double overlap_m = (lower[2] + half_height(stack->boxes[i - 1], stack->sides_m[i - 1])) -
-                       (upper[2] - half_height(stack->boxes[i], stack->sides_m[i]));
+    double overlap_m = (lower[2] + halfHeight(stack->boxes[i - 1], stack->sides_m[i - 1])) -
+                       (upper[2] - halfHeight(stack->boxes[i], stack->sides_m[i]));
     double offset_m = hypot(upper[0] - lower[0], upper[1] - lower[1]);
     double offset_bound_m = STACK_MAX_OFFSET_OF_SIDE * stack->sides_m[i];
     if (overlap_m / STACK_MAX_OVERLAP_M > use) {
@@ -190,7 +190,7 @@ const ssSceneDesc ssStackScene = {
                  .body_count = 6},
     .max_body_count = STACK_MAX_BOXES,
     .build = build,
-    .before_step = before_step,
+    .before_step = beforeStep,
     .collide = collide,
     .sample = sample,
     .check = check,

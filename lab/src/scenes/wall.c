@@ -58,7 +58,7 @@ static void destroy(void* state) {
   free(wall);
 }
 
-static dBodyID make_body(const ssSceneWorld* world, const dMass* mass, dGeomID geom, double x, double y, double z) {
+static dBodyID makeBody(const ssSceneWorld* world, const dMass* mass, dGeomID geom, double x, double y, double z) {
   dBodyID body = dBodyCreate(world->world);
   dBodySetMass(body, mass);
   dBodySetPosition(body, x, y, z);
@@ -97,7 +97,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
   *wall = (Wall){.count = params->body_count, .bricks = bricks, .starts = starts, .gravity = params->gravity};
   *state = wall;
   ssSoftness tuned;
-  ssStatus status = ssSoftnessFromSpring(params->spring, SS_PROGRAM_TUNED_STEP_S, &tuned);
+  ssStatus status = ssImplicitEulerSoftness(params->spring, SS_PROGRAM_TUNED_STEP_S, &tuned);
   if (status != SS_OK) {
     destroy(wall);
     *state = NULL;
@@ -129,11 +129,11 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
     double y_m = (place - 0.5 * (in_course - 1)) * cell_m;
     double z_m = 0.5 * WALL_SIDE_M + course * cell_m;
     dGeomID geom = dCreateBox(world->space, WALL_SIDE_M, WALL_SIDE_M, WALL_SIDE_M);
-    bricks[i] = make_body(world, &mass, geom, 0, y_m, z_m);
+    bricks[i] = makeBody(world, &mass, geom, 0, y_m, z_m);
     starts[i][0] = 0, starts[i][1] = y_m, starts[i][2] = z_m;
   }
   dMassSetSphereTotal(&mass, WALL_BALL_MASS_OF_BRICKS * params->mass, WALL_BALL_RADIUS_M);
-  wall->ball = make_body(world, &mass, dCreateSphere(world->space, WALL_BALL_RADIUS_M), WALL_BALL_START_X_M, 0,
+  wall->ball = makeBody(world, &mass, dCreateSphere(world->space, WALL_BALL_RADIUS_M), WALL_BALL_START_X_M, 0,
                          WALL_BALL_START_Z_M);
   dBodySetLinearVel(wall->ball, WALL_BALL_SPEED_M_PER_S, 0, WALL_BALL_CLIMB_M_PER_S);
   wall->energy_start_j = energy(wall);

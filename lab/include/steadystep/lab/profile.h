@@ -15,7 +15,7 @@
  *                             SS_MAX_TRACE_LINE_CHARS characters and no NUL byte, at most SS_MAX_TRACE_FRAMES
  *                             durations
  * Rates are in frames per second (> 0), durations in seconds (> 0). Every frame a profile hands out is finite and
- * lies in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S] = [1e-12 s, 3600 s] (limits.h): a spec whose frames
+ * lies in [SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S] = [1e-12 s, 3600 s] (below): a spec whose frames
  * could leave that range is refused, naming the field (so a rate is in [1/3600, 1e12] fps, a jitter's mean ± 3
  * deviations and a hitch's SECONDS inside the range, EVERY a whole number in [1, 1e9]).
  * Messages quote the spec, path and trace line with bytes outside printable ASCII written as \xNN.
@@ -32,6 +32,11 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/** The shortest and longest frame (s) a profile hands out: 1e-12 s to SS_MAX_STEP_S (limits.h), the longest step
+ *  the library takes. Frames shorter than SS_MIN_STEP_S are allowed on purpose, to exercise carrying a frame over. */
+#define SS_MIN_PROFILE_FRAME_S 1e-12
+#define SS_MAX_PROFILE_FRAME_S SS_MAX_STEP_S
 
 /** Bounds on a trace file: bytes read (64 MiB), characters in one line, durations kept (10^7). */
 #define SS_MAX_TRACE_BYTES 67108864

@@ -77,6 +77,15 @@ extern "C" {
 
 #define SS_MAX_QUANTITIES 4
 
+/** A run (ssRun_Execute) takes at most this many frames and this many physics steps: 10^7 each. A run records 2 + 4
+ *  doubles per step, so the largest run holds about 480 MB. A run expected to need more is refused before it
+ *  starts; one that reaches the bound (a random profile's unlucky draw) stops with SS_ERROR_OUT_OF_RANGE. */
+#define SS_MAX_RUN_FRAMES 10000000
+#define SS_MAX_RUN_STEPS 10000000
+
+/** The longest simulated duration (s) of a run: 10^6 s (about 11.6 days). */
+#define SS_MAX_RUN_DURATION_S 1e6
+
 /** The largest |x0| (m) and |gravity| (m/s²) a scene takes: scenes are a few metres across; far beyond these, ODE's
  *  products of error, stiffness and step overflow inside a step (limits.h). */
 #define SS_SCENE_MAX_X0_M 1e3
@@ -233,7 +242,7 @@ typedef struct ssRunDef {
   ssStepping stepping;      /* from ssLabStepping (or ssDefaultStepping with the solver and steps set) */
   const char* profile;      /* profile spec (profile.h) */
   uint64_t seed;            /* profile seed */
-  double duration_s;        /* simulated seconds, in (0, SS_MAX_RUN_DURATION_S] (limits.h) */
+  double duration_s;        /* simulated seconds, in (0, SS_MAX_RUN_DURATION_S] (above) */
 } ssRunDef;
 
 typedef struct ssRun ssRun;
@@ -252,7 +261,7 @@ typedef enum ssRunOutcome {
 /** Runs def to the end, or to the first blow-up or broken step (which is recorded in the run, not an error); the
  *  records run up to and including the step that blew up or broke. Steps after it within the same frame are
  *  simulated (the stepper finishes its frame) but not recorded.
- *  A run takes at most SS_MAX_RUN_FRAMES frames and SS_MAX_RUN_STEPS physics steps (limits.h). One expected to
+ *  A run takes at most SS_MAX_RUN_FRAMES frames and SS_MAX_RUN_STEPS physics steps (above). One expected to
  *  need more (duration_s over the profile's mean frame; steps from the policy's cut) is refused before it starts,
  *  naming duration_s; one that reaches a bound anyway (a random profile's draw) ends with SS_ERROR_OUT_OF_RANGE.
  *  Errors (*out untouched): those of ssScene_Create and ssProfile_Create; SS_ERROR_OUT_OF_RANGE for def, out,
