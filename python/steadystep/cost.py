@@ -10,8 +10,13 @@ For each scene and policy three copies of the scene step the same frame times (a
   substeps included.
 The copies take the frames in blocks, the order of the three rotating from block to block so that all see the same
 machine at the same moments; each ratio is taken per block, and the median and range over the blocks are reported
-(as bench/bench_stepper.c does in C). The stepper's steps are counted on a fourth, untimed copy stepped ahead over
-the same frames. The timing loop runs in C (ssScene_TimeFrames), so that Python's call overhead is not measured.
+(as bench/bench_stepper.c does in C). The timing loop runs in C (ssScene_TimeFrames), so that Python's call overhead
+is not measured.
+
+What the copies step is fixed before any of them is timed, by plan(): the block's length (frames that take about
+BLOCK_TARGET_S plain), the frames, and the stepper's steps over them, counted on a fourth, untimed copy that steps
+the same frames (a third of the benchmark's stepping). Nothing in a plan is timed but the calibration, so a study
+makes the plans in its sweep, wherever its executor runs them, and only the timing runs alone (report_tasks).
 """
 
 from __future__ import annotations
@@ -68,32 +73,89 @@ def _steps_of(counter: runs.Scene, stepping: dict, frames: np.ndarray) -> np.nda
     return np.asarray(steps, dtype=np.float64)
 
 
+@dataclass
+class Plan:
+    """What a cost benchmark steps (plan()): its frames in blocks and the stepper's steps over them, or why there
+    are none (status)."""
+
+    scene: str
+    policy: str
+    profile: str
+    seed: int
+    params: dict | None
+    frames_per_block: int
+    repeats: int
+    probe_steps: np.ndarray   # the stepper's steps (s each) over the calibration frames
+    frames: np.ndarray        # frames_per_block * repeats frames (s each), block after block
+    block_steps: list[np.ndarray]  # the stepper's steps (s each) over each block's frames
+    status: str = "ok"        # "ok", or why the counting stopped (a blow-up)
+
+
+def _calibration_frames(profile: str, seed: int) -> tuple[float, np.ndarray]:
+    """The frame every copy steps first (writes every softness, as a program tunes it once), then the 20 frames
+    the block is calibrated on (stepped by every copy before the blocks, as a warm-up)."""
+    return float(frame_times(profile, 1, seed)[0]), frame_times(profile, 20, seed + 1)
+
+
+def plan(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: int = DEFAULT_REPEATS, seed: int = 1,
+         params: dict | None = None) -> Plan:
+    """The benchmark's frames and the stepper's steps over them: a block is as many frames as take about
+    BLOCK_TARGET_S when the program steps them plain (timed here, once, on a copy of its own), the steps are counted
+    on an untimed copy that steps every frame the timed stepper will."""
+    stepping = runs.make_stepping(policy)
+    counter = runs.Scene(scene, policy, params=params)
+    program = runs.Scene(scene, "naive", params=params)
+    try:
+        first, probe_frames = _calibration_frames(profile, seed)
+        counter.frame(first)
+        program.frame(first)
+        per_frame = max(program.time_frames(probe_frames, plain=True) / len(probe_frames), 1e-7)
+        block = int(min(MAX_BLOCK_FRAMES, max(5, BLOCK_TARGET_S / per_frame)))
+        probe_steps = _steps_of(counter, stepping, probe_frames)
+        frames = frame_times(profile, block * repeats, seed + 2)
+        block_steps = [_steps_of(counter, stepping, frames[r * block:(r + 1) * block]) for r in range(repeats)]
+        return Plan(scene, policy, profile, seed, params, block, repeats, probe_steps, frames, block_steps)
+    except SteadystepError as error:
+        return Plan(scene, policy, profile, seed, params, 0, repeats, np.empty(0), np.empty(0), [],
+                    status=f"{error.status}: {error.message}")
+    finally:
+        counter.close()
+        program.close()
+
+
 def measure(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: int = DEFAULT_REPEATS,
             seed: int = 1, params: dict | None = None) -> Cost:
     """policy against plain ODE on scene under profile's frames: repeats rounds of interleaved blocks."""
-    stepping = runs.make_stepping(policy)
+    return time_plan(plan(scene, policy, profile, repeats, seed, params))
+
+
+def time_plan(planned: Plan) -> Cost:
+    """The benchmark of a plan (made here or elsewhere): the policy and two plain copies of its scene step its
+    blocks, each timed, the order of the three rotating."""
+    scene, policy, profile, repeats, seed, params = (planned.scene, planned.policy, planned.profile, planned.repeats,
+                                                     planned.seed, planned.params)
+    failed = Cost(scene, policy, profile, 0, repeats, math.nan, math.nan, math.nan, math.nan, math.nan, math.nan,
+                  status=planned.status)
+    if planned.status != "ok":
+        return failed
+    block = planned.frames_per_block
     stepped = runs.Scene(scene, policy, params=params)
     same_steps = runs.Scene(scene, policy, params=params)
-    counter = runs.Scene(scene, policy, params=params)
     program = runs.Scene(scene, "naive", params=params)
-    copies = (stepped, same_steps, counter, program)
+    copies = (stepped, same_steps, program)
     try:
-        first = float(frame_times(profile, 1, seed)[0])
+        first, probe_frames = _calibration_frames(profile, seed)
         for copy in copies:
             copy.frame(first)  # writes every softness once, as a program tunes it once
-        # Calibrate: how many frames make a plain block of about BLOCK_TARGET_S.
-        probe_frames = frame_times(profile, 20, seed + 1)
-        wall = program.time_frames(probe_frames, plain=True)
-        same_steps.time_frames(_steps_of(counter, stepping, probe_frames), plain=True)
+        # The calibration's frames again, as the plan's copies stepped them: the same history, and a warm-up.
+        program.time_frames(probe_frames, plain=True)
+        same_steps.time_frames(planned.probe_steps, plain=True)
         stepped.time_frames(probe_frames)
-        per_frame = max(wall / len(probe_frames), 1e-7)
-        block = int(min(MAX_BLOCK_FRAMES, max(5, BLOCK_TARGET_S / per_frame)))
-        frames = frame_times(profile, block * repeats, seed + 2)
         steps_before = stepped.counters()["steps"]
         walls = {"policy": [], "same": [], "program": []}
         for r in range(repeats):
-            chunk = frames[r * block:(r + 1) * block]
-            steps = _steps_of(counter, stepping, chunk)
+            chunk = planned.frames[r * block:(r + 1) * block]
+            steps = planned.block_steps[r]
             timed = {"policy": lambda: stepped.time_frames(chunk),
                      "same": lambda: same_steps.time_frames(steps, plain=True),
                      "program": lambda: program.time_frames(chunk, plain=True)}
@@ -108,9 +170,8 @@ def measure(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: in
                     1e6 * statistics.median(walls["program"]) / block, steps / (block * repeats),
                     statistics.median(overheads), min(overheads), max(overheads))
     except SteadystepError as error:
-        return Cost(scene, policy, profile, 0, repeats, math.nan, math.nan, math.nan, math.nan, math.nan, math.nan,
-                    status=f"{error.status}: {error.message}")
+        failed.status = f"{error.status}: {error.message}"
+        return failed
     finally:
         for copy in copies:
             copy.close()
-
