@@ -37,6 +37,12 @@ DEFAULT_REPEATS = 7
 # of a shared machine.
 BLOCK_TARGET_S = 0.005
 MAX_BLOCK_FRAMES = 2000
+# The benchmark measures at least one whole rotation of the three copies' order (3 blocks), and stops at the end of
+# a rotation once both ratios' ranges over the blocks so far lie within TIGHT_RANGE of their medians: a quiet
+# machine, whose blocks agree to within that. The page calls two policies tied where their ranges overlap; a busy
+# machine widens the ranges, and then every block of `repeats` is measured.
+MIN_REPEATS = 3
+TIGHT_RANGE = 0.02
 
 
 @dataclass
@@ -47,7 +53,7 @@ class Cost:
     policy: str
     profile: str
     frames_per_block: int
-    repeats: int
+    repeats: int              # the blocks measured (fewer than asked for when the ranges were tight: TIGHT_RANGE)
     ratio_median: float       # policy wall time / the program's plain frames, median over the blocks
     ratio_low: float          # the smallest and largest of that ratio over the blocks
     ratio_high: float
@@ -125,13 +131,20 @@ def plan(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: int =
 
 def measure(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: int = DEFAULT_REPEATS,
             seed: int = 1, params: dict | None = None) -> Cost:
-    """policy against plain ODE on scene under profile's frames: repeats rounds of interleaved blocks."""
+    """policy against plain ODE on scene under profile's frames: up to repeats rounds of interleaved blocks
+    (time_plan)."""
     return time_plan(plan(scene, policy, profile, repeats, seed, params))
 
 
-def time_plan(planned: Plan) -> Cost:
+def _tight(ratios: list[float], within: float) -> bool:
+    middle = statistics.median(ratios)
+    return math.isfinite(middle) and max(ratios) - min(ratios) <= within * middle
+
+
+def time_plan(planned: Plan, tight_range: float = TIGHT_RANGE) -> Cost:
     """The benchmark of a plan (made here or elsewhere): the policy and two plain copies of its scene step its
-    blocks, each timed, the order of the three rotating."""
+    blocks, each timed, the order of the three rotating; after every rotation from MIN_REPEATS blocks on, it stops
+    once both ratios' ranges lie within tight_range of their medians (0: every block of the plan)."""
     scene, policy, profile, repeats, seed, params = (planned.scene, planned.policy, planned.profile, planned.repeats,
                                                      planned.seed, planned.params)
     failed = Cost(scene, policy, profile, 0, repeats, math.nan, math.nan, math.nan, math.nan, math.nan, math.nan,
@@ -153,6 +166,7 @@ def time_plan(planned: Plan) -> Cost:
         stepped.time_frames(probe_frames)
         steps_before = stepped.counters()["steps"]
         walls = {"policy": [], "same": [], "program": []}
+        ratios, overheads = [], []
         for r in range(repeats):
             chunk = planned.frames[r * block:(r + 1) * block]
             steps = planned.block_steps[r]
@@ -162,12 +176,16 @@ def time_plan(planned: Plan) -> Cost:
             order = list(timed)[r % 3:] + list(timed)[:r % 3]
             for name in order:
                 walls[name].append(timed[name]())
+            ratios.append(walls["policy"][-1] / walls["program"][-1] if walls["program"][-1] > 0 else math.inf)
+            overheads.append(walls["policy"][-1] / walls["same"][-1] if walls["same"][-1] > 0 else math.inf)
+            measured = r + 1
+            if measured >= MIN_REPEATS and measured % 3 == 0 and _tight(ratios, tight_range) and \
+                    _tight(overheads, tight_range):
+                break
         steps = stepped.counters()["steps"] - steps_before
-        ratios = [a / b if b > 0 else math.inf for a, b in zip(walls["policy"], walls["program"])]
-        overheads = [a / b if b > 0 else math.inf for a, b in zip(walls["policy"], walls["same"])]
-        return Cost(scene, policy, profile, block, repeats, statistics.median(ratios), min(ratios), max(ratios),
+        return Cost(scene, policy, profile, block, measured, statistics.median(ratios), min(ratios), max(ratios),
                     1e6 * statistics.median(walls["policy"]) / block,
-                    1e6 * statistics.median(walls["program"]) / block, steps / (block * repeats),
+                    1e6 * statistics.median(walls["program"]) / block, steps / (block * measured),
                     statistics.median(overheads), min(overheads), max(overheads))
     except SteadystepError as error:
         failed.status = f"{error.status}: {error.message}"
