@@ -91,16 +91,16 @@ class Plan:
     params: dict | None
     frames_per_block: int
     repeats: int
-    probe_steps: np.ndarray   # the stepper's steps (s each) over the calibration frames
+    warmup_frames: np.ndarray  # stepped by every copy before the blocks (s each): one block's worth at most
+    warmup_steps: np.ndarray   # the stepper's steps (s each) over them
     frames: np.ndarray        # frames_per_block * repeats frames (s each), block after block
     block_steps: list[np.ndarray]  # the stepper's steps (s each) over each block's frames
     status: str = "ok"        # "ok", or why the counting stopped (a blow-up)
 
 
-def _calibration_frames(profile: str, seed: int) -> tuple[float, np.ndarray]:
-    """The frame every copy steps first (writes every softness, as a program tunes it once), then the 20 frames
-    the block is calibrated on (stepped by every copy before the blocks, as a warm-up)."""
-    return float(frame_times(profile, 1, seed)[0]), frame_times(profile, 20, seed + 1)
+def _first_frame(profile: str, seed: int) -> float:
+    """The frame every copy steps first: it writes every softness, as a program tunes it once."""
+    return float(frame_times(profile, 1, seed)[0])
 
 
 def plan(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: int = DEFAULT_REPEATS, seed: int = 1,
@@ -112,17 +112,20 @@ def plan(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: int =
     counter = runs.Scene(scene, policy, params=params)
     program = runs.Scene(scene, "naive", params=params)
     try:
-        first, probe_frames = _calibration_frames(profile, seed)
+        first = _first_frame(profile, seed)
         counter.frame(first)
         program.frame(first)
-        per_frame = max(program.time_frames(probe_frames, plain=True) / len(probe_frames), 1e-7)
+        calibration = frame_times(profile, 20, seed + 1)
+        per_frame = max(program.time_frames(calibration, plain=True) / len(calibration), 1e-7)
         block = int(min(MAX_BLOCK_FRAMES, max(5, BLOCK_TARGET_S / per_frame)))
-        probe_steps = _steps_of(counter, stepping, probe_frames)
+        warmup = calibration[:block]
+        warmup_steps = _steps_of(counter, stepping, warmup)
         frames = frame_times(profile, block * repeats, seed + 2)
         block_steps = [_steps_of(counter, stepping, frames[r * block:(r + 1) * block]) for r in range(repeats)]
-        return Plan(scene, policy, profile, seed, params, block, repeats, probe_steps, frames, block_steps)
+        return Plan(scene, policy, profile, seed, params, block, repeats, warmup, warmup_steps, frames, block_steps)
     except SteadystepError as error:
-        return Plan(scene, policy, profile, seed, params, 0, repeats, np.empty(0), np.empty(0), [],
+        nothing = np.empty(0)
+        return Plan(scene, policy, profile, seed, params, 0, repeats, nothing, nothing, nothing, [],
                     status=f"{error.status}: {error.message}")
     finally:
         counter.close()
@@ -157,13 +160,13 @@ def time_plan(planned: Plan, tight_range: float = TIGHT_RANGE) -> Cost:
     program = runs.Scene(scene, "naive", params=params)
     copies = (stepped, same_steps, program)
     try:
-        first, probe_frames = _calibration_frames(profile, seed)
+        first = _first_frame(profile, seed)
         for copy in copies:
-            copy.frame(first)  # writes every softness once, as a program tunes it once
-        # The calibration's frames again, as the plan's copies stepped them: the same history, and a warm-up.
-        program.time_frames(probe_frames, plain=True)
-        same_steps.time_frames(planned.probe_steps, plain=True)
-        stepped.time_frames(probe_frames)
+            copy.frame(first)
+        # A warm-up (caches, branch predictors), untimed; the plan's counter stepped it too: the same history.
+        program.time_frames(planned.warmup_frames, plain=True)
+        same_steps.time_frames(planned.warmup_steps, plain=True)
+        stepped.time_frames(planned.warmup_frames)
         steps_before = stepped.counters()["steps"]
         walls = {"policy": [], "same": [], "program": []}
         ratios, overheads = [], []
