@@ -6,10 +6,10 @@ Prints each timing with its phases (report_tasks: runs, figures still drawing af
 timing, which runs in this process alone either way, with how many of its scene-policy pairs stopped before the
 most blocks because their ranges were tight (cost.TIGHT_RANGE: a quiet machine); "other": the rest, in this process:
 the pool's start-up, the aggregation, the page and the data written), the ratio one process / local pool, and the
-load average before and after (the machine may be shared). The order is serial, local, local, serial (ABBA), so that a drift in the load
-falls on both sides alike; --once measures serial, local once each (half the time). First it prints the
-parallelism the machine gives two processes at that moment (two CPU-bound loops in one process, then in two): a
-shared machine whose cores others take gives about 1, and then no pool can be faster.
+load average before and after (the machine may be shared). The order is serial, local, local, serial (ABBA), so
+that a drift in the load falls on both sides alike; --once measures serial, local once each (half the time). First
+it prints the parallelism the machine gives two processes at that moment (two CPU-bound loops in one process, then
+in two): a shared machine whose cores others take gives about 1, and then no pool can be faster.
 Usage: python bench/bench_report.py [DURATION_S] [--once] (default 5, the report's)
 """
 

@@ -126,8 +126,9 @@ def cost_table(report: Report) -> dict:
                      f"{number(c.ratio_low)} – {number(c.ratio_high)}" if ok else "-",
                      f"×{number(c.overhead_median, 4)}" if ok else "-",
                      f"{number(c.overhead_low, 4)} – {number(c.overhead_high, 4)}" if ok else "-"])
-    return {"header": ["scene", "policy", "blocks", "steps / frame", "µs / frame", "per frame / program's own (median)",
-                       "range over blocks", "library: / plain ODE at the same steps (median)", "range over blocks"],
+    return {"header": ["scene", "policy", "blocks", "steps / frame", "µs / frame",
+                       "per frame / program's own (median)", "range over blocks",
+                       "library: / plain ODE at the same steps (median)", "range over blocks"],
             "rows": rows}
 
 
