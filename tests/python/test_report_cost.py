@@ -29,8 +29,8 @@ def test_a_plan_made_in_a_worker_is_what_the_timed_stepper_steps(scene, policy):
 
 @pytest.mark.parametrize("repeats, tight_range, blocks", [(7, math.inf, 3), (4, math.inf, 3), (7, 0.0, 7),
                                                           (2, math.inf, 2)])
-def test_the_timing_stops_early_only_after_whole_rotations_whose_ranges_are_tight(repeats, tight_range, blocks):
-    """A range always within inf of its median stops at the first rotation (3 blocks, one per position of each
+def test_the_timing_stops_early_only_after_a_whole_rotation_whose_ranges_are_tight(repeats, tight_range, blocks):
+    """A range always within inf of its median stops after the first rotation (3 blocks, one per position of each
     copy); within 0 (blocks that never time alike) never; a plan shorter than a rotation is measured whole."""
     planned = cost.plan("oscillator", "matched", repeats=repeats)
     measured = cost.time_plan(planned, tight_range=tight_range)
