@@ -111,7 +111,8 @@ def served_table(report: Report) -> dict:
 
 
 def _blocks(costs) -> str:
-    """How many blocks the benchmark measured: "7", or "3 to 7" when some pairs stopped early (cost.TIGHT_RANGE)."""
+    """How many blocks the benchmark measured: "7", or "3 to 7" when some pairs stopped after a rotation
+    (cost.TIGHT_RANGE)."""
     counts = sorted({c.repeats for c in costs if c.status == "ok"}) or [0]
     return f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
 
