@@ -10,8 +10,13 @@ For each scene and policy three copies of the scene step the same frame times (a
   substeps included.
 The copies take the frames in blocks, the order of the three rotating from block to block so that all see the same
 machine at the same moments; each ratio is taken per block, and the median and range over the blocks are reported
-(as bench/bench_stepper.c does in C). The stepper's steps are counted on a fourth, untimed copy stepped ahead over
-the same frames. The timing loop runs in C (ssScene_TimeFrames), so that Python's call overhead is not measured.
+(as bench/bench_stepper.c does in C). The timing loop runs in C (ssScene_TimeFrames), so that Python's call overhead
+is not measured.
+
+What the copies step is fixed before any of them is timed, by plan(): the block's length (frames that take about
+BLOCK_TARGET_S plain), the frames, and the stepper's steps over them, counted on a fourth, untimed copy that steps
+the same frames (a third of the benchmark's stepping). Nothing in a plan is timed but the calibration, so a study
+makes the plans in its sweep, wherever its executor runs them, and only the timing runs alone (report_tasks).
 """
 
 from __future__ import annotations
@@ -32,6 +37,12 @@ DEFAULT_REPEATS = 7
 # of a shared machine.
 BLOCK_TARGET_S = 0.005
 MAX_BLOCK_FRAMES = 2000
+# The benchmark stops after one whole rotation of the three copies' order (MIN_REPEATS blocks) when both ratios'
+# ranges over them lie within TIGHT_RANGE of their medians: a quiet machine, whose blocks agree to within that. The
+# page calls two policies tied where their ranges overlap; a busy machine widens the ranges, and then every block of
+# `repeats` is measured.
+MIN_REPEATS = 3
+TIGHT_RANGE = 0.02
 
 
 @dataclass
@@ -42,7 +53,7 @@ class Cost:
     policy: str
     profile: str
     frames_per_block: int
-    repeats: int
+    repeats: int              # the blocks measured (fewer than asked for when the ranges were tight: TIGHT_RANGE)
     ratio_median: float       # policy wall time / the program's plain frames, median over the blocks
     ratio_low: float          # the smallest and largest of that ratio over the blocks
     ratio_high: float
@@ -68,49 +79,119 @@ def _steps_of(counter: runs.Scene, stepping: dict, frames: np.ndarray) -> np.nda
     return np.asarray(steps, dtype=np.float64)
 
 
-def measure(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: int = DEFAULT_REPEATS,
-            seed: int = 1, params: dict | None = None) -> Cost:
-    """policy against plain ODE on scene under profile's frames: repeats rounds of interleaved blocks."""
+@dataclass
+class Plan:
+    """What a cost benchmark steps (plan()): its frames in blocks and the stepper's steps over them, or why there
+    are none (status)."""
+
+    scene: str
+    policy: str
+    profile: str
+    seed: int
+    params: dict | None
+    frames_per_block: int
+    repeats: int
+    warmup_frames: np.ndarray  # stepped by every copy before the blocks (s each): one block's worth at most
+    warmup_steps: np.ndarray   # the stepper's steps (s each) over them
+    frames: np.ndarray        # frames_per_block * repeats frames (s each), block after block
+    block_steps: list[np.ndarray]  # the stepper's steps (s each) over each block's frames
+    status: str = "ok"        # "ok", or why the counting stopped (a blow-up)
+
+
+def _first_frame(profile: str, seed: int) -> float:
+    """The frame every copy steps first: it writes every softness, as a program tunes it once."""
+    return float(frame_times(profile, 1, seed)[0])
+
+
+def plan(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: int = DEFAULT_REPEATS, seed: int = 1,
+         params: dict | None = None) -> Plan:
+    """The benchmark's frames and the stepper's steps over them: a block is as many frames as take about
+    BLOCK_TARGET_S when the program steps them plain (timed here, once, on a copy of its own), the steps are counted
+    on an untimed copy that steps every frame the timed stepper will."""
     stepping = runs.make_stepping(policy)
-    stepped = runs.Scene(scene, policy, params=params)
-    same_steps = runs.Scene(scene, policy, params=params)
     counter = runs.Scene(scene, policy, params=params)
     program = runs.Scene(scene, "naive", params=params)
-    copies = (stepped, same_steps, counter, program)
     try:
-        first = float(frame_times(profile, 1, seed)[0])
-        for copy in copies:
-            copy.frame(first)  # writes every softness once, as a program tunes it once
-        # Calibrate: how many frames make a plain block of about BLOCK_TARGET_S.
-        probe_frames = frame_times(profile, 20, seed + 1)
-        wall = program.time_frames(probe_frames, plain=True)
-        same_steps.time_frames(_steps_of(counter, stepping, probe_frames), plain=True)
-        stepped.time_frames(probe_frames)
-        per_frame = max(wall / len(probe_frames), 1e-7)
+        first = _first_frame(profile, seed)
+        counter.frame(first)
+        program.frame(first)
+        calibration = frame_times(profile, 20, seed + 1)
+        per_frame = max(program.time_frames(calibration, plain=True) / len(calibration), 1e-7)
         block = int(min(MAX_BLOCK_FRAMES, max(5, BLOCK_TARGET_S / per_frame)))
+        warmup = calibration[:block]
+        warmup_steps = _steps_of(counter, stepping, warmup)
         frames = frame_times(profile, block * repeats, seed + 2)
+        block_steps = [_steps_of(counter, stepping, frames[r * block:(r + 1) * block]) for r in range(repeats)]
+        return Plan(scene, policy, profile, seed, params, block, repeats, warmup, warmup_steps, frames, block_steps)
+    except SteadystepError as error:
+        nothing = np.empty(0)
+        return Plan(scene, policy, profile, seed, params, 0, repeats, nothing, nothing, nothing, [],
+                    status=f"{error.status}: {error.message}")
+    finally:
+        counter.close()
+        program.close()
+
+
+def measure(scene: str, policy: str, profile: str = DEFAULT_PROFILE, repeats: int = DEFAULT_REPEATS,
+            seed: int = 1, params: dict | None = None) -> Cost:
+    """policy against plain ODE on scene under profile's frames: up to repeats rounds of interleaved blocks
+    (time_plan)."""
+    return time_plan(plan(scene, policy, profile, repeats, seed, params))
+
+
+def _tight(ratios: list[float], within: float) -> bool:
+    middle = statistics.median(ratios)
+    return math.isfinite(middle) and max(ratios) - min(ratios) <= within * middle
+
+
+def time_plan(planned: Plan, tight_range: float = TIGHT_RANGE) -> Cost:
+    """The benchmark of a plan (made here or elsewhere): the policy and two plain copies of its scene step its
+    blocks, each timed, the order of the three rotating; it stops after the first MIN_REPEATS blocks (a rotation)
+    when both ratios' ranges over them lie within tight_range of their medians (0: every block of the plan)."""
+    scene, policy, profile, repeats, seed, params = (planned.scene, planned.policy, planned.profile, planned.repeats,
+                                                     planned.seed, planned.params)
+    failed = Cost(scene, policy, profile, 0, repeats, math.nan, math.nan, math.nan, math.nan, math.nan, math.nan,
+                  status=planned.status)
+    if planned.status != "ok":
+        return failed
+    block = planned.frames_per_block
+    stepped = runs.Scene(scene, policy, params=params)
+    same_steps = runs.Scene(scene, policy, params=params)
+    program = runs.Scene(scene, "naive", params=params)
+    copies = (stepped, same_steps, program)
+    try:
+        first = _first_frame(profile, seed)
+        for copy in copies:
+            copy.frame(first)
+        # A warm-up (caches, branch predictors), untimed; the plan's counter stepped it too: the same history.
+        program.time_frames(planned.warmup_frames, plain=True)
+        same_steps.time_frames(planned.warmup_steps, plain=True)
+        stepped.time_frames(planned.warmup_frames)
         steps_before = stepped.counters()["steps"]
         walls = {"policy": [], "same": [], "program": []}
+        ratios, overheads = [], []
         for r in range(repeats):
-            chunk = frames[r * block:(r + 1) * block]
-            steps = _steps_of(counter, stepping, chunk)
+            chunk = planned.frames[r * block:(r + 1) * block]
+            steps = planned.block_steps[r]
             timed = {"policy": lambda: stepped.time_frames(chunk),
                      "same": lambda: same_steps.time_frames(steps, plain=True),
                      "program": lambda: program.time_frames(chunk, plain=True)}
             order = list(timed)[r % 3:] + list(timed)[:r % 3]
             for name in order:
                 walls[name].append(timed[name]())
+            ratios.append(walls["policy"][-1] / walls["program"][-1] if walls["program"][-1] > 0 else math.inf)
+            overheads.append(walls["policy"][-1] / walls["same"][-1] if walls["same"][-1] > 0 else math.inf)
+            measured = r + 1
+            if measured == MIN_REPEATS and _tight(ratios, tight_range) and _tight(overheads, tight_range):
+                break  # checked once: more blocks only widen a range
         steps = stepped.counters()["steps"] - steps_before
-        ratios = [a / b if b > 0 else math.inf for a, b in zip(walls["policy"], walls["program"])]
-        overheads = [a / b if b > 0 else math.inf for a, b in zip(walls["policy"], walls["same"])]
-        return Cost(scene, policy, profile, block, repeats, statistics.median(ratios), min(ratios), max(ratios),
+        return Cost(scene, policy, profile, block, measured, statistics.median(ratios), min(ratios), max(ratios),
                     1e6 * statistics.median(walls["policy"]) / block,
-                    1e6 * statistics.median(walls["program"]) / block, steps / (block * repeats),
+                    1e6 * statistics.median(walls["program"]) / block, steps / (block * measured),
                     statistics.median(overheads), min(overheads), max(overheads))
     except SteadystepError as error:
-        return Cost(scene, policy, profile, 0, repeats, math.nan, math.nan, math.nan, math.nan, math.nan, math.nan,
-                    status=f"{error.status}: {error.message}")
+        failed.status = f"{error.status}: {error.message}"
+        return failed
     finally:
         for copy in copies:
             copy.close()
-

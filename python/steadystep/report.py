@@ -65,7 +65,7 @@ def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: f
                                                    for profile in SIDE_BY_SIDE_PROFILES
                                                    for policy in runs.policy_names()], point)
     report.animation = done.get(("animation", None))
-    report_tasks.costs(report, params, progress)
+    report_tasks.costs(report, done, progress)
     report.elapsed_s = time.perf_counter() - started
     return report
 

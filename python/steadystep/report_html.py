@@ -13,7 +13,7 @@ from pathlib import Path
 
 from markupsafe import Markup
 
-from steadystep import animation, figures, page, runs
+from steadystep import animation, cost, figures, page, runs
 from steadystep.report_export import swept_axes
 from steadystep.report_model import Report
 from steadystep.report_tasks import NOT_PROBED
@@ -110,18 +110,26 @@ def served_table(report: Report) -> dict:
     return {"header": header, "rows": rows}
 
 
+def _blocks(costs) -> str:
+    """How many blocks the benchmark measured: "7", or "3 to 7" when some pairs stopped after a rotation
+    (cost.TIGHT_RANGE)."""
+    counts = sorted({c.repeats for c in costs if c.status == "ok"}) or [0]
+    return f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
+
+
 def cost_table(report: Report) -> dict:
     rows = []
     for c in report.costs:
         ok = c.status == "ok"
-        rows.append([c.scene, policy_cell(c.policy), number(c.steps_per_frame),
+        rows.append([c.scene, policy_cell(c.policy), str(c.repeats) if ok else "-", number(c.steps_per_frame),
                      number(c.us_per_frame) if ok else bad(c.status),
                      f"×{number(c.ratio_median)}" if ok else "-",
                      f"{number(c.ratio_low)} – {number(c.ratio_high)}" if ok else "-",
                      f"×{number(c.overhead_median, 4)}" if ok else "-",
                      f"{number(c.overhead_low, 4)} – {number(c.overhead_high, 4)}" if ok else "-"])
-    return {"header": ["scene", "policy", "steps / frame", "µs / frame", "per frame / program's own (median)",
-                       "range over blocks", "library: / plain ODE at the same steps (median)", "range over blocks"],
+    return {"header": ["scene", "policy", "blocks", "steps / frame", "µs / frame",
+                       "per frame / program's own (median)", "range over blocks",
+                       "library: / plain ODE at the same steps (median)", "range over blocks"],
             "rows": rows}
 
 
@@ -198,7 +206,7 @@ def as_html(report: Report, command: str, article_paths: list[Path]) -> str:
         side_by_side=side_by_side_table(report) if report.side_by_side else None,
         cost=cost_table(report) if report.costs else None,
         cost_profile=report.costs[0].profile if report.costs else "-",
-        cost_repeats=report.costs[0].repeats if report.costs else 0,
+        cost_repeats=_blocks(report.costs), cost_tight=f"{100 * cost.TIGHT_RANGE:g} %",
         stable=stable_table(report) if report.probes else None,
         not_probed=[(scene, NOT_PROBED.get(scene, "")) for scene in report.not_probed],
         article=embed(pngs[0]) if pngs else None,

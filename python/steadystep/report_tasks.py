@@ -1,15 +1,16 @@
 """The comparison's task graph and its phases.
 
 Every piece of the comparison that does not depend on another is a unit (a reference run, a run, a repeat of a
-run under the next seed, one largest-stable-step bisection, the animation's recording, a scene's figures), run
-wherever the executor puts it. The phases, each named on the progress bar:
+run under the next seed, one largest-stable-step bisection, the animation's recording, the plan of a cost
+benchmark, a scene's figures), run wherever the executor puts it. The phases, each named on the progress bar:
 
-1. runs: references first (the longest, at 1 ms steps), then each scene's runs, then the bisections;
+1. runs: references first (the longest, at 1 ms steps), then each scene's runs, then the bisections, then the cost
+   benchmark's plans (its frames and the stepper's steps over them, counted untimed: cost.plan);
 2. figures: a scene's figures (one unit each) are drawn in a worker as soon as that scene's reference and runs
    are back, ahead of the units still waiting, so that they fill the sweep instead of following it (the unit
    returns the files' bytes; they are written here, on this machine, whatever executor drew them);
-3. cost: the benchmark runs in this process once every unit is done, so that its timings are taken while nothing
-   else of the study runs; the aggregation and the page do not wait for anything else.
+3. cost: the benchmark times its plans in this process once every unit is done, so that its timings are taken
+   while nothing else of the study runs; the aggregation and the page do not wait for anything else.
 """
 
 from __future__ import annotations
@@ -59,13 +60,15 @@ def scene_figures(scene: str, figure: str, profiles: list[str], policies: list[s
 def unit(kind: str, **arguments):
     """One independent piece of the comparison, run wherever the executor puts it."""
     return {"reference": runs.reference_run, "run": runs.run, "probe": probe.largest_stable_step,
-            "animation": animation.record, "figures": scene_figures}[kind](**arguments)
+            "animation": animation.record, "figures": scene_figures, "cost plan": cost.plan}[kind](**arguments)
 
 
 def label(task: dict) -> str:
     """What the progress bar says of a finished unit."""
     if task["kind"] in ("animation", "figures"):
         return f"{task.get('scene', '')} {task['kind']}".strip()
+    if task["kind"] == "cost plan":
+        return f"{task['scene']} {task['policy']} cost plan"
     words = [task["scene"], task.get("profile", "reference" if task["kind"] == "reference" else ""),
              task.get("policy", ""), "(seed + 1)" if task.get("repeat") else ""]
     if task["kind"] == "probe":
@@ -81,8 +84,8 @@ def repeat_profiles(profiles: list[str], seed: int) -> list[str]:
 
 def tasks(report, params: dict, springs: list[dict], steps: list[dict], probed: list[str]) -> dict[tuple, dict]:
     """Every unit of phase 1 by key, in the order they are started: the references (the longest, at 1 ms steps),
-    each scene's runs (so that its figures can start while the rest runs), the side-by-side runs, the bisections
-    and the animation."""
+    each scene's runs (so that its figures can start while the rest runs), the side-by-side runs, the bisections,
+    the animation and the cost benchmark's plans (short: they fill the sweep's end)."""
     duration_s, seed, out = report.duration_s, report.seed, {}
     for scene in report.scenes:
         for i, point in enumerate(springs):
@@ -116,6 +119,10 @@ def tasks(report, params: dict, springs: list[dict], steps: list[dict], probed: 
     if animation.SCENE in report.scenes:
         out["animation", None] = dict(kind="animation", duration_s=duration_s, seed=seed,
                                       params=with_spring(params.get(animation.SCENE), springs[0]))
+    for scene in report.scenes:
+        for policy in report.policies[scene]:
+            out["cost", scene, policy] = dict(kind="cost plan", scene=scene, policy=policy, seed=seed,
+                                              params=params.get(scene))
     return out
 
 
@@ -211,14 +218,15 @@ def run_phases(report, units: dict[tuple, dict], executor, progress: bool | None
     return done
 
 
-def costs(report, params: dict, progress: bool | None) -> None:
-    """Phase 3: cost.measure for every scene and policy in this process, once every unit is done, so that its
-    timings are taken while nothing else of the study runs."""
+def costs(report, done: dict, progress: bool | None) -> None:
+    """Phase 3: the cost benchmark of every scene and policy timed in this process (cost.time_plan of its plan,
+    made in phase 1), once every unit is done, so that its timings are taken while nothing else of the study
+    runs."""
     pairs = [(scene, policy) for scene in report.scenes for policy in report.policies[scene]]
     started = time.perf_counter()
     with study.progress_bar(len(pairs), progress, "steadystep compare [cost against plain ODE]", "run") as bar:
         for scene, policy in pairs:
-            report.costs.append(cost.measure(scene, policy, seed=report.seed, params=params.get(scene)))
+            report.costs.append(cost.time_plan(done["cost", scene, policy]))
             bar.set_postfix_str(f"{scene} {policy}", refresh=False)
             bar.update()
     report.cost_wall_s = report.phases_s["cost"] = time.perf_counter() - started

@@ -101,7 +101,8 @@ bound and no contact softened through the stepper are left out.</p>
 <p class=small>One benchmark run of {{ "%.1f"|format(report.cost_wall_s) }} s, alone on the machine's share of this
 study (after every run and figure): each policy and two plain ODE copies of the same scene take the same
 {{ cost_profile }} frames in {{ cost_repeats }} blocks, the order of the three rotating; each ratio is taken per
-block, its median and range shown. The program's own: collide, one dWorldQuickStep of each whole frame, softness as
+block, its median and range shown (the blocks column: 3 where the first rotation's blocks already agreed within
+{{ cost_tight }} in both ratios). The program's own: collide, one dWorldQuickStep of each whole frame, softness as
 tuned once for 30 fps (a program without the library). Plain ODE at the same steps: one dWorldQuickStep per step the
 stepper takes, no library call in between; its ratio is what the library itself costs. The timing loop runs in C
 (ssScene_TimeFrames). Where two policies' ranges overlap, the recommendation calls them tied.</p>
