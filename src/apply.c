@@ -25,7 +25,10 @@
  *    leaves its own there and says so in computed_mapping); a binding, a load or a load's fallback voids it
  *    (computed_step_s = NAN). The mappings are pure functions of these inputs, so equal inputs reuse it.
  *  - Within one Apply only: the shared-softness ring maps (law, mass) to a softness computed in this Apply, and a
- *    stop and a motor on one axis (sharesRow) share the mass measured for the first.
+ *    stop and a motor on one axis (sharesRow) share the mass measured for the first. The law fallbacks hold the
+ *    implicit-Euler softness of each law of the table for this step, given (without the accurate arithmetic) to
+ *    the unloaded rows that ssSurelyFailsStaticResponse says the rule hands on: ssRowSoftness gives those rows
+ *    exactly that softness and fallback (row_law.h; tested against it in test_apply.cpp).
  *  - disabled_caches turns caches off one by one (ssRegistryDisableCaches): bench_apply measures what each buys,
  *    and the differential check requires the same values either way. */
 #include <math.h>
@@ -104,6 +107,17 @@ static int sameLaw(const ssRowLaw* a, const ssRowLaw* b) {
 static int sharedLaw(const SharedSoftness* shared, const ssRowLaw* law, int law_slot) {
   if (shared->law_slot >= 0 && law_slot >= 0) return shared->law_slot == law_slot;
   return sameLaw(shared->law, law);
+}
+
+/* The softness computed in this Apply for the row's law and mass (any mass where the mapping reads none) with the
+ * same load declared, or NULL. */
+static const SharedSoftness* findShared(const SharedSoftness* shared, int count, const ssRowLaw* law, int law_slot,
+                                        int any_mass, double mass, int load_declared) {
+  for (int j = 0; j < count; ++j)
+    if ((any_mass || shared[j].mass == mass) && shared[j].load_declared == load_declared &&
+        sharedLaw(&shared[j], law, law_slot))
+      return &shared[j];
+  return NULL;
 }
 
 /* Gives every row in the law table its written back from law_written: before a pass that reads the rows' own, and
@@ -244,6 +258,30 @@ static int sameWrite(int erp_number, const ssSoftness* a, const ssSoftness* b) {
   return ssSameInOde(a->cfm, b->cfm) && (erp_number < 0 || ssSameInOde(a->erp, b->erp));
 }
 
+/* The implicit-Euler softness of the laws in the table that rows of one Apply were handed to, each computed (and
+ * checked) at its first use in the Apply. */
+typedef struct LawFallbacks {
+  unsigned char known[kLawTableSize];
+  ssSoftness softness[kLawTableSize];
+} LawFallbacks;
+
+/* The softness ssRowSoftness gives a row an accurate mapping hands to implicit Euler: the law's implicit-Euler
+ * softness, checked for ODE as every computed softness is. */
+static ssStatus lawFallback(const ssRowLaw* law, int law_slot, double step_s, LawFallbacks* fallbacks,
+                            ssSoftness* out) {
+  if (law_slot >= 0 && fallbacks->known[law_slot]) {
+    *out = fallbacks->softness[law_slot];
+    return SS_OK;
+  }
+  ssStatus status = ssRowSoftness(law, SS_MAPPING_IMPLICIT_EULER, NAN, step_s, 0, 0, NULL, out);
+  if (status == SS_OK) status = ssCheckSoftnessForOde("softness", out->erp, out->cfm);
+  if (status == SS_OK && law_slot >= 0) {
+    fallbacks->known[law_slot] = 1;
+    fallbacks->softness[law_slot] = *out;
+  }
+  return status;
+}
+
 /* Apply's first pass in general: each row's mass and softness into pending, and the load corrections, all checked
  * before anything is written. */
 static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step_s, double previous_s, int measure,
@@ -256,6 +294,8 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
   SharedSoftness shared[kSharedSize];
   int shared_count = 0, shared_next = 0;
   double last_mass = NAN;
+  LawFallbacks fallbacks;
+  memset(fallbacks.known, 0, sizeof fallbacks.known);
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
     PREFETCH_ROWS(registry, i, 2);
@@ -276,12 +316,20 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     }
     binding->mass = mass;
     int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
-    const SharedSoftness* hit = NULL;
-    for (int j = 0; j < shared_count && hit == NULL; ++j)
-      if ((any_mass || shared[j].mass == mass) && shared[j].load_declared == (binding->load != 0) &&
-          sharedLaw(&shared[j], law, binding->law_slot))
-        hit = &shared[j];
-    if (hit != NULL) {
+    const SharedSoftness* hit;
+    /* a row the rule surely hands to implicit Euler gets the law's implicit-Euler softness, without the accurate
+     * arithmetic whose only use would be to decide so (a declared load keeps the accurate softness instead) */
+    if (!any_mass && !(registry->disabled_caches & SS_CACHE_SURE_FALLBACK) &&
+        !(binding->load != 0 && law->spring.stiffness > 0) && ssSurelyFailsStaticResponse(law->spring, mass, step_s)) {
+      status = lawFallback(law, binding->law_slot, step_s, &fallbacks, &binding->pending);
+      if (status != SS_OK) {
+        binding->computed_step_s = NAN;
+        return failBinding(status, binding);
+      }
+      binding->computed_fallback = (ssRowFallback){0, 1};
+      countRow(&binding->computed_fallback, counts);
+    } else if ((hit = findShared(shared, shared_count, law, binding->law_slot, any_mass, mass,
+                                 binding->load != 0)) != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
       countRow(&hit->fallback, counts);
