@@ -126,7 +126,7 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
         *out = matched;
         return SS_OK;
       }
-      status = ssExactSoftness(law->spring, mass, step_s, previous_step_s, out);
+      status = ssExactSoftnessQuiet(law->spring, mass, step_s, previous_step_s, out);
       if (status == SS_OK) return SS_OK;
       if (status != SS_ERROR_NO_FINITE_MAPPING) return status;
       *out = matched;
