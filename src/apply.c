@@ -24,7 +24,7 @@
  *    computed_step_s, computed_previous_s) where computed_mapping is an accurate one (implicit Euler's general pass
  *    leaves its own there and says so in computed_mapping); a binding, a load or a load's fallback voids it
  *    (computed_step_s = NAN). The mappings are pure functions of these inputs, so equal inputs reuse it.
- *  - Within one Apply only: the shared-softness ring maps (law, mass) to a softness computed in this Apply, and a
+ *  - Within one Apply only: the shared-softness table maps (law, mass) to a softness computed in this Apply, and a
  *    stop and a motor on one axis (sharesRow) share the mass measured for the first. The law fallbacks hold the
  *    implicit-Euler softness of each law of the table for this step, given (without the accurate arithmetic) to
  *    the unloaded rows that ssSurelyFailsStaticResponse says the rule hands on: ssRowSoftness gives those rows
@@ -109,14 +109,37 @@ static int sharedLaw(const SharedSoftness* shared, const ssRowLaw* law, int law_
   return sameLaw(shared->law, law);
 }
 
+/* The softnesses one Apply computed, direct-mapped by law, mass and load: a row looks in one entry only (rows with
+ * distinct masses, which never share, pay one comparison). */
+enum { kSharedSize = 16 };
+typedef struct SharedTable {
+  unsigned char used[kSharedSize];
+  SharedSoftness entries[kSharedSize];
+} SharedTable;
+
+static uint64_t bitsOf(double value) {
+  uint64_t bits;
+  memcpy(&bits, &value, sizeof bits);
+  return bits;
+}
+
+/* The entry of (law, mass, load): equal laws (by slot, or outside the table by k and c) and equal masses land on
+ * one entry. any_mass: the mapping reads no mass for the law. */
+static unsigned sharedSlot(const ssRowLaw* law, int law_slot, int any_mass, double mass, int load_declared) {
+  uint64_t key = law_slot >= 0 ? (uint64_t)law_slot : bitsOf(law->spring.stiffness) ^ bitsOf(law->spring.damping);
+  if (!any_mass) key ^= bitsOf(mass) * 0x9E3779B97F4A7C15ull;
+  key = (key ^ (uint64_t)load_declared) * 0x9E3779B97F4A7C15ull;
+  return (unsigned)(key >> 60); /* the top 4 bits: kSharedSize entries */
+}
+
 /* The softness computed in this Apply for the row's law and mass (any mass where the mapping reads none) with the
  * same load declared, or NULL. */
-static const SharedSoftness* findShared(const SharedSoftness* shared, int count, const ssRowLaw* law, int law_slot,
+static const SharedSoftness* findShared(const SharedTable* table, unsigned slot, const ssRowLaw* law, int law_slot,
                                         int any_mass, double mass, int load_declared) {
-  for (int j = 0; j < count; ++j)
-    if ((any_mass || shared[j].mass == mass) && shared[j].load_declared == load_declared &&
-        sharedLaw(&shared[j], law, law_slot))
-      return &shared[j];
+  const SharedSoftness* entry = &table->entries[slot];
+  if (table->used[slot] && (any_mass || entry->mass == mass) && entry->load_declared == load_declared &&
+      sharedLaw(entry, law, law_slot))
+    return entry;
   return NULL;
 }
 
@@ -290,9 +313,8 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
   /* Programs bind many rows to a few springs, and many rows move equal masses (identical links, wheels, stop and
    * motor on one axis): within one Apply the softness is a function of the law and (accurate mappings) the mass, so
    * each distinct pair is computed once and shared. */
-  enum { kSharedSize = 8 };
-  SharedSoftness shared[kSharedSize];
-  int shared_count = 0, shared_next = 0;
+  SharedTable shared;
+  memset(shared.used, 0, sizeof shared.used);
   double last_mass = NAN;
   LawFallbacks fallbacks;
   memset(fallbacks.known, 0, sizeof fallbacks.known);
@@ -317,6 +339,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     binding->mass = mass;
     int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
     const SharedSoftness* hit;
+    unsigned slot = 0;
     /* a row the rule surely hands to implicit Euler gets the law's implicit-Euler softness, without the accurate
      * arithmetic whose only use would be to decide so (a declared load keeps the accurate softness instead) */
     if (!any_mass && !(registry->disabled_caches & SS_CACHE_SURE_FALLBACK) &&
@@ -328,8 +351,8 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       }
       binding->computed_fallback = (ssRowFallback){0, 1};
       countRow(&binding->computed_fallback, counts);
-    } else if ((hit = findShared(shared, shared_count, law, binding->law_slot, any_mass, mass,
-                                 binding->load != 0)) != NULL) {
+    } else if ((slot = sharedSlot(law, binding->law_slot, any_mass, mass, binding->load != 0),
+                hit = findShared(&shared, slot, law, binding->law_slot, any_mass, mass, binding->load != 0)) != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
       countRow(&hit->fallback, counts);
@@ -343,11 +366,9 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
         return failBinding(status, binding);
       }
       if (!(registry->disabled_caches & SS_CACHE_SHARED)) {
-        shared[shared_next] =
-            (SharedSoftness){law, binding->law_slot, mass, binding->load != 0, binding->pending,
-                             binding->computed_fallback};
-        shared_next = (shared_next + 1) % kSharedSize;
-        if (shared_count < kSharedSize) shared_count += 1;
+        shared.entries[slot] = (SharedSoftness){law, binding->law_slot, mass, binding->load != 0, binding->pending,
+                                                binding->computed_fallback};
+        shared.used[slot] = 1;
       }
     }
     *unwritten += !sameWrite(binding->writer.erp_number, &binding->pending, &binding->written);

@@ -80,12 +80,12 @@ static inline int ssSurelyFailsStaticResponse(ssSpring spring, double mass, doub
    * series' sums to w³ (above) and to w⁴ (below, still positive); the numerator grows with both. */
   const double k = spring.stiffness, c = spring.damping;
   if (!(k <= 1e150 && c >= 1e-150 && c <= 1e150 && mass >= 1e-150 && mass <= 1e150)) return 0;
-  double x = c / (2.0 * mass) * step_s;
+  double h_over_m = step_s / mass, x = 0.5 * c * h_over_m; /* within roundings of the mapping's: the margin's */
   /* a damper (k = 0): matched's static damping is c·cfm = 2x/(e^(2x) - 1), below 1 - tol from x = 0.0513 on and
    * decreasing (0.9412 at x = 0.06): the motor rows of a program tuned at ODE's CFM 1e-10 are far beyond */
   if (k == 0) return x >= 0.06;
   if (!(k >= 1e-150)) return 0;
-  double kh2_over_m = k / mass * step_s * step_s;
+  double kh2_over_m = k * h_over_m * step_s;
   double w = kh2_over_m - x * x;
   if (!(x >= 1e-8 && x <= 1.0 && w >= 0.0 && w <= 4.0)) return 0;
   double x2 = x * x;
@@ -96,8 +96,8 @@ static inline int ssSurelyFailsStaticResponse(ssSpring spring, double mass, doub
   double n_low = e_low * e_low + 2.0 * (1.0 + e_low) * c_low;
   double n_high = e_high * e_high + 2.0 * (1.0 + e_high) * c_high;
   const double margin = 1e-6; /* against this function's roundings and those of the softness and its check */
-  return n_high < kh2_over_m * (1.0 - margin) / (1.0 + SS_STATIC_RESPONSE_TOLERANCE) ||
-         n_low > kh2_over_m * (1.0 + margin) / (1.0 - SS_STATIC_RESPONSE_TOLERANCE);
+  return n_high < kh2_over_m * ((1.0 - margin) / (1.0 + SS_STATIC_RESPONSE_TOLERANCE)) ||
+         n_low > kh2_over_m * ((1.0 + margin) / (1.0 - SS_STATIC_RESPONSE_TOLERANCE));
 }
 
 /* w·h > π, i.e. k·h² > π²·m: the spring's natural frequency is above half the step rate. False for a NAN
