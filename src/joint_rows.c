@@ -205,7 +205,8 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < 3; ++k) scaled[i][k] = R[4 * i + k] * inverse[k];
     double* M = out->inverse_inertia;
-#define SS_PRINCIPAL_ENTRY(i, j) (scaled[i][0] * R[4 * (j)] + scaled[i][1] * R[4 * (j) + 1] + scaled[i][2] * R[4 * (j) + 2])
+#define SS_PRINCIPAL_ENTRY(i, j) \
+  (scaled[i][0] * R[4 * (j)] + scaled[i][1] * R[4 * (j) + 1] + scaled[i][2] * R[4 * (j) + 2])
     M[0] = SS_PRINCIPAL_ENTRY(0, 0);
     M[1] = M[3] = SS_PRINCIPAL_ENTRY(0, 1);
     M[2] = M[6] = SS_PRINCIPAL_ENTRY(0, 2);

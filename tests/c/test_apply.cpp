@@ -75,8 +75,10 @@ TEST(ApplyTest, RowsSurelyHandedOnAreHandedOnByTheRule) {
   // dampers (k = 0), to far beyond the step's decay: the motor rows of programs tuned at ODE's CFM 1e-10
   for (double mass : masses)
     for (double step_s : steps)
-      for (int i = 1; i <= 2000; ++i) check({0.0, 2.0 * mass * (i <= 1000 ? 1e-4 * i : std::pow(1.02, i - 1000)) / step_s},
-                                            mass, step_s);
+      for (int i = 1; i <= 2000; ++i) {
+        double x = i <= 1000 ? 1e-4 * i : std::pow(1.02, i - 1000);
+        check({0.0, 2.0 * mass * x / step_s}, mass, step_s);
+      }
   std::mt19937 random(7);
   std::uniform_real_distribution<double> exponent(-4.0, 4.0);
   for (int i = 0; i < 200000; ++i) {
