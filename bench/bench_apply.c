@@ -18,7 +18,7 @@
 #include "bench_common.h"
 
 enum { kChains = 50, kLinks = 20, kBlock = 10, kMaxRepeats = 32 };
-enum { kConfigs = 8 };
+enum { kConfigs = 9 };
 static const unsigned kDisabled[kConfigs] = {0,
                                              SS_CACHE_SAME_STEP,
                                              SS_CACHE_BY_LAW,
@@ -26,9 +26,10 @@ static const unsigned kDisabled[kConfigs] = {0,
                                              SS_CACHE_SHARED,
                                              SS_CACHE_REUSE,
                                              SS_CACHE_SAME_AXIS,
+                                             SS_CACHE_SURE_FALLBACK,
                                              SS_CACHE_ALL};
-static const char* const kConfigNames[kConfigs] = {"all on", "-same step", "-by law", "-bodies",
-                                                   "-shared", "-reuse",    "-same axis", "all off"};
+static const char* const kConfigNames[kConfigs] = {"all on",  "-same step", "-by law",   "-bodies", "-shared",
+                                                   "-reuse",  "-same axis", "-fallback", "all off"};
 static const ssSpring kLimit = {5.0, 0.05}, kFriction = {0.0, 0.01};
 static const double kFrame_s = 1.0 / 60.0;
 

@@ -2,7 +2,7 @@
 quantities depend on the frame rate, how far they are from a fine-step reference, and what adopted stepping costs.
 
 Usage: .venv/bin/python bench/bench_examples.py [BUILD_DIR] [--repeats N] [--boxes N] [--cost-seconds S]
-       [--skip-cost] [--executor WHERE]
+       [--vehicle-seconds S] [--skip-cost | --cost-only] [--executor WHERE]
 
 1-2. Frame-rate spread and accuracy: `steadystep audit` (python/steadystep/audit.py, docs/audit.md) of each adopted
    program with its *_ode twin as its own stepping, under the profiles fixed:60, fixed:30 and uniform:15:45 (seeds 1,
@@ -19,10 +19,12 @@ Usage: .venv/bin/python bench/bench_examples.py [BUILD_DIR] [--repeats N] [--box
    reference's grid, divided by the same A. Both over the whole run; the audit's own claims use the times where
    its reference holds (checked at 0.25 ms), printed below each table.
 3. Cost. The stack with --boxes N (default 200) under fixed:60: its own stepping (one dWorldQuickStep a frame)
-   against the adopted program under implicit-euler with --max-step 1 (also one step a frame: the same step sequence). Each
-   program times its stepping loop alone (--quiet): wall clock and process CPU time. Runs alternate (own, adopted,
-   adopted, own, ...) and the ratio adopted / own is taken per pair; printed: the median ratio over the pairs and its
-   range, for both clocks (CPU time is the one a shared, busy machine disturbs least).
+   against the adopted program under implicit-euler with --max-step 1 (also one step a frame: the same step
+   sequence); the vehicle likewise under implicit-euler, matched and exact (issue 15: the accurate mappings where
+   they serve, its suspension). Each program times its stepping loop alone (--quiet): wall clock and process CPU
+   time. Each repeat runs the own stepping and every policy once, in an order rotated from repeat to repeat, and the
+   ratio policy / own is taken per repeat; printed: the median ratio over the repeats and its range, for both clocks
+   (CPU time is the one a shared, busy machine disturbs least).
 Prints Markdown tables. Exit 1 when a run fails (a program the audit refuses: its one line, exit 1).
 """
 
@@ -69,13 +71,15 @@ def frame_rate_tables(build: pathlib.Path, executor: str) -> None:
             sys.exit(f"bench_examples: {program}: {len(failed)} runs failed: {failed[0]['status']}")
 
 
-def loop_seconds(build: pathlib.Path, variant: str, boxes: int, seconds: float) -> tuple[float, float]:
-    """The stepping loop's (wall, CPU) seconds of one stack run at fixed:60."""
+def loop_seconds(build: pathlib.Path, program: str, variant: str, seconds: float,
+                 extra: list[str]) -> tuple[float, float]:
+    """The stepping loop's (wall, CPU) seconds of one run of the program at fixed:60: its own stepping ("own") or
+    adopted under the policy `variant` with one step a frame."""
     if variant == "own":
-        command = [str(build / "steadystep_example_stack_ode")]
+        command = [str(build / f"steadystep_example_{program}_ode")]
     else:
-        command = [str(build / "steadystep_example_stack_steadystep"), "--policy", "implicit-euler", "--max-step", "1"]
-    command += ["--profile", "fixed:60", "--duration", str(seconds), "--boxes", str(boxes), "--quiet"]
+        command = [str(build / f"steadystep_example_{program}_steadystep"), "--policy", variant, "--max-step", "1"]
+    command += ["--profile", "fixed:60", "--duration", str(seconds), "--quiet"] + extra
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
         sys.exit(f"bench_examples: {' '.join(command)} exited {done.returncode}: {done.stderr.strip()}")
@@ -83,22 +87,28 @@ def loop_seconds(build: pathlib.Path, variant: str, boxes: int, seconds: float) 
     return wall_s, cpu_s
 
 
-def cost_table(build: pathlib.Path, repeats: int, boxes: int, seconds: float) -> None:
-    times: dict[str, list[tuple[float, float]]] = {"own": [], "adopted": []}
+def cost_table(build: pathlib.Path, program: str, policies: list[str], repeats: int, seconds: float,
+               extra: list[str], title: str) -> None:
+    """Each repeat runs the program's own stepping and every policy once, in an order rotated from repeat to repeat;
+    each policy's ratio to the own run of the same repeat, median and range over the repeats."""
+    variants = ["own"] + policies
+    times: dict[str, list[tuple[float, float]]] = {v: [] for v in variants}
     for repeat in range(repeats):
-        for variant in ["own", "adopted"] if repeat % 2 == 0 else ["adopted", "own"]:
-            times[variant].append(loop_seconds(build, variant, boxes, seconds))
+        shift = repeat % len(variants)
+        for variant in variants[shift:] + variants[:shift]:
+            times[variant].append(loop_seconds(build, program, variant, seconds, extra))
     print()
-    print(f"| stack, {boxes} boxes, {seconds:g} s at fixed:60, {repeats} interleaved pairs | wall clock | CPU time |")
+    print(f"| {title}, {seconds:g} s at fixed:60, {repeats} interleaved repeats | wall clock | CPU time |")
     print("|---|---|---|")
-    for label, variant in [("own stepping loop, median (s)", "own"),
-                           ("adopted stepping loop (implicit-euler, one step a frame), median (s)", "adopted")]:
+    for variant in variants:
+        label = "own stepping loop, median (s)" if variant == "own" else \
+            f"adopted, {variant} (one step a frame), median (s)"
         print(f"| {label} | " + " | ".join(f"{statistics.median(t[k] for t in times[variant]):.4f}" for k in (0, 1))
               + " |")
-    ratios = [[a[k] / o[k] for a, o in zip(times["adopted"], times["own"])] for k in (0, 1)]
-    print("| ratio adopted / own, median over pairs | "
-          + " | ".join(f"{statistics.median(r):.4f}" for r in ratios) + " |")
-    print("| ratio, min - max over pairs | " + " | ".join(f"{min(r):.4f} - {max(r):.4f}" for r in ratios) + " |")
+    for variant in policies:
+        ratios = [[a[k] / o[k] for a, o in zip(times[variant], times["own"])] for k in (0, 1)]
+        print(f"| ratio {variant} / own, median (min - max) | "
+              + " | ".join(f"{statistics.median(r):.4f} ({min(r):.4f} - {max(r):.4f})" for r in ratios) + " |")
 
 
 def diff_sizes(root: pathlib.Path) -> None:
@@ -116,21 +126,28 @@ def diff_sizes(root: pathlib.Path) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("build", nargs="?", default="build", help="the CMake build directory (default build)")
-    parser.add_argument("--repeats", type=int, default=9, help="interleaved cost pairs (default 9)")
+    parser.add_argument("--repeats", type=int, default=9, help="interleaved cost repeats (default 9)")
     parser.add_argument("--boxes", type=int, default=200, help="boxes of the cost run (default 200)")
     parser.add_argument("--cost-seconds", type=float, default=10.0, help="simulated time of a cost run (s)")
+    parser.add_argument("--vehicle-seconds", type=float, default=300.0,
+                        help="simulated time of a vehicle cost run (s; default 300: its loop takes about 0.3 s)")
     parser.add_argument("--skip-cost", action="store_true", help="the frame-rate tables only")
+    parser.add_argument("--cost-only", action="store_true", help="the cost tables only")
     parser.add_argument("--executor", default="local", help="where the audit's runs go (study.py; default local)")
     args = parser.parse_args()
     build = pathlib.Path(args.build).resolve()
-    from steadystep._native import SteadystepError
+    if not args.cost_only:
+        from steadystep._native import SteadystepError
 
-    try:
-        frame_rate_tables(build, args.executor)
-    except SteadystepError as error:  # a program the audit refuses (BadProgram): its one line
-        sys.exit(f"bench_examples: {error}")
+        try:
+            frame_rate_tables(build, args.executor)
+        except SteadystepError as error:  # a program the audit refuses (BadProgram): its one line
+            sys.exit(f"bench_examples: {error}")
     if not args.skip_cost:
-        cost_table(build, args.repeats, args.boxes, args.cost_seconds)
+        cost_table(build, "stack", ["implicit-euler"], args.repeats, args.cost_seconds, ["--boxes", str(args.boxes)],
+                   f"stack, {args.boxes} boxes")
+        cost_table(build, "vehicle", ["implicit-euler", "matched", "exact"], args.repeats, args.vehicle_seconds, [],
+                   "vehicle")
     diff_sizes(pathlib.Path(__file__).resolve().parent.parent)
 
 

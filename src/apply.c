@@ -24,8 +24,11 @@
  *    computed_step_s, computed_previous_s) where computed_mapping is an accurate one (implicit Euler's general pass
  *    leaves its own there and says so in computed_mapping); a binding, a load or a load's fallback voids it
  *    (computed_step_s = NAN). The mappings are pure functions of these inputs, so equal inputs reuse it.
- *  - Within one Apply only: the shared-softness ring maps (law, mass) to a softness computed in this Apply, and a
- *    stop and a motor on one axis (sharesRow) share the mass measured for the first.
+ *  - Within one Apply only: the shared-softness table maps (law, mass) to a softness computed in this Apply, and a
+ *    stop and a motor on one axis (sharesRow) share the mass measured for the first. The law fallbacks hold the
+ *    implicit-Euler softness of each law of the table for this step, given (without the accurate arithmetic) to
+ *    the unloaded rows that ssSurelyFailsStaticResponse says the rule hands on: ssRowSoftness gives those rows
+ *    exactly that softness and fallback (row_law.h; tested against it in test_apply.cpp).
  *  - disabled_caches turns caches off one by one (ssRegistryDisableCaches): bench_apply measures what each buys,
  *    and the differential check requires the same values either way. */
 #include <math.h>
@@ -104,6 +107,40 @@ static int sameLaw(const ssRowLaw* a, const ssRowLaw* b) {
 static int sharedLaw(const SharedSoftness* shared, const ssRowLaw* law, int law_slot) {
   if (shared->law_slot >= 0 && law_slot >= 0) return shared->law_slot == law_slot;
   return sameLaw(shared->law, law);
+}
+
+/* The softnesses one Apply computed, direct-mapped by law, mass and load: a row looks in one entry only (rows with
+ * distinct masses, which never share, pay one comparison). */
+enum { kSharedSize = 16 };
+typedef struct SharedTable {
+  unsigned char used[kSharedSize];
+  SharedSoftness entries[kSharedSize];
+} SharedTable;
+
+static uint64_t bitsOf(double value) {
+  uint64_t bits;
+  memcpy(&bits, &value, sizeof bits);
+  return bits;
+}
+
+/* The entry of (law, mass, load): equal laws (by slot, or outside the table by k and c) and equal masses land on
+ * one entry. any_mass: the mapping reads no mass for the law. */
+static unsigned sharedSlot(const ssRowLaw* law, int law_slot, int any_mass, double mass, int load_declared) {
+  uint64_t key = law_slot >= 0 ? (uint64_t)law_slot : bitsOf(law->spring.stiffness) ^ bitsOf(law->spring.damping);
+  if (!any_mass) key ^= bitsOf(mass) * 0x9E3779B97F4A7C15ull;
+  key = (key ^ (uint64_t)load_declared) * 0x9E3779B97F4A7C15ull;
+  return (unsigned)(key >> 60); /* the top 4 bits: kSharedSize entries */
+}
+
+/* The softness computed in this Apply for the row's law and mass (any mass where the mapping reads none) with the
+ * same load declared, or NULL. */
+static const SharedSoftness* findShared(const SharedTable* table, unsigned slot, const ssRowLaw* law, int law_slot,
+                                        int any_mass, double mass, int load_declared) {
+  const SharedSoftness* entry = &table->entries[slot];
+  if (table->used[slot] && (any_mass || entry->mass == mass) && entry->load_declared == load_declared &&
+      sharedLaw(entry, law, law_slot))
+    return entry;
+  return NULL;
 }
 
 /* Gives every row in the law table its written back from law_written: before a pass that reads the rows' own, and
@@ -244,6 +281,30 @@ static int sameWrite(int erp_number, const ssSoftness* a, const ssSoftness* b) {
   return ssSameInOde(a->cfm, b->cfm) && (erp_number < 0 || ssSameInOde(a->erp, b->erp));
 }
 
+/* The implicit-Euler softness of the laws in the table that rows of one Apply were handed to, each computed (and
+ * checked) at its first use in the Apply. */
+typedef struct LawFallbacks {
+  unsigned char known[kLawTableSize];
+  ssSoftness softness[kLawTableSize];
+} LawFallbacks;
+
+/* The softness ssRowSoftness gives a row an accurate mapping hands to implicit Euler: the law's implicit-Euler
+ * softness, checked for ODE as every computed softness is. */
+static ssStatus lawFallback(const ssRowLaw* law, int law_slot, double step_s, LawFallbacks* fallbacks,
+                            ssSoftness* out) {
+  if (law_slot >= 0 && fallbacks->known[law_slot]) {
+    *out = fallbacks->softness[law_slot];
+    return SS_OK;
+  }
+  ssStatus status = ssRowSoftness(law, SS_MAPPING_IMPLICIT_EULER, NAN, step_s, 0, 0, NULL, out);
+  if (status == SS_OK) status = ssCheckSoftnessForOde("softness", out->erp, out->cfm);
+  if (status == SS_OK && law_slot >= 0) {
+    fallbacks->known[law_slot] = 1;
+    fallbacks->softness[law_slot] = *out;
+  }
+  return status;
+}
+
 /* Apply's first pass in general: each row's mass and softness into pending, and the load corrections, all checked
  * before anything is written. */
 static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step_s, double previous_s, int measure,
@@ -252,10 +313,11 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
   /* Programs bind many rows to a few springs, and many rows move equal masses (identical links, wheels, stop and
    * motor on one axis): within one Apply the softness is a function of the law and (accurate mappings) the mass, so
    * each distinct pair is computed once and shared. */
-  enum { kSharedSize = 8 };
-  SharedSoftness shared[kSharedSize];
-  int shared_count = 0, shared_next = 0;
+  SharedTable shared;
+  memset(shared.used, 0, sizeof shared.used);
   double last_mass = NAN;
+  LawFallbacks fallbacks;
+  memset(fallbacks.known, 0, sizeof fallbacks.known);
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
     PREFETCH_ROWS(registry, i, 2);
@@ -276,12 +338,21 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     }
     binding->mass = mass;
     int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
-    const SharedSoftness* hit = NULL;
-    for (int j = 0; j < shared_count && hit == NULL; ++j)
-      if ((any_mass || shared[j].mass == mass) && shared[j].load_declared == (binding->load != 0) &&
-          sharedLaw(&shared[j], law, binding->law_slot))
-        hit = &shared[j];
-    if (hit != NULL) {
+    const SharedSoftness* hit;
+    unsigned slot = 0;
+    /* a row the rule surely hands to implicit Euler gets the law's implicit-Euler softness, without the accurate
+     * arithmetic whose only use would be to decide so (a declared load keeps the accurate softness instead) */
+    if (!any_mass && !(registry->disabled_caches & SS_CACHE_SURE_FALLBACK) &&
+        !(binding->load != 0 && law->spring.stiffness > 0) && ssSurelyFailsStaticResponse(law->spring, mass, step_s)) {
+      status = lawFallback(law, binding->law_slot, step_s, &fallbacks, &binding->pending);
+      if (status != SS_OK) {
+        binding->computed_step_s = NAN;
+        return failBinding(status, binding);
+      }
+      binding->computed_fallback = (ssRowFallback){0, 1};
+      countRow(&binding->computed_fallback, counts);
+    } else if ((slot = sharedSlot(law, binding->law_slot, any_mass, mass, binding->load != 0),
+                hit = findShared(&shared, slot, law, binding->law_slot, any_mass, mass, binding->load != 0)) != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
       countRow(&hit->fallback, counts);
@@ -295,11 +366,9 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
         return failBinding(status, binding);
       }
       if (!(registry->disabled_caches & SS_CACHE_SHARED)) {
-        shared[shared_next] =
-            (SharedSoftness){law, binding->law_slot, mass, binding->load != 0, binding->pending,
-                             binding->computed_fallback};
-        shared_next = (shared_next + 1) % kSharedSize;
-        if (shared_count < kSharedSize) shared_count += 1;
+        shared.entries[slot] = (SharedSoftness){law, binding->law_slot, mass, binding->load != 0, binding->pending,
+                                                binding->computed_fallback};
+        shared.used[slot] = 1;
       }
     }
     *unwritten += !sameWrite(binding->writer.erp_number, &binding->pending, &binding->written);

@@ -3,6 +3,7 @@
 #include "joint_rows.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "error.h"
@@ -164,6 +165,14 @@ void ssJointRowWriterOf(dJointID joint, ssJointParam param, int axis, ssRowWrite
 
 static int isDynamic(dBodyID body) { return body != 0 && !dBodyIsKinematic(body); }
 
+/* Whether the six off-diagonal entries are all zero (of either sign), as `== 0` says, by their bits at once. */
+static int offDiagonalZero(double a, double b, double c, double d, double e, double f) {
+  uint64_t bits[6];
+  const double values[6] = {a, b, c, d, e, f};
+  memcpy(bits, values, sizeof bits);
+  return ((bits[0] | bits[1] | bits[2] | bits[3] | bits[4] | bits[5]) << 1) == 0;
+}
+
 void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
   /* every field written without memset, whose startup costs more than the rest on the registry's path */
   out->dynamic = isDynamic(body);
@@ -183,19 +192,28 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
   double a00 = I[0], a01 = I[1], a02 = I[2], a10 = I[4], a11 = I[5], a12 = I[6], a20 = I[8], a21 = I[9],
          a22 = I[10];
   const dReal* R = dBodyGetRotation(body); /* rows of 4 */
-  if (a01 == 0 && a02 == 0 && a10 == 0 && a12 == 0 && a20 == 0 && a21 == 0) {
+  if (offDiagonalZero(a01, a02, a10, a12, a20, a21)) {
     /* principal axes along the body's (boxes, spheres, capsules, cylinders): R·diag(1/I)·Rᵀ, symmetric, in half the
-     * products of the general case */
+     * products of the general case; entry (i, j) = (R[i][0]/I0)·R[j][0] + (R[i][1]/I1)·R[j][1] + (R[i][2]/I2)·R[j][2]
+     * in that order, each R[i][k]/I_k computed once (the registry asks this of every body at every Apply) */
     if (!(a00 > 0 && a11 > 0 && a22 > 0)) {
       for (int i = 0; i < 9; ++i) out->inverse_inertia[i] = 0;
       return;
     }
     double inverse[3] = {1.0 / a00, 1.0 / a11, 1.0 / a22};
+    double scaled[3][3]; /* R[i][k]·(1/I_k) */
     for (int i = 0; i < 3; ++i)
-      for (int j = i; j < 3; ++j)
-        out->inverse_inertia[3 * i + j] = out->inverse_inertia[3 * j + i] =
-            R[4 * i] * inverse[0] * R[4 * j] + R[4 * i + 1] * inverse[1] * R[4 * j + 1] +
-            R[4 * i + 2] * inverse[2] * R[4 * j + 2];
+      for (int k = 0; k < 3; ++k) scaled[i][k] = R[4 * i + k] * inverse[k];
+    double* M = out->inverse_inertia;
+#define SS_PRINCIPAL_ENTRY(i, j) \
+  (scaled[i][0] * R[4 * (j)] + scaled[i][1] * R[4 * (j) + 1] + scaled[i][2] * R[4 * (j) + 2])
+    M[0] = SS_PRINCIPAL_ENTRY(0, 0);
+    M[1] = M[3] = SS_PRINCIPAL_ENTRY(0, 1);
+    M[2] = M[6] = SS_PRINCIPAL_ENTRY(0, 2);
+    M[4] = SS_PRINCIPAL_ENTRY(1, 1);
+    M[5] = M[7] = SS_PRINCIPAL_ENTRY(1, 2);
+    M[8] = SS_PRINCIPAL_ENTRY(2, 2);
+#undef SS_PRINCIPAL_ENTRY
     return;
   }
   double c0 = a11 * a22 - a12 * a21, c1 = a12 * a20 - a10 * a22, c2 = a10 * a21 - a11 * a20;

@@ -59,22 +59,25 @@ static ssStatus validate(ssSpring spring, double mass, double step_s, const ssSo
 }
 
 /* Every exit with a result passes here: NaN, infinities and values beyond ODE's range (limits.h) from any
- * intermediate overflow or underflow end as a refusal, never as output. */
-static ssStatus finish(double a, double erp, double step_s, double mass, ssSoftness* out) {
+ * intermediate overflow or underflow end as a refusal, never as output. quiet: refused without a message, for the
+ * registry's rows, which a refusal hands on to another mapping at every step (formatting the message would cost
+ * more than the mapping). */
+static ssStatus finish(double a, double erp, double step_s, double mass, int quiet, ssSoftness* out) {
   double cfm = a * step_s / mass;
-  if (!(isfinite(erp) && isfinite(cfm) && cfm >= SS_MIN_POSITIVE_CFM && cfm <= SS_MAX_CFM && fabs(erp) <= SS_MAX_ERP))
-    return ssFail(SS_ERROR_NO_FINITE_MAPPING,
-                  "step_s = %g s gives erp = %g, cfm = %g: not a usable softness "
-                  "(finite, |erp| <= %g, %g <= cfm <= %g)",
-                  step_s, erp, cfm, SS_MAX_ERP, SS_MIN_POSITIVE_CFM, SS_MAX_CFM);
-  *out = (ssSoftness){.erp = erp, .cfm = cfm};
-  return SS_OK;
+  if (isfinite(erp) && isfinite(cfm) && cfm >= SS_MIN_POSITIVE_CFM && cfm <= SS_MAX_CFM && fabs(erp) <= SS_MAX_ERP) {
+    *out = (ssSoftness){.erp = erp, .cfm = cfm};
+    return SS_OK;
+  }
+  if (quiet) return SS_ERROR_NO_FINITE_MAPPING;
+  return ssFail(SS_ERROR_NO_FINITE_MAPPING,
+                "step_s = %g s gives erp = %g, cfm = %g: not a usable softness (finite, |erp| <= %g, %g <= cfm <= %g)",
+                step_s, erp, cfm, SS_MAX_ERP, SS_MIN_POSITIVE_CFM, SS_MAX_CFM);
 }
 
 /* With d = e^(-σh), P = d², the numerator of erp, 1 + P - 2·d·C(h), is written as (1 - d)² + 2·d·(1 - C(h)): both
  * terms are computed without cancellation, so erp keeps its digits at short steps (where it is O(h²)·k/c and the
  * closed form subtracts numbers near 1), and 1 - P = (1 - d)(1 + d) needs no second exponential. */
-ssStatus ssMatchedSoftnessUnchecked(ssSpring spring, double mass, double step_s, ssSoftness* out) {
+static ssStatus matchedSoftness(ssSpring spring, double mass, double step_s, int quiet, ssSoftness* out) {
   double sigma = spring.damping / (2.0 * mass);
   double sigma_h = sigma * step_s;
   double one_minus_d = -expm1(-sigma_h);
@@ -103,16 +106,21 @@ ssStatus ssMatchedSoftnessUnchecked(ssSpring spring, double mass, double step_s,
   }
   double a = product / one_minus_product;
   double erp = (one_minus_d * one_minus_d + twice_d_one_minus_c) / one_minus_product;
-  return finish(a, erp, step_s, mass, out);
+  return finish(a, erp, step_s, mass, quiet, out);
+}
+
+ssStatus ssMatchedSoftnessUnchecked(ssSpring spring, double mass, double step_s, ssSoftness* out) {
+  return matchedSoftness(spring, mass, step_s, 1, out);
 }
 
 ssStatus ssMatchedSoftness(ssSpring spring, double mass, double step_s, ssSoftness* out) {
   ssStatus status = validate(spring, mass, step_s, out);
   if (status != SS_OK) return status;
-  return ssMatchedSoftnessUnchecked(spring, mass, step_s, out);
+  return matchedSoftness(spring, mass, step_s, 0, out);
 }
 
-ssStatus ssExactSoftness(ssSpring spring, double mass, double step_s, double previous_step_s, ssSoftness* out) {
+static ssStatus exactSoftness(ssSpring spring, double mass, double step_s, double previous_step_s, int quiet,
+                              ssSoftness* out) {
   ssStatus status = validate(spring, mass, step_s, out);
   if (status == SS_OK) status = ssCheckNonNegative("previous_step_s", "s", previous_step_s);
   if (status == SS_OK && previous_step_s != 0) status = ssCheckStepLength("previous_step_s", previous_step_s);
@@ -124,17 +132,26 @@ ssStatus ssExactSoftness(ssSpring spring, double mass, double step_s, double pre
     double gain = now.decayed_s / step_s; /* a/(1+a) */
     double a = gain / (1.0 - gain);
     double x_gain = now.decayed_c + sigma * now.decayed_s; /* φ11 */
-    return finish(a, (1.0 - x_gain) * (1.0 + a), step_s, mass, out);
+    return finish(a, (1.0 - x_gain) * (1.0 + a), step_s, mass, quiet, out);
   }
   Propagator before = propagate(sigma, q, previous_step_s);
   /* e^(-σ h_p)/S(h_p) = e^(-2σ h_p)/decayed_s(h_p); decayed_s(h_p) = 0 (h_p at a half period) has no history. */
   double alpha = now.decayed_c + now.decayed_s * before.c_over_s;
   double beta = -now.decayed_s * exp(-2.0 * sigma * previous_step_s) / before.decayed_s;
   double ratio = step_s / previous_step_s;
+  if (!(ratio + beta > 0 && beta < 0) && quiet) return SS_ERROR_NO_FINITE_MAPPING;
   if (!(ratio + beta > 0 && beta < 0))
     return ssFail(SS_ERROR_NO_FINITE_MAPPING,
                   "step_s = %g s after previous_step_s = %g s: the exact step would need cfm <= 0", step_s,
                   previous_step_s);
   double a = -beta / (ratio + beta);
-  return finish(a, a * ratio - (alpha - 1.0) * (1.0 + a), step_s, mass, out);
+  return finish(a, a * ratio - (alpha - 1.0) * (1.0 + a), step_s, mass, quiet, out);
+}
+
+ssStatus ssExactSoftness(ssSpring spring, double mass, double step_s, double previous_step_s, ssSoftness* out) {
+  return exactSoftness(spring, mass, step_s, previous_step_s, 0, out);
+}
+
+ssStatus ssExactSoftnessQuiet(ssSpring spring, double mass, double step_s, double previous_step_s, ssSoftness* out) {
+  return exactSoftness(spring, mass, step_s, previous_step_s, 1, out);
 }

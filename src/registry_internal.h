@@ -90,7 +90,8 @@ enum {
   SS_CACHE_SHARED = 1 << 3,    /* within an Apply, rows with the same law and mass share one softness */
   SS_CACHE_REUSE = 1 << 4,     /* accurate mappings: a row's softness kept while its inputs are the same */
   SS_CACHE_SAME_AXIS = 1 << 5, /* a stop and a motor on one axis share the mass measured for the first */
-  SS_CACHE_ALL = (1 << 6) - 1
+  SS_CACHE_SURE_FALLBACK = 1 << 6, /* accurate mappings: a row the rule surely hands on, without the arithmetic */
+  SS_CACHE_ALL = (1 << 7) - 1
 };
 
 /* Turns off the caches in mask (and on the others). The values Apply writes are the same either way. */

@@ -72,7 +72,8 @@ static ssStatus implicitEuler(const ssRowLaw* law, double step_s, ssSoftness* ou
  * its own spring is not. ODE's row law is f = -(erp/(h·cfm))·x - (1/cfm)·v', so a constant load F along the row
  * rests at x = F/k' with the step's static stiffness
  *     k' = erp/(h·cfm) = m·(1 - z1)(1 - z2)/(h²·z1·z2)   (matched; z = e^(s·h), the poles)
- *        ≈ k·(1 + σh)·sinc²(ω·h/2)                        (lightly damped; σ = c/2m, ω the frequency),
+ *        = k·((e^x - 1)² + 2·e^x·(1 - cos √w))/(x² + w)   (x = σh, σ = c/2m; w = q·h², q = k/m - σ²)
+ *        ≈ k·(1 + σh)·sinc²(ω·h/2)                        (lightly damped; ω the frequency),
  * while implicit Euler (erp = hk/(hk + c), cfm = 1/(hk + c)) has k' = k exactly, at every step. A load the registry
  * knows (ssRegistry_SetJointLoad) is corrected: the registry adds F·(k'/k - 1) along the row, which moves the rest
  * back to F/k without touching the poles. A load it does not know is the weight a stacked contact carries, the
@@ -125,7 +126,7 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
         *out = matched;
         return SS_OK;
       }
-      status = ssExactSoftness(law->spring, mass, step_s, previous_step_s, out);
+      status = ssExactSoftnessQuiet(law->spring, mass, step_s, previous_step_s, out);
       if (status == SS_OK) return SS_OK;
       if (status != SS_ERROR_NO_FINITE_MAPPING) return status;
       *out = matched;

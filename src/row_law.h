@@ -64,6 +64,42 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
  * instead of F/c). The implicit-Euler mapping keeps both exactly (k' = k, 1/cfm = h·k + c). */
 int ssKeepsStaticResponse(ssSpring spring, ssSoftness softness, double step_s);
 
+/* Whether ssRowSoftness would hand the row to implicit Euler under an accurate mapping for its static response
+ * alone, decided without the matched softness' arithmetic (no exp, sqrt or sin): 1 only when the matched
+ * softness of (spring, mass, step_s), if it is finite, certainly fails ssKeepsStaticResponse, by bounds on the exact
+ * value of its static stiffness (or a damper's static damping) that are a million times wider than the roundings
+ * of computing it. 0 (undecided) outside the ranges the bounds are derived for (over-damped springs, σh > 1,
+ * ω·h > 2, extreme values), and near the tolerance. A row that falls back has the implicit-Euler softness whatever
+ * the reason, so where this says 1 the row's softness and fallback are those ssRowSoftness gives (for a row whose
+ * load is not declared: a declared load keeps the accurate softness). Inline: Apply asks it of every unloaded row at every step of an accurate mapping. */
+static inline int ssSurelyFailsStaticResponse(ssSpring spring, double mass, double step_s) {
+  /* In x = σh = c·h/2m and w = q·h² (q = k/m - σ², so x² + w = D = k·h²/m), the matched static stiffness is
+   *     k'/k = g = ((e^x - 1)² + 2·e^x·(1 - cos √w)) / D      (row_law.c: the derivation)
+   * and the row is kept iff 1/(1 + tol) <= g <= 1/(1 - tol). For 0 < x <= 1 and 0 <= w <= 4, e^x - 1 lies between
+   * its Taylor sum to x⁵ and that plus x⁶/240 (Lagrange: e^ξ/720 < 1/240), and 1 - cos √w between its alternating
+   * series' sums to w³ (above) and to w⁴ (below, still positive); the numerator grows with both. */
+  const double k = spring.stiffness, c = spring.damping;
+  if (!(k <= 1e150 && c >= 1e-150 && c <= 1e150 && mass >= 1e-150 && mass <= 1e150)) return 0;
+  double h_over_m = step_s / mass, x = 0.5 * c * h_over_m; /* within roundings of the mapping's: the margin's */
+  /* a damper (k = 0): matched's static damping is c·cfm = 2x/(e^(2x) - 1), below 1 - tol from x = 0.0513 on and
+   * decreasing (0.9412 at x = 0.06): the motor rows of a program tuned at ODE's CFM 1e-10 are far beyond */
+  if (k == 0) return x >= 0.06;
+  if (!(k >= 1e-150)) return 0;
+  double kh2_over_m = k * h_over_m * step_s;
+  double w = kh2_over_m - x * x;
+  if (!(x >= 1e-8 && x <= 1.0 && w >= 0.0 && w <= 4.0)) return 0;
+  double x2 = x * x;
+  double e_low = x * (1.0 + x * (0.5 + x * (1.0 / 6.0 + x * (1.0 / 24.0 + x * (1.0 / 120.0)))));
+  double e_high = e_low + x2 * x2 * x2 * (1.0 / 240.0);
+  double c_high = w * (0.5 - w * (1.0 / 24.0 - w * (1.0 / 720.0)));
+  double c_low = c_high - w * w * w * w * (1.0 / 40320.0);
+  double n_low = e_low * e_low + 2.0 * (1.0 + e_low) * c_low;
+  double n_high = e_high * e_high + 2.0 * (1.0 + e_high) * c_high;
+  const double margin = 1e-6; /* against this function's roundings and those of the softness and its check */
+  return n_high < kh2_over_m * ((1.0 - margin) / (1.0 + SS_STATIC_RESPONSE_TOLERANCE)) ||
+         n_low > kh2_over_m * ((1.0 + margin) / (1.0 - SS_STATIC_RESPONSE_TOLERANCE));
+}
+
 /* w·h > π, i.e. k·h² > π²·m: the spring's natural frequency is above half the step rate. False for a NAN
  * mass. Inline: the registry asks it of every row at every Apply. */
 static inline int ssOverNyquist(ssSpring spring, double mass, double step_s) {
