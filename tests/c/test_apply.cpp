@@ -53,7 +53,7 @@ TEST(ApplyTest, RowsSurelyHandedOnAreHandedOnByTheRule) {
       return;
     }
     decided += 1;
-    ASSERT_EQ(ssSoftnessFromSpring(spring, step_s, &euler), SS_OK);
+    ASSERT_EQ(ssImplicitEulerSoftness(spring, step_s, &euler), SS_OK);
     ASSERT_TRUE(fails) << "k " << spring.stiffness << " c " << spring.damping << " m " << mass << " h " << step_s;
     EXPECT_EQ(softness.erp, euler.erp);
     EXPECT_EQ(softness.cfm, euler.cfm);
