@@ -71,7 +71,8 @@ int ssKeepsStaticResponse(ssSpring spring, ssSoftness softness, double step_s);
  * of computing it. 0 (undecided) outside the ranges the bounds are derived for (over-damped springs, σh > 1,
  * ω·h > 2, extreme values), and near the tolerance. A row that falls back has the implicit-Euler softness whatever
  * the reason, so where this says 1 the row's softness and fallback are those ssRowSoftness gives (for a row whose
- * load is not declared: a declared load keeps the accurate softness). Inline: Apply asks it of every unloaded row at every step of an accurate mapping. */
+ * load is not declared: a declared load keeps the accurate softness). Inline: Apply asks it of every unloaded row
+ * at every step of an accurate mapping. */
 static inline int ssSurelyFailsStaticResponse(ssSpring spring, double mass, double step_s) {
   /* In x = σh = c·h/2m and w = q·h² (q = k/m - σ², so x² + w = D = k·h²/m), the matched static stiffness is
    *     k'/k = g = ((e^x - 1)² + 2·e^x·(1 - cos √w)) / D      (row_law.c: the derivation)
