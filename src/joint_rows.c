@@ -195,7 +195,8 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
   if (offDiagonalZero(a01, a02, a10, a12, a20, a21)) {
     /* principal axes along the body's (boxes, spheres, capsules, cylinders): R·diag(1/I)·Rᵀ, symmetric, in half the
      * products of the general case; entry (i, j) = (R[i][0]/I0)·R[j][0] + (R[i][1]/I1)·R[j][1]
-     * + (R[i][2]/I2)·R[j][2] in that order, each R[i][k]/I_k computed once (the registry asks this of every body at every Apply) */
+     * + (R[i][2]/I2)·R[j][2] in that order, each R[i][k]/I_k computed once (the registry asks this of every body
+     * at every Apply) */
     if (!(a00 > 0 && a11 > 0 && a22 > 0)) {
       for (int i = 0; i < 9; ++i) out->inverse_inertia[i] = 0;
       return;
