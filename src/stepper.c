@@ -511,8 +511,9 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     }
     /* the boundary: whatever the program or its callbacks did, ODE gets a state and forces it can step. Without
      * callbacks only the stepper wrote since the last check (after the last step, or before the frame): the
-     * frame's checked forces spread over its steps, and load corrections within SS_MAX_FORCE_N */
-    int called_back = def->before_step || def->collide;
+     * frame's checked forces spread over its steps, and load corrections within SS_MAX_FORCE_N. step_done ran
+     * after the last step's check */
+    int called_back = def->before_step || def->collide || (i > 0 && def->step_done);
     if ((status = refreshKnown(stepper)) != SS_OK ||
         (called_back && (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);

@@ -155,6 +155,45 @@ TEST_F(PromiseTest, AStateSetBetweenFramesIsRefusedByNameBeforeODEOrTheSpaceSees
   }
 }
 
+// step_done runs between a frame's steps: what it sets is checked before the next step even when the program has no
+// before_step or collide callback (without them, nothing else runs between two steps and no other check is made).
+TEST_F(PromiseTest, AStateSetInStepDoneIsRefusedBeforeTheNextStepWithNoOtherCallback) {
+  dBodyID body = Box(0, 0, 1);
+  struct Case {
+    void (*set)(dBodyID);
+    ssStatus status;
+    const char* named;
+  } cases[] = {
+      {[](dBodyID b) { dBodySetLinearVel(b, NAN, 0, 0); }, SS_ERROR_BLOWUP, "linear velocity (nan, 0, 0)"},
+      {[](dBodyID b) { dBodyAddForce(b, 0, 0, kTooStrongN); }, SS_ERROR_OUT_OF_RANGE, "beyond SS_MAX_FORCE_N"},
+  };
+  for (const Case& c : cases) {
+    ssStepper_Destroy(stepper);
+    stepper = nullptr;
+    dBodySetPosition(body, 0, 0, 1);
+    dBodySetLinearVel(body, 0, 0, 0);
+    ssStepperDef def = Def();
+    def.collide = nullptr;
+    struct Setter {
+      const Case* c;
+      dBodyID body;
+      int calls = 0;
+    } setter{&c, body};
+    def.step_done = [](void* context, double) {
+      auto* s = static_cast<Setter*>(context);
+      if (++s->calls == 1) s->c->set(s->body);
+    };
+    def.step_done_context = &setter;
+    ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+    ssFrameReport report;
+    EXPECT_EQ(ssStepper_Step(stepper, 0.05, &report), c.status) << c.named;
+    EXPECT_TRUE(Names(c.named)) << ssLastError();
+    EXPECT_TRUE(Names("before step 2 of 3")) << ssLastError();
+    EXPECT_EQ(report.steps, 1);
+    EXPECT_EQ(report.failed_body, body);
+  }
+}
+
 TEST_F(PromiseTest, TheRunawayLeftByAResetWithoutRepairIsRefusedAgainNotStepped) {
   dBodyID body = Box(0, 0, 1);
   ssStepperDef def = Def();
