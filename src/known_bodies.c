@@ -279,21 +279,45 @@ static double gearTurn(dBodyID body, double step_s) {
   return turn;
 }
 
-/* Whether a body's state is one ODE can step: position within SS_MAX_POSITION_M, speeds within the bounds. Every
- * comparison is false for a NaN and an infinity is beyond every bound, so one comparison a number tests finiteness and
- * bound together; the tests are combined with & (no branch a number), the slow naming path runs only on failure. */
+/* A double's magnitude as an integer: non-negative doubles order as their bit patterns do, and a NaN's or an
+ * infinity's lies above every finite number's, so one integer comparison tests finiteness and a bound together. */
+static uint64_t magnitudeBits(dReal value) {
+  double x = value;
+  uint64_t bits;
+  memcpy(&bits, &x, sizeof bits);
+  return bits & ~(UINT64_C(1) << 63);
+}
+
+static uint64_t largestOf(const dReal* v) {
+  uint64_t a = magnitudeBits(v[0]), b = magnitudeBits(v[1]), c = magnitudeBits(v[2]);
+  uint64_t m = a > b ? a : b;
+  return m > c ? m : c;
+}
+
+/* Whether a body's state is one ODE can step: position within SS_MAX_POSITION_M, speeds within the bounds (every
+ * comparison is false for a NaN). Combined with & (no branch a number): the slow naming path runs only on failure. */
 static int stateWithin(const ssBodyValues* v, double max_speed2, double max_spin2) {
-  const dReal* p = v->position;
-  return (fabs(p[0]) <= SS_MAX_POSITION_M) & (fabs(p[1]) <= SS_MAX_POSITION_M) &
-         (fabs(p[2]) <= SS_MAX_POSITION_M) & (squared(v->linear_vel) <= max_speed2) &
+  return (largestOf(v->position) <= magnitudeBits(SS_MAX_POSITION_M)) & (squared(v->linear_vel) <= max_speed2) &
          (squared(v->angular_vel) <= max_spin2);
 }
 
 /* Whether a body's force and torque accumulators are within SS_MAX_FORCE_N (and finite), as stateWithin. */
 static int forcesWithin(const ssBodyValues* v) {
-  const dReal *f = v->force, *t = v->torque;
-  return (fabs(f[0]) <= SS_MAX_FORCE_N) & (fabs(f[1]) <= SS_MAX_FORCE_N) & (fabs(f[2]) <= SS_MAX_FORCE_N) &
-         (fabs(t[0]) <= SS_MAX_FORCE_N) & (fabs(t[1]) <= SS_MAX_FORCE_N) & (fabs(t[2]) <= SS_MAX_FORCE_N);
+  uint64_t f = largestOf(v->force), t = largestOf(v->torque);
+  return (f > t ? f : t) <= magnitudeBits(SS_MAX_FORCE_N);
+}
+
+/* How many bodies ahead the checks ask for a body's values: a large world's bodies are out of cache after ODE's step
+ * or the program's frame, and the loads of several bodies then overlap instead of waiting one after the other. */
+enum { kPrefetchAhead = 8, kPrefetchFrom = 256 };
+
+/* How far ahead a pass over count bodies asks for them: past the end (none) for a list that stays in cache. */
+static int prefetchDistance(int count) { return count >= kPrefetchFrom ? kPrefetchAhead : count; }
+
+static void prefetchState(const ssBodyValues* v) {
+  __builtin_prefetch(v->position);
+  __builtin_prefetch(v->linear_vel);
+  __builtin_prefetch(v->angular_vel);
 }
 
 ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
@@ -303,11 +327,12 @@ ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, co
   const ssBodyValues* values = known->values;
   /* the whole list first, with no branch a body (the usual case: all pass); the first failure is found after */
   int all = 1;
-  if (bounds->forces)
-    for (int k = 0; k < known->count; ++k)
-      all &= stateWithin(&values[k], max_speed2, max_spin2) & forcesWithin(&values[k]);
-  else
-    for (int k = 0; k < known->count; ++k) all &= stateWithin(&values[k], max_speed2, max_spin2);
+  const int count = known->count, ahead = prefetchDistance(count);
+  for (int k = 0; k < count; ++k) {
+    if (k + ahead < count) prefetchState(&values[k + ahead]);
+    all &= stateWithin(&values[k], max_speed2, max_spin2);
+    if (bounds->forces) all &= forcesWithin(&values[k]);
+  }
   char named[64];
   for (int k = 0; !all && k < known->count; ++k) {
     if (stateWithin(&values[k], max_speed2, max_spin2) && (!bounds->forces || forcesWithin(&values[k]))) continue;
@@ -328,6 +353,14 @@ ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, co
   return SS_OK;
 }
 
+/* Whether a vector of finite values is not all zeros (-0 is zero), as integers: no floating-point comparison. */
+static int anyBitBesidesSign(const dReal* v) {
+  double x = v[0], y = v[1], z = v[2];
+  uint64_t a, b, c;
+  memcpy(&a, &x, sizeof a), memcpy(&b, &y, sizeof b), memcpy(&c, &z, sizeof c);
+  return ((a | b | c) << 1) != 0;
+}
+
 static int anyNonZero(const double* values) {
   return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
 }
@@ -339,8 +372,16 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBo
   /* last frame's pushed bodies are unmarked through their list: only a pushed body's entry is written */
   for (int p = 0; p < known->pushed_count; ++p) known->bodies[known->pushed[p]].pushed = 0;
   known->pushed_count = 0;
-  for (int k = 0; k < known->count; ++k) {
+  const int count = known->count, ahead = prefetchDistance(count);
+  for (int k = 0; k < count; ++k) {
     const ssBodyValues* values = &known->values[k];
+    if (k + ahead < count) { /* the body and its first joint, where ODE's joint list starts, then its values */
+      __builtin_prefetch(known->ids[k + ahead]);
+      if (known->first_joints[k + ahead] != 0) __builtin_prefetch(known->first_joints[k + ahead]);
+      prefetchState(&values[ahead]);
+      __builtin_prefetch(values[ahead].force);
+      __builtin_prefetch(values[ahead].torque);
+    }
     if (firstJointChanged(dBodyGetJoint(known->ids[k], 0), known->first_joints[k])) {
       *joints_changed = 1;
       return SS_OK;
@@ -350,8 +391,7 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBo
       return describe(known->ids[k], bounds, "before the frame");
     }
     const dReal *force = values->force, *torque = values->torque;
-    int pushing = (force[0] != 0) | (force[1] != 0) | (force[2] != 0) | (torque[0] != 0) | (torque[1] != 0) |
-                  (torque[2] != 0);
+    int pushing = anyBitBesidesSign(force) | anyBitBesidesSign(torque);
     if (!pushing && !(known->carrying && anyNonZero(known->bodies[k].carried))) continue;
     ssKnownBody* body = &known->bodies[k];
     double* f = body->frame_force;
