@@ -534,6 +534,9 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
   return SS_OK;
 }
 
+/* x, or 0 for a negative x (fmax(x, 0) without a call into libm). */
+static double atLeastZero(double x) { return x > 0 ? x : 0; }
+
 /* WHOLE_FRAME: one step of the frame. SUBSTEPS: n equal substeps no longer than max_step_s, at most
  * max_steps_per_frame. A frame too short to step waits for the next one. */
 static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* report) {
@@ -546,18 +549,19 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
     return SS_OK;
   }
   int steps = 1;
-  if (stepping->cut == SS_CUT_SUBSTEPS) {
+  /* a frame no longer than max_step_s is one step (the division would say so: total_s / max_step_s <= 1) */
+  if (stepping->cut == SS_CUT_SUBSTEPS && total_s > stepping->max_step_s) {
     double count = ceil(total_s / stepping->max_step_s - kStepCountSlack);
     steps = count < 1 ? 1 : count > stepping->max_steps_per_frame ? stepping->max_steps_per_frame : (int)count;
   }
   stepper->short_frame_s = 0;
-  double step_s = total_s / steps;
+  double step_s = steps == 1 ? total_s : total_s / steps;
   if (stepping->cut == SS_CUT_SUBSTEPS && step_s > stepping->max_step_s * (1 + kStepCountSlack)) {
     /* a long frame (a breakpoint, a hitch) is cut off like the fixed cut's: the rest is dropped, and reported */
     step_s = stepping->max_step_s;
     report->dropped_s = total_s - steps * step_s;
   }
-  ssStatus status = takeSteps(stepper, steps, step_s, fmax(frame_s - report->dropped_s, 0), report);
+  ssStatus status = takeSteps(stepper, steps, step_s, atLeastZero(frame_s - report->dropped_s), report);
   clearCarried(stepper);
   return status;
 }
@@ -579,10 +583,10 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
   if (due == 0) {
     carryForces(stepper, frame_s);
   } else {
-    status = takeSteps(stepper, (int)due, step_s, fmax(frame_s - report->dropped_s, 0), report);
+    status = takeSteps(stepper, (int)due, step_s, atLeastZero(frame_s - report->dropped_s), report);
     clearCarried(stepper);
   }
-  stepper->accumulator_s = fmax(accumulator_s - report->steps * step_s, 0);
+  stepper->accumulator_s = atLeastZero(accumulator_s - report->steps * step_s);
   report->carried_s = stepper->accumulator_s;
   report->interpolation = fmin(stepper->accumulator_s / step_s, nextafter(1.0, 0.0));
   ssPoseHistory_EndFrame(stepper->poses, report->steps, report->interpolation);
@@ -613,7 +617,7 @@ ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* repor
   if (stepper != NULL) REFUSE_IN_STEP(stepper, "ssStepper_Step");
   ssFrameReport local;
   if (report == NULL) report = &local;
-  memset(report, 0, sizeof *report);
+  *report = (ssFrameReport){0};
   REQUIRE_STEPPER(stepper);
   if (stepper->failed_status != SS_OK)
     return ssFail(SS_ERROR_FAILED, "an earlier frame failed (%s): repair or restore the bodies, then call "
