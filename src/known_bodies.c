@@ -375,9 +375,10 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBo
   const int count = known->count, ahead = prefetchDistance(count);
   for (int k = 0; k < count; ++k) {
     const ssBodyValues* values = &known->values[k];
-    if (k + ahead < count) { /* the body and its first joint, where ODE's joint list starts, then its values */
+    if (k + ahead < count) { /* the body and the head of its first joint, where ODE's joint list runs, then its values */
+      const char* joint = (const char*)known->first_joints[k + ahead];
       __builtin_prefetch(known->ids[k + ahead]);
-      if (known->first_joints[k + ahead] != 0) __builtin_prefetch(known->first_joints[k + ahead]);
+      if (joint != NULL) __builtin_prefetch(joint), __builtin_prefetch(joint + 64);
       prefetchState(&values[ahead]);
       __builtin_prefetch(values[ahead].force);
       __builtin_prefetch(values[ahead].torque);
