@@ -375,7 +375,7 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBo
   const int count = known->count, ahead = prefetchDistance(count);
   for (int k = 0; k < count; ++k) {
     const ssBodyValues* values = &known->values[k];
-    if (k + ahead < count) { /* the body and the head of its first joint, where ODE's joint list runs, then its values */
+    if (k + ahead < count) { /* the body, the head of its first joint (where ODE keeps its joint list), its values */
       const char* joint = (const char*)known->first_joints[k + ahead];
       __builtin_prefetch(known->ids[k + ahead]);
       if (joint != NULL) __builtin_prefetch(joint), __builtin_prefetch(joint + 64);
