@@ -20,7 +20,8 @@
 static const double kStepCountSlack = 1e-9;
 
 /* A space the stepper adopted from, as it was when last walked: ODE adds a geom at the head of a space's list, so a
- * new geom changes the count or the first geom (sweep-and-prune appends: there only the count tells). */
+ * new geom changes the count or the first geom, or gives the first a body not known (sweep-and-prune appends: there
+ * only the count tells, and ssStepper_DestroyBody, which has every space walked again). */
 typedef struct SeenSpace {
   dSpaceID space;
   int geoms;
@@ -210,6 +211,9 @@ ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body) {
     }
   }
   ssKnownForget(&stepper->known, body); /* at once: inside a frame, the next check must not read it */
+  /* a box spawned in its place leaves a space's count as it was, and may take its geom's or its own address: the
+   * spaces are walked again before the next step */
+  if (stepper->space_count > 0) stepper->spaces[0].geoms = -1;
   ssPoseHistory_ForgetBody(stepper->poses, body);
   dBodyDestroy(body);
   return SS_OK;
@@ -334,11 +338,18 @@ static ssStatus adoptBody(ssStepper* stepper, dBodyID body) {
   return status;
 }
 
+/* Whether a space may hold a geom of a body the stepper does not know: its count changed, its first geom is another,
+ * or the first geom's body is not known (a geom destroyed and another added may reuse its address: the body tells). */
 static int spacesChanged(const ssStepper* stepper) {
   for (int i = 0; i < stepper->space_count; ++i) {
     const SeenSpace* seen = &stepper->spaces[i];
     int geoms = dSpaceGetNumGeoms(seen->space);
-    if (geoms != seen->geoms || (geoms > 0 && dSpaceGetGeom(seen->space, 0) != seen->first)) return 1;
+    if (geoms != seen->geoms) return 1;
+    if (geoms == 0) continue;
+    dGeomID first = dSpaceGetGeom(seen->space, 0);
+    if (first != seen->first) return 1;
+    dBodyID body = dGeomIsSpace(first) ? 0 : dGeomGetBody(first);
+    if (body != 0 && !ssKnownContains(&stepper->known, body)) return 1;
   }
   return 0;
 }
