@@ -525,8 +525,8 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
      * frame's checked forces spread over its steps, and load corrections within SS_MAX_FORCE_N. step_done ran
      * after the last step's check */
     int called_back = def->before_step || def->collide || (i > 0 && def->step_done);
-    if ((status = refreshKnown(stepper)) != SS_OK ||
-        (called_back && (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
+    if (called_back && ((status = refreshKnown(stepper)) != SS_OK || /* what the callbacks bound or watched */
+                        (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistory_BeforeLastStep(stepper->poses);
     int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, step_s)
@@ -628,18 +628,22 @@ ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* repor
   if (stepper != NULL) REFUSE_IN_STEP(stepper, "ssStepper_Step");
   ssFrameReport local;
   if (report == NULL) report = &local;
-  *report = (ssFrameReport){0};
+  static const ssFrameReport kNothingYet; /* copied in a few moves (zeroing in place compiles to a slow rep stos) */
+  *report = kNothingYet;
   REQUIRE_STEPPER(stepper);
   if (stepper->failed_status != SS_OK)
     return ssFail(SS_ERROR_FAILED, "an earlier frame failed (%s): repair or restore the bodies, then call "
                                    "ssStepper_Reset", stepper->failed_message);
   /* any frame from 0 up is taken: one shorter than SS_MIN_STEP_S (0 included) waits for the next, with its forces */
-  ssStatus status = ssCheckNonNegative("frame_s", "s", frame_s);
-  if (status == SS_OK && frame_s > SS_MAX_FRAME_S)
-    status = ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: must be at most SS_MAX_FRAME_S = %g s", frame_s,
-                    (double)SS_MAX_FRAME_S);
+  if (!(frame_s >= 0 && frame_s <= SS_MAX_FRAME_S)) { /* false for a NaN too; named below */
+    ssStatus refused = ssCheckNonNegative("frame_s", "s", frame_s);
+    if (refused == SS_OK)
+      refused = ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: must be at most SS_MAX_FRAME_S = %g s", frame_s,
+                       (double)SS_MAX_FRAME_S);
+    return refused;
+  }
+  ssStatus status = startFrame(stepper, report);
   if (status != SS_OK) return status;
-  if ((status = startFrame(stepper, report)) != SS_OK) return status;
   stepper->report = report;
   stepper->in_step = 1;
   status = stepper->def.stepping.cut == SS_CUT_FIXED ? stepFixed(stepper, frame_s, report)
