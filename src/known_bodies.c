@@ -14,6 +14,7 @@
 void ssKnownFree(ssKnownBodies* known) {
   free(known->bodies);
   free(known->ids);
+  free(known->values);
   free(known->first_joints);
   free(known->pushed);
   free(known->geared);
@@ -116,23 +117,28 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
   size_t count = (size_t)walk.count, room = count > 0 ? count : 1;
   ssKnownBody* bodies = walk.failed ? NULL : calloc(room, sizeof *bodies);
   dBodyID* ids = walk.failed ? NULL : malloc(room * sizeof *ids);
+  ssBodyValues* values = walk.failed ? NULL : malloc(room * sizeof *values);
   dJointID* first_joints = walk.failed ? NULL : malloc(room * sizeof *first_joints);
   int* pushed = walk.failed ? NULL : malloc(room * sizeof *pushed);
   free(walk.slots);
-  if (bodies == NULL || ids == NULL || first_joints == NULL || pushed == NULL) {
+  if (bodies == NULL || ids == NULL || values == NULL || first_joints == NULL || pushed == NULL) {
     free(walk.list);
     free(bodies);
     free(ids);
+    free(values);
     free(first_joints);
     free(pushed);
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
   }
   if (count > 0) qsort(walk.list, count, sizeof(dBodyID), compareIds);
   for (size_t i = 0; i < count; ++i) {
-    const ssKnownBody* old = findOld(known, walk.list[i]);
-    bodies[i] = old != NULL ? *old : (ssKnownBody){.body = walk.list[i]};
-    ids[i] = walk.list[i];
-    first_joints[i] = dBodyGetJoint(walk.list[i], 0);
+    dBodyID body = walk.list[i];
+    const ssKnownBody* old = findOld(known, body);
+    bodies[i] = old != NULL ? *old : (ssKnownBody){.body = body};
+    ids[i] = body;
+    values[i] = (ssBodyValues){dBodyGetPosition(body), dBodyGetLinearVel(body), dBodyGetAngularVel(body),
+                               dBodyGetForce(body), dBodyGetTorque(body)};
+    first_joints[i] = dBodyGetJoint(body, 0);
   }
   free(walk.list);
   int geared_count = 0;
@@ -141,6 +147,7 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
   if (geared_count > 0 && geared_ids == NULL) {
     free(bodies);
     free(ids);
+    free(values);
     free(first_joints);
     free(pushed);
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
@@ -150,8 +157,8 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
   unsigned registry_generation = known->registry_generation, watched_generation = known->watched_generation;
   int carrying = known->carrying;
   ssKnownFree(known);
-  *known = (ssKnownBodies){bodies, ids, first_joints, (int)count, pushed, 0, carrying, geared_ids, geared_count, 1,
-                           registry_generation, watched_generation};
+  *known = (ssKnownBodies){bodies,      ids, values, first_joints, (int)count, pushed, 0, carrying, geared_ids,
+                           geared_count, 1,   registry_generation, watched_generation};
   listPushed(known);
   return SS_OK;
 }
@@ -164,6 +171,7 @@ void ssKnownForget(ssKnownBodies* known, dBodyID body) {
   size_t k = (size_t)(found - known->bodies), after = (size_t)known->count - k - 1;
   memmove(&known->bodies[k], &known->bodies[k + 1], after * sizeof *known->bodies);
   memmove(&known->ids[k], &known->ids[k + 1], after * sizeof *known->ids);
+  memmove(&known->values[k], &known->values[k + 1], after * sizeof *known->values);
   memmove(&known->first_joints[k], &known->first_joints[k + 1], after * sizeof *known->first_joints);
   known->count -= 1;
   for (int g = 0; g < known->geared_count; ++g)
@@ -271,23 +279,66 @@ static double gearTurn(dBodyID body, double step_s) {
   return turn;
 }
 
+/* A double's magnitude as an integer: non-negative doubles order as their bit patterns do, and a NaN's or an
+ * infinity's lies above every finite number's, so one integer comparison tests finiteness and a bound together. */
+static uint64_t magnitudeBits(dReal value) {
+  double x = value;
+  uint64_t bits;
+  memcpy(&bits, &x, sizeof bits);
+  return bits & ~(UINT64_C(1) << 63);
+}
+
+static uint64_t largestOf(const dReal* v) {
+  uint64_t a = magnitudeBits(v[0]), b = magnitudeBits(v[1]), c = magnitudeBits(v[2]);
+  uint64_t m = a > b ? a : b;
+  return m > c ? m : c;
+}
+
+/* Whether a body's state is one ODE can step: position within SS_MAX_POSITION_M, speeds within the bounds (every
+ * comparison is false for a NaN). Combined with & (no branch a number): the slow naming path runs only on failure. */
+static int stateWithin(const ssBodyValues* v, double max_speed2, double max_spin2) {
+  return (largestOf(v->position) <= magnitudeBits(SS_MAX_POSITION_M)) & (squared(v->linear_vel) <= max_speed2) &
+         (squared(v->angular_vel) <= max_spin2);
+}
+
+/* Whether a body's force and torque accumulators are within SS_MAX_FORCE_N (and finite), as stateWithin. */
+static int forcesWithin(const ssBodyValues* v) {
+  uint64_t f = largestOf(v->force), t = largestOf(v->torque);
+  return (f > t ? f : t) <= magnitudeBits(SS_MAX_FORCE_N);
+}
+
+/* How many bodies ahead the checks ask for a body's values: a large world's bodies are out of cache after ODE's step
+ * or the program's frame, and the loads of several bodies then overlap instead of waiting one after the other. */
+enum { kPrefetchAhead = 8, kPrefetchFrom = 256 };
+
+/* How far ahead a pass over count bodies asks for them: past the end (none) for a list that stays in cache. */
+static int prefetchDistance(int count) { return count >= kPrefetchFrom ? kPrefetchAhead : count; }
+
+static void prefetchState(const ssBodyValues* v) {
+  __builtin_prefetch(v->position);
+  __builtin_prefetch(v->linear_vel);
+  __builtin_prefetch(v->angular_vel);
+}
+
 ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       dBodyID* failed) {
   const double max_speed2 = bounds->max_speed * bounds->max_speed;
   const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
+  const ssBodyValues* values = known->values;
+  /* the whole list first, with no branch a body (the usual case: all pass); the first failure is found after */
+  int all = 1;
+  const int count = known->count, ahead = prefetchDistance(count);
+  for (int k = 0; k < count; ++k) {
+    if (k + ahead < count) prefetchState(&values[k + ahead]);
+    all &= stateWithin(&values[k], max_speed2, max_spin2);
+    if (bounds->forces) all &= forcesWithin(&values[k]);
+  }
   char named[64];
-  for (int k = 0; k < known->count; ++k) {
-    dBodyID body = known->ids[k];
-    /* every comparison is false for a NaN, and an infinity is beyond every bound: one test a number */
-    int ok = within(dBodyGetPosition(body), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(body)) <= max_speed2 &&
-             squared(dBodyGetAngularVel(body)) <= max_spin2;
-    if (ok && bounds->forces)
-      ok = within(dBodyGetForce(body), SS_MAX_FORCE_N) && within(dBodyGetTorque(body), SS_MAX_FORCE_N);
-    if (!ok) {
-      *failed = body;
-      snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
-      return describe(body, bounds, named);
-    }
+  for (int k = 0; !all && k < known->count; ++k) {
+    if (stateWithin(&values[k], max_speed2, max_spin2) && (!bounds->forces || forcesWithin(&values[k]))) continue;
+    *failed = known->ids[k];
+    snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
+    return describe(known->ids[k], bounds, named);
   }
   for (int g = 0; g < known->geared_count && bounds->gear_step_s > 0; ++g) {
     dBodyID body = known->geared[g];
@@ -302,6 +353,14 @@ ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, co
   return SS_OK;
 }
 
+/* Whether a vector of finite values is not all zeros (-0 is zero), as integers: no floating-point comparison. */
+static int anyBitBesidesSign(const dReal* v) {
+  double x = v[0], y = v[1], z = v[2];
+  uint64_t a, b, c;
+  memcpy(&a, &x, sizeof a), memcpy(&b, &y, sizeof b), memcpy(&c, &z, sizeof c);
+  return ((a | b | c) << 1) != 0;
+}
+
 static int anyNonZero(const double* values) {
   return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
 }
@@ -310,27 +369,36 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBo
   const double max_speed2 = bounds->max_speed * bounds->max_speed;
   const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
   *joints_changed = 0;
+  /* last frame's pushed bodies are unmarked through their list: only a pushed body's entry is written */
+  for (int p = 0; p < known->pushed_count; ++p) known->bodies[known->pushed[p]].pushed = 0;
   known->pushed_count = 0;
-  for (int k = 0; k < known->count; ++k) {
-    dBodyID id = known->ids[k];
-    if (firstJointChanged(dBodyGetJoint(id, 0), known->first_joints[k])) {
+  const int count = known->count, ahead = prefetchDistance(count);
+  for (int k = 0; k < count; ++k) {
+    const ssBodyValues* values = &known->values[k];
+    if (k + ahead < count) { /* the body, the head of its first joint (where ODE keeps its joint list), its values */
+      const char* joint = (const char*)known->first_joints[k + ahead];
+      __builtin_prefetch(known->ids[k + ahead]);
+      if (joint != NULL) __builtin_prefetch(joint), __builtin_prefetch(joint + 64);
+      prefetchState(&values[ahead]);
+      __builtin_prefetch(values[ahead].force);
+      __builtin_prefetch(values[ahead].torque);
+    }
+    if (firstJointChanged(dBodyGetJoint(known->ids[k], 0), known->first_joints[k])) {
       *joints_changed = 1;
       return SS_OK;
     }
-    const dReal* force = dBodyGetForce(id);
-    const dReal* torque = dBodyGetTorque(id);
-    int ok = within(dBodyGetPosition(id), SS_MAX_POSITION_M) && squared(dBodyGetLinearVel(id)) <= max_speed2 &&
-             squared(dBodyGetAngularVel(id)) <= max_spin2 && within(force, SS_MAX_FORCE_N) &&
-             within(torque, SS_MAX_FORCE_N);
-    if (!ok) {
-      *failed = id;
-      return describe(id, bounds, "before the frame");
+    if (!(stateWithin(values, max_speed2, max_spin2) & forcesWithin(values))) {
+      *failed = known->ids[k];
+      return describe(known->ids[k], bounds, "before the frame");
     }
+    const dReal *force = values->force, *torque = values->torque;
+    int pushing = anyBitBesidesSign(force) | anyBitBesidesSign(torque);
+    if (!pushing && !(known->carrying && anyNonZero(known->bodies[k].carried))) continue;
     ssKnownBody* body = &known->bodies[k];
     double* f = body->frame_force;
     f[0] = force[0], f[1] = force[1], f[2] = force[2], f[3] = torque[0], f[4] = torque[1], f[5] = torque[2];
-    body->pushed = anyNonZero(f) || (known->carrying && anyNonZero(body->carried));
-    if (body->pushed) known->pushed[known->pushed_count++] = k;
+    body->pushed = 1;
+    known->pushed[known->pushed_count++] = k;
   }
   return SS_OK;
 }

@@ -20,12 +20,23 @@ typedef struct ssKnownBody {
   double carried[6];     /* momentum (N·s, N·m·s) of frames that took no step, delivered with the next steps */
 } ssKnownBody;
 
+/* Where ODE keeps a body's checked values: its getters return pointers into the body, which stay put for its life,
+ * so they are read once when the body is listed and the checks at every step load the values with no call. */
+typedef struct ssBodyValues {
+  const dReal* position;
+  const dReal* linear_vel;
+  const dReal* angular_vel;
+  const dReal* force;  /* the force accumulator (N) */
+  const dReal* torque; /* the torque accumulator (N·m) */
+} ssBodyValues;
+
 typedef struct ssKnownBodies {
-  ssKnownBody* bodies;
-  dBodyID* ids;           /* bodies[i].body, packed: the checks read nothing else */
+  ssKnownBody* bodies;    /* at a step, read for pushed bodies only (and for all while momentum is carried) */
+  dBodyID* ids;           /* bodies[i].body, packed */
+  ssBodyValues* values;   /* bodies[i]'s values, packed: the checks read nothing else */
   dJointID* first_joints; /* each body's first joint when listed */
   int count;
-  int* pushed; /* indices into bodies of those with pushed set */
+  int* pushed; /* indices into bodies of those with pushed set, and only those */
   int pushed_count;
   int carrying; /* whether any body may carry momentum */
   dBodyID* geared; /* the listed bodies a transmission joint gears (ODE aborts when one turns by pi in a step) */
@@ -63,12 +74,12 @@ typedef struct ssBodyBounds {
   double gear_step_s;
 } ssBodyBounds;
 
-/* Checks every listed body, one pass over the packed handles: its position within SS_MAX_POSITION_M, velocities finite
- * and within the bounds, a geared body's turn within a step (bounds->gear_step_s), and with bounds->forces its
- * accumulators. On the first failure records the message (the body,
- * the quantity, its value, "`when` step `step` of `steps`", formatted then only), sets *failed to the body and returns
- * SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a force or
- * torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). */
+/* Checks every listed body in one pass over the packed values (a second names the first failure): its position
+ * within SS_MAX_POSITION_M, velocities finite and within the bounds, a geared body's turn within a step
+ * (bounds->gear_step_s), and with bounds->forces its accumulators. On the first failure records the message (the
+ * body, the quantity, its value, "`when` step `step` of `steps`", formatted then only), sets *failed to the body and
+ * returns SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a
+ * force or torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). */
 ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       dBodyID* failed);
 

@@ -20,7 +20,8 @@
 static const double kStepCountSlack = 1e-9;
 
 /* A space the stepper adopted from, as it was when last walked: ODE adds a geom at the head of a space's list, so a
- * new geom changes the count or the first geom (sweep-and-prune appends: there only the count tells). */
+ * new geom changes the count or the first geom, or gives the first a body not known (sweep-and-prune appends: there
+ * only the count tells, and ssStepper_DestroyBody, which has every space walked again). */
 typedef struct SeenSpace {
   dSpaceID space;
   int geoms;
@@ -210,6 +211,9 @@ ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body) {
     }
   }
   ssKnownForget(&stepper->known, body); /* at once: inside a frame, the next check must not read it */
+  /* a box spawned in its place leaves a space's count as it was, and may take its geom's or its own address: the
+   * spaces are walked again before the next step */
+  if (stepper->space_count > 0) stepper->spaces[0].geoms = -1;
   ssPoseHistoryForgetBody(stepper->poses, body);
   dBodyDestroy(body);
   return SS_OK;
@@ -334,11 +338,18 @@ static ssStatus adoptBody(ssStepper* stepper, dBodyID body) {
   return status;
 }
 
+/* Whether a space may hold a geom of a body the stepper does not know: its count changed, its first geom is another,
+ * or the first geom's body is not known (a geom destroyed and another added may reuse its address: the body tells). */
 static int spacesChanged(const ssStepper* stepper) {
   for (int i = 0; i < stepper->space_count; ++i) {
     const SeenSpace* seen = &stepper->spaces[i];
     int geoms = dSpaceGetNumGeoms(seen->space);
-    if (geoms != seen->geoms || (geoms > 0 && dSpaceGetGeom(seen->space, 0) != seen->first)) return 1;
+    if (geoms != seen->geoms) return 1;
+    if (geoms == 0) continue;
+    dGeomID first = dSpaceGetGeom(seen->space, 0);
+    if (first != seen->first) return 1;
+    dBodyID body = dGeomIsSpace(first) ? 0 : dGeomGetBody(first);
+    if (body != 0 && !ssKnownContains(&stepper->known, body)) return 1;
   }
   return 0;
 }
@@ -511,10 +522,11 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     }
     /* the boundary: whatever the program or its callbacks did, ODE gets a state and forces it can step. Without
      * callbacks only the stepper wrote since the last check (after the last step, or before the frame): the
-     * frame's checked forces spread over its steps, and load corrections within SS_MAX_FORCE_N */
-    int called_back = def->before_step || def->collide;
-    if ((status = refreshKnown(stepper)) != SS_OK ||
-        (called_back && (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
+     * frame's checked forces spread over its steps, and load corrections within SS_MAX_FORCE_N. step_done ran
+     * after the last step's check */
+    int called_back = def->before_step || def->collide || (i > 0 && def->step_done);
+    if (called_back && ((status = refreshKnown(stepper)) != SS_OK || /* what the callbacks bound or watched */
+                        (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistoryBeforeLastStep(stepper->poses);
     int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, step_s)
@@ -533,6 +545,9 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
   return SS_OK;
 }
 
+/* x, or 0 for a negative x (fmax(x, 0) without a call into libm). */
+static double atLeastZero(double x) { return x > 0 ? x : 0; }
+
 /* WHOLE_FRAME: one step of the frame. SUBSTEPS: n equal substeps no longer than max_step_s, at most
  * max_steps_per_frame. A frame too short to step waits for the next one. */
 static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* report) {
@@ -545,18 +560,19 @@ static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* rep
     return SS_OK;
   }
   int steps = 1;
-  if (stepping->cut == SS_CUT_SUBSTEPS) {
+  /* a frame no longer than max_step_s is one step (the division would say so: total_s / max_step_s <= 1) */
+  if (stepping->cut == SS_CUT_SUBSTEPS && total_s > stepping->max_step_s) {
     double count = ceil(total_s / stepping->max_step_s - kStepCountSlack);
     steps = count < 1 ? 1 : count > stepping->max_steps_per_frame ? stepping->max_steps_per_frame : (int)count;
   }
   stepper->short_frame_s = 0;
-  double step_s = total_s / steps;
+  double step_s = steps == 1 ? total_s : total_s / steps;
   if (stepping->cut == SS_CUT_SUBSTEPS && step_s > stepping->max_step_s * (1 + kStepCountSlack)) {
     /* a long frame (a breakpoint, a hitch) is cut off like the fixed cut's: the rest is dropped, and reported */
     step_s = stepping->max_step_s;
     report->dropped_s = total_s - steps * step_s;
   }
-  ssStatus status = takeSteps(stepper, steps, step_s, fmax(frame_s - report->dropped_s, 0), report);
+  ssStatus status = takeSteps(stepper, steps, step_s, atLeastZero(frame_s - report->dropped_s), report);
   clearCarried(stepper);
   return status;
 }
@@ -578,10 +594,10 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
   if (due == 0) {
     carryForces(stepper, frame_s);
   } else {
-    status = takeSteps(stepper, (int)due, step_s, fmax(frame_s - report->dropped_s, 0), report);
+    status = takeSteps(stepper, (int)due, step_s, atLeastZero(frame_s - report->dropped_s), report);
     clearCarried(stepper);
   }
-  stepper->accumulator_s = fmax(accumulator_s - report->steps * step_s, 0);
+  stepper->accumulator_s = atLeastZero(accumulator_s - report->steps * step_s);
   report->carried_s = stepper->accumulator_s;
   report->interpolation = fmin(stepper->accumulator_s / step_s, nextafter(1.0, 0.0));
   ssPoseHistoryEndFrame(stepper->poses, report->steps, report->interpolation);
@@ -612,18 +628,22 @@ ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* repor
   if (stepper != NULL) REFUSE_IN_STEP(stepper, "ssStepper_Step");
   ssFrameReport local;
   if (report == NULL) report = &local;
-  memset(report, 0, sizeof *report);
+  static const ssFrameReport kNothingYet; /* copied in a few moves (zeroing in place compiles to a slow rep stos) */
+  *report = kNothingYet;
   REQUIRE_STEPPER(stepper);
   if (stepper->failed_status != SS_OK)
     return ssFail(SS_ERROR_FAILED, "an earlier frame failed (%s): repair or restore the bodies, then call "
                                    "ssStepper_Reset", stepper->failed_message);
   /* any frame from 0 up is taken: one shorter than SS_MIN_STEP_S (0 included) waits for the next, with its forces */
-  ssStatus status = ssCheckNonNegative("frame_s", "s", frame_s);
-  if (status == SS_OK && frame_s > SS_MAX_FRAME_S)
-    status = ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: must be at most SS_MAX_FRAME_S = %g s", frame_s,
-                    (double)SS_MAX_FRAME_S);
+  if (!(frame_s >= 0 && frame_s <= SS_MAX_FRAME_S)) { /* false for a NaN too; named below */
+    ssStatus refused = ssCheckNonNegative("frame_s", "s", frame_s);
+    if (refused == SS_OK)
+      refused = ssFail(SS_ERROR_OUT_OF_RANGE, "frame_s = %g s: must be at most SS_MAX_FRAME_S = %g s", frame_s,
+                       (double)SS_MAX_FRAME_S);
+    return refused;
+  }
+  ssStatus status = startFrame(stepper, report);
   if (status != SS_OK) return status;
-  if ((status = startFrame(stepper, report)) != SS_OK) return status;
   stepper->report = report;
   stepper->in_step = 1;
   status = stepper->def.stepping.cut == SS_CUT_FIXED ? stepFixed(stepper, frame_s, report)

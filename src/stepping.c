@@ -93,7 +93,9 @@ enum { POLICY_COUNT = sizeof policies / sizeof policies[0] };
 
 int ssSteppingPolicyCount(void) { return POLICY_COUNT; }
 
-const char* ssSteppingPolicyNameAt(int index) { return index >= 0 && index < POLICY_COUNT ? policies[index].name : NULL; }
+const char* ssSteppingPolicyNameAt(int index) {
+  return index >= 0 && index < POLICY_COUNT ? policies[index].name : NULL;
+}
 
 ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssStepping* stepping) {
   if (stepping == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping = NULL: needs somewhere to write the policy");

@@ -155,6 +155,45 @@ TEST_F(PromiseTest, AStateSetBetweenFramesIsRefusedByNameBeforeODEOrTheSpaceSees
   }
 }
 
+// step_done runs between a frame's steps: what it sets is checked before the next step even when the program has no
+// before_step or collide callback (without them, nothing else runs between two steps and no other check is made).
+TEST_F(PromiseTest, AStateSetInStepDoneIsRefusedBeforeTheNextStepWithNoOtherCallback) {
+  dBodyID body = Box(0, 0, 1);
+  struct Case {
+    void (*set)(dBodyID);
+    ssStatus status;
+    const char* named;
+  } cases[] = {
+      {[](dBodyID b) { dBodySetLinearVel(b, NAN, 0, 0); }, SS_ERROR_BLOWUP, "linear velocity (nan, 0, 0)"},
+      {[](dBodyID b) { dBodyAddForce(b, 0, 0, kTooStrongN); }, SS_ERROR_OUT_OF_RANGE, "beyond SS_MAX_FORCE_N"},
+  };
+  for (const Case& c : cases) {
+    ssStepper_Destroy(stepper);
+    stepper = nullptr;
+    dBodySetPosition(body, 0, 0, 1);
+    dBodySetLinearVel(body, 0, 0, 0);
+    ssStepperDef def = Def();
+    def.collide = nullptr;
+    struct Setter {
+      const Case* c;
+      dBodyID body;
+      int calls = 0;
+    } setter{&c, body};
+    def.step_done = [](void* context, double) {
+      auto* s = static_cast<Setter*>(context);
+      if (++s->calls == 1) s->c->set(s->body);
+    };
+    def.step_done_context = &setter;
+    ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+    ssFrameReport report;
+    EXPECT_EQ(ssStepper_Step(stepper, 0.05, &report), c.status) << c.named;
+    EXPECT_TRUE(Names(c.named)) << ssLastError();
+    EXPECT_TRUE(Names("before step 2 of 3")) << ssLastError();
+    EXPECT_EQ(report.steps, 1);
+    EXPECT_EQ(report.failed_body, body);
+  }
+}
+
 TEST_F(PromiseTest, TheRunawayLeftByAResetWithoutRepairIsRefusedAgainNotStepped) {
   dBodyID body = Box(0, 0, 1);
   ssStepperDef def = Def();
@@ -406,6 +445,52 @@ TEST_F(PromiseTest, ABodySpawnedInACallbackIsFoundBeforeTheNextStep) {
   ssFrameReport report;
   EXPECT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_ERROR_BLOWUP);
   EXPECT_EQ(report.failed_body, spawner.body);
+}
+
+// The stepper looks at an adopted space's geom count and its first geom to find what was added since: a program
+// that destroys a box and spawns another between frames leaves the count as it was. In every kind of space that
+// lists its geoms (a hash and a simple space add at the head of their list, sweep-and-prune appends), the spawned
+// body is known at the next frame: its state is checked before ODE steps it.
+TEST_F(PromiseTest, ABoxSpawnedInPlaceOfADestroyedOneIsFoundAtTheSameGeomCount) {
+  struct Kind {
+    const char* name;
+    dSpaceID (*make)();
+  } kinds[] = {
+      {"hash", [] { return dHashSpaceCreate(0); }},
+      {"simple", [] { return dSimpleSpaceCreate(0); }},
+      {"sweep-and-prune", [] { return dSweepAndPruneSpaceCreate(0, dSAP_AXES_XYZ); }},
+  };
+  for (const Kind& kind : kinds) {
+    for (int doomed_index = 0; doomed_index < 3; ++doomed_index) {
+      SCOPED_TRACE(std::string(kind.name) + ", destroying box " + std::to_string(doomed_index));
+      dSpaceID boxes = kind.make();
+      dBodyID bodies[3];
+      for (int i = 0; i < 3; ++i) {
+        bodies[i] = MakeBody(1.0, 2.0 * i, 0, 0);
+        dGeomSetBody(dCreateBox(boxes, 0.1, 0.1, 0.1), bodies[i]);
+      }
+      ssStepperDef def = Def();
+      def.space = boxes;
+      def.collide = nullptr;
+      ssStepper* own = nullptr;
+      ASSERT_EQ(ssStepper_Create(&def, &own), SS_OK) << ssLastError();
+      ASSERT_EQ(ssStepper_Step(own, 1.0 / 60, nullptr), SS_OK) << ssLastError();
+      const int geoms = dSpaceGetNumGeoms(boxes);
+      dBodyID doomed = bodies[doomed_index];
+      dGeomDestroy(dBodyGetFirstGeom(doomed));
+      ASSERT_EQ(ssStepper_DestroyBody(own, doomed), SS_OK);
+      dBodyID spawned = MakeBody(1.0, 0, 3, 0);
+      dGeomSetBody(dCreateBox(boxes, 0.1, 0.1, 0.1), spawned);
+      ASSERT_EQ(dSpaceGetNumGeoms(boxes), geoms);
+      dBodySetLinearVel(spawned, NAN, 0, 0);
+      ssFrameReport report;
+      EXPECT_EQ(ssStepper_Step(own, 1.0 / 60, &report), SS_ERROR_BLOWUP);
+      EXPECT_EQ(report.failed_body, spawned);
+      EXPECT_TRUE(Names("before the frame")) << ssLastError();
+      ssStepper_Destroy(own);
+      dSpaceDestroy(boxes);
+    }
+  }
 }
 
 TEST_F(PromiseTest, ABobHungFromAKnownBodyIsKnownThroughItsJointAndOneHungFromTheWorldIsWatched) {
