@@ -297,8 +297,9 @@ static uint64_t largestOf(const dReal* v) {
 /* Whether a body's state is one ODE can step: position within SS_MAX_POSITION_M, speeds within the bounds (every
  * comparison is false for a NaN). Combined with & (no branch a number): the slow naming path runs only on failure. */
 static int stateWithin(const ssBodyValues* v, double max_speed2, double max_spin2) {
-  return (largestOf(v->position) <= magnitudeBits(SS_MAX_POSITION_M)) & (squared(v->linear_vel) <= max_speed2) &
-         (squared(v->angular_vel) <= max_spin2);
+  int position_within = largestOf(v->position) <= magnitudeBits(SS_MAX_POSITION_M);
+  int speed_within = squared(v->linear_vel) <= max_speed2, spin_within = squared(v->angular_vel) <= max_spin2;
+  return position_within & speed_within & spin_within;
 }
 
 /* Whether a body's force and torque accumulators are within SS_MAX_FORCE_N (and finite), as stateWithin. */

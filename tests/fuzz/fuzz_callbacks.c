@@ -33,8 +33,8 @@ typedef struct Action {
   When when;
   What what;
   int step;         /* the step index within the frame it fires at, or EVERY_STEP */
-  uint8_t target;   /* the body or joint, by pick_body / pick_joint */
-  uint8_t which;    /* ADD_FORCE and SET_STATE: what of the body (see push and set_state) */
+  uint8_t target;   /* the body or joint, by pickBody / pickJoint */
+  uint8_t which;    /* ADD_FORCE and SET_STATE: what of the body (see push and setState) */
   double values[3]; /* the vector; REENTER_STEP: values[0] is the frame (s) */
   uint8_t policy;   /* REENTER_SET_STEPPING: the policy index (one past the end is NULL) */
 } Action;
@@ -56,14 +56,14 @@ static int named(ssStatus status) {
 }
 
 /* A refusal is a named status with a message. */
-static void check_status(ssStatus status, const char* what) {
+static void checkStatus(ssStatus status, const char* what) {
   FUZZ_REQUIRE(named(status), "%s returned an unnamed status %d", what, (int)status);
   FUZZ_REQUIRE(status == SS_OK || ssLastError()[0] != '\0', "%s refused (%s) without a message", what,
                ssStatusName(status));
 }
 
 /* Forgets the body (and its geom) or the joint in the islands' lists, once the stepper destroyed it. */
-static void forget_body(World* w, dBodyID body) {
+static void forgetBody(World* w, dBodyID body) {
   for (int k = 0; k < ISLAND_COUNT; ++k) {
     Island* island = &w->islands[k];
     for (int i = 0; i < island->body_count; ++i)
@@ -81,7 +81,7 @@ static void forget_body(World* w, dBodyID body) {
   }
 }
 
-static void forget_joint(World* w, dJointID joint) {
+static void forgetJoint(World* w, dJointID joint) {
   for (int k = 0; k < ISLAND_COUNT; ++k) {
     Island* island = &w->islands[k];
     for (int i = 0; i < island->joint_count; ++i)
@@ -94,7 +94,7 @@ static void forget_joint(World* w, dJointID joint) {
   }
 }
 
-static dGeomID geom_of(World* w, dBodyID body) {
+static dGeomID geomOf(World* w, dBodyID body) {
   for (int k = 0; k < ISLAND_COUNT; ++k)
     for (int i = 0; i < w->islands[k].body_count; ++i)
       if (w->islands[k].bodies[i] == body) return w->islands[k].geoms[i];
@@ -103,17 +103,17 @@ static dGeomID geom_of(World* w, dBodyID body) {
 
 /* A program's destroying of a body: its geom first (never inside dSpaceCollide: actions run outside it), then the
  * stepper's DestroyBody. */
-static void destroy_body(World* w, ssStepper* stepper, dBodyID body) {
-  dGeomID geom = geom_of(w, body);
+static void destroyBody(World* w, ssStepper* stepper, dBodyID body) {
+  dGeomID geom = geomOf(w, body);
   if (geom != 0) {
     dGeomSetBody(geom, 0);
     dGeomDisable(geom); /* a geom without a body sits in the space until the body is gone */
   }
   ssStatus status = ssStepper_DestroyBody(stepper, body);
-  check_status(status, "ssStepper_DestroyBody");
+  checkStatus(status, "ssStepper_DestroyBody");
   if (status == SS_OK) {
     if (geom != 0) dGeomDestroy(geom);
-    forget_body(w, body);
+    forgetBody(w, body);
   } else if (geom != 0) {
     dGeomSetBody(geom, body);
     dGeomEnable(geom);
@@ -132,7 +132,7 @@ static void push(dBodyID body, uint8_t which, const double* v) {
 }
 
 /* Sets a state the way a program does: which % 3 is the position, the velocity, the spin. */
-static void set_state(World* w, dBodyID body, uint8_t which, const double* v) {
+static void setState(World* w, dBodyID body, uint8_t which, const double* v) {
   switch (which % 3) {
     case 0: teleport(w, body, v[0], v[1], v[2]); break;
     case 1: dBodySetLinearVel(body, v[0], v[1], v[2]); break;
@@ -147,38 +147,38 @@ static void fire(Program* p, ssStepper* stepper, const Action* a) {
             WHAT_NAMES[a->what], a->target, a->which, a->values[0], a->values[1], a->values[2]);
   switch (a->what) {
     case ADD_FORCE: {
-      dBodyID body = pick_body(w, a->target);
+      dBodyID body = pickBody(w, a->target);
       if (body != 0) push(body, a->which, a->values);
       break;
     }
     case SET_STATE: {
-      dBodyID body = pick_body(w, a->target);
+      dBodyID body = pickBody(w, a->target);
       if (body == 0) break;
-      set_state(w, body, a->which, a->values);
+      setState(w, body, a->which, a->values);
       if (a->when == WHEN_STEP_DONE) p->set_after_check = 1;
       break;
     }
     case DESTROY_BODY: {
-      dBodyID body = pick_body(w, a->target);
+      dBodyID body = pickBody(w, a->target);
       if (body != 0) {
-        destroy_body(w, stepper, body);
+        destroyBody(w, stepper, body);
       } else {
         ssStatus status = ssStepper_DestroyBody(stepper, 0);
         FUZZ_REQUIRE(status != SS_OK, "ssStepper_DestroyBody(NULL) accepted");
-        check_status(status, "ssStepper_DestroyBody(NULL)");
+        checkStatus(status, "ssStepper_DestroyBody(NULL)");
       }
       break;
     }
     case DESTROY_JOINT: {
-      dJointID joint = pick_joint(w, a->target);
+      dJointID joint = pickJoint(w, a->target);
       ssStatus status = ssStepper_DestroyJoint(stepper, joint);
-      check_status(status, "ssStepper_DestroyJoint");
+      checkStatus(status, "ssStepper_DestroyJoint");
       if (joint == 0) FUZZ_REQUIRE(status != SS_OK, "ssStepper_DestroyJoint(NULL) accepted");
-      if (status == SS_OK) forget_joint(w, joint);
+      if (status == SS_OK) forgetJoint(w, joint);
       break;
     }
     case REENTER_STEP: {
-      if (!within_budget(w, a->values[0])) break;
+      if (!withinBudget(w, a->values[0])) break;
       ssFrameReport report;
       ssStatus status = ssStepper_Step(stepper, a->values[0], &report);
       if (verbose) fprintf(stderr, "    = %s %s\n", ssStatusName(status), status == SS_OK ? "" : ssLastError());
@@ -211,7 +211,7 @@ static void fire(Program* p, ssStepper* stepper, const Action* a) {
 
 /* Runs the actions armed for this callback and step, in the outermost frame only, and not after the stepper was
  * destroyed (the program no longer has it). */
-static void run_actions(Program* p, ssStepper* stepper, When when, int step) {
+static void runActions(Program* p, ssStepper* stepper, When when, int step) {
   if (p->in_action) return;
   p->in_action = 1;
   for (int i = 0; i < p->action_count && !p->stepper_destroyed; ++i) {
@@ -221,41 +221,41 @@ static void run_actions(Program* p, ssStepper* stepper, When when, int step) {
   p->in_action = 0;
 }
 
-static void before_step(void* context, ssStepper* stepper) {
+static void beforeStep(void* context, ssStepper* stepper) {
   Program* p = context;
   p->set_after_check = 0;
-  run_actions(p, stepper, WHEN_BEFORE_STEP, ssStepper_CurrentStep(stepper).index);
+  runActions(p, stepper, WHEN_BEFORE_STEP, ssStepper_CurrentStep(stepper).index);
 }
 
 static void collide(void* context, ssStepper* stepper) {
   Program* p = context;
-  run_actions(p, stepper, WHEN_COLLIDE, ssStepper_CurrentStep(stepper).index);
-  if (!p->stepper_destroyed) collide_all(&p->w, stepper);
+  runActions(p, stepper, WHEN_COLLIDE, ssStepper_CurrentStep(stepper).index);
+  if (!p->stepper_destroyed) collideAll(&p->w, stepper);
 }
 
-static void step_done(void* context, double step_s) {
+static void stepDone(void* context, double step_s) {
   (void)step_s;
   Program* p = context;
   if (p->in_action) return;
-  run_actions(p, p->w.stepper, WHEN_STEP_DONE, p->steps_done++);
+  runActions(p, p->w.stepper, WHEN_STEP_DONE, p->steps_done++);
 }
 
-static ssStepperDef program_def(void) {
+static ssStepperDef programDef(void) {
   ssStepperDef def = ssDefaultStepperDef();
-  def.before_step = before_step;
+  def.before_step = beforeStep;
   def.before_step_context = &program;
   def.collide = collide;
   def.collide_context = &program;
-  def.step_done = step_done;
+  def.step_done = stepDone;
   def.step_done_context = &program;
   return def;
 }
 
 /* After ssStepper_Destroy from a callback: the program makes a new stepper with the stepping it had, and watches its
  * bodies again. */
-static void replace_stepper(Program* p) {
+static void replaceStepper(Program* p) {
   World* w = &p->w;
-  ssStepperDef def = program_def();
+  ssStepperDef def = programDef();
   def.world = w->world;
   def.registry = w->registry;
   def.contact_group = w->contacts;
@@ -271,7 +271,7 @@ static void replace_stepper(Program* p) {
  * repair, reset without repairing, or step again. */
 static void frame(Program* p, double frame_s, int op) {
   World* w = &p->w;
-  if (!within_budget(w, frame_s)) return;
+  if (!withinBudget(w, frame_s)) return;
   p->steps_done = 0;
   p->set_after_check = 0;
   ssFrameReport report;
@@ -281,11 +281,11 @@ static void frame(Program* p, double frame_s, int op) {
     fprintf(stderr, "op %d: %s/%s frame %.17g s: %s, %d steps, %s\n", op,
             NAME_OR_UNKNOWN(ssFrameCutName(w->stepping.cut)), NAME_OR_UNKNOWN(ssMappingName(w->stepping.mapping)),
             frame_s, ssStatusName(status), report.steps, status == SS_OK ? "" : ssLastError());
-  check_status(status, "ssStepper_Step");
+  checkStatus(status, "ssStepper_Step");
   if (p->stepper_destroyed) {
     /* stepper.h: the frame stops where it is, the report is filled, SS_OK, and the stepper is freed. */
     FUZZ_REQUIRE(status == SS_OK, "op %d: the frame that destroyed its stepper returned %s", op, ssStatusName(status));
-    replace_stepper(p);
+    replaceStepper(p);
     return;
   }
   w->steps_left -= report.steps > 0 ? report.steps : 0;
@@ -293,7 +293,7 @@ static void frame(Program* p, double frame_s, int op) {
   if (status == SS_OK && report.steps > 0 && !p->set_after_check) {
     BodyState after[STATE_CAPACITY];
     int count = snapshot(w, after), which = -1;
-    FUZZ_REQUIRE(all_finite(after, count, &which), "op %d: frame %.17g s reported OK but body %d is not finite", op,
+    FUZZ_REQUIRE(allFinite(after, count, &which), "op %d: frame %.17g s reported OK but body %d is not finite", op,
                  frame_s, which);
   }
   if (status == SS_ERROR_BLOWUP || status == SS_ERROR_SPEED_LIMIT)
@@ -314,12 +314,12 @@ static void repair(World* w) {
     }
 }
 
-static void read_vector(FuzzInput* in, double* v) {
-  for (int i = 0; i < 3; ++i) v[i] = fuzz_double(in);
+static void readVector(FuzzInput* in, double* v) {
+  for (int i = 0; i < 3; ++i) v[i] = fuzzDouble(in);
 }
 
 /* An action from the input: [when, what, step] [target] [which] [its values]. */
-static Action read_action(FuzzInput* in) {
+static Action readAction(FuzzInput* in) {
   Action a;
   memset(&a, 0, sizeof a);
   uint8_t kind = fuzz_byte(in);
@@ -331,8 +331,8 @@ static Action read_action(FuzzInput* in) {
   a.which = fuzz_byte(in);
   switch (a.what) {
     case ADD_FORCE:
-    case SET_STATE: read_vector(in, a.values); break;
-    case REENTER_STEP: a.values[0] = fuzz_double(in); break;
+    case SET_STATE: readVector(in, a.values); break;
+    case REENTER_STEP: a.values[0] = fuzzDouble(in); break;
     case REENTER_SET_STEPPING: a.policy = a.which; break;
     default: break;
   }
@@ -343,24 +343,24 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzInput in = {data, size};
   Program* p = &program;
   memset(p, 0, sizeof *p);
-  ssStepperDef def = program_def();
-  make_world(&p->w, &in, &def);
+  ssStepperDef def = programDef();
+  makeWorld(&p->w, &in, &def);
   World* w = &p->w;
-  for (int op = 0; op < MAX_OPS && !fuzz_empty(&in); ++op) {
+  for (int op = 0; op < MAX_OPS && !fuzzEmpty(&in); ++op) {
     uint8_t code = fuzz_byte(&in);
     if (verbose) fprintf(stderr, "op %d: code %d\n", op, code % 9);
     switch (code % 9) {
       case 0:
-        frame(p, fuzz_double(&in), op);
+        frame(p, fuzzDouble(&in), op);
         break;
       case 1: {
         int repeat = 1 + fuzz_byte(&in) % 8;
-        double frame_s = fuzz_double(&in);
+        double frame_s = fuzzDouble(&in);
         for (int i = 0; i < repeat; ++i) frame(p, frame_s, op);
         break;
       }
       case 2: {
-        Action a = read_action(&in);
+        Action a = readAction(&in);
         if (p->action_count < MAX_ACTIONS) p->actions[p->action_count++] = a;
         if (verbose)
           fprintf(stderr, "  armed %s in %s at step %d\n", WHAT_NAMES[a.what], WHEN_NAMES[a.when], a.step);
@@ -369,12 +369,12 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       case 3:
       case 4: {
         /* Between frames: a state set (a teleport, a corrupt save) or a force added, any value. */
-        dBodyID body = pick_body(w, fuzz_byte(&in));
+        dBodyID body = pickBody(w, fuzz_byte(&in));
         uint8_t which = fuzz_byte(&in);
         double v[3];
-        read_vector(&in, v);
+        readVector(&in, v);
         if (body == 0) break;
-        if (code % 9 == 3) set_state(w, body, which, v);
+        if (code % 9 == 3) setState(w, body, which, v);
         else push(body, which, v);
         if (verbose)
           fprintf(stderr, "  %s %d: %.17g %.17g %.17g\n", code % 9 == 3 ? "state" : "force", which, v[0], v[1], v[2]);
@@ -390,9 +390,9 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       case 7: {
         ssStepping stepping = w->stepping;
         const char* name = ssSteppingPolicyNameAt(fuzz_byte(&in) % (ssSteppingPolicyCount() + 1));
-        if (ssSteppingForPolicy(name, fuzz_double(&in), &stepping) != SS_OK) break;
+        if (ssSteppingForPolicy(name, fuzzDouble(&in), &stepping) != SS_OK) break;
         ssStatus status = ssStepper_SetStepping(w->stepper, &stepping);
-        check_status(status, "ssStepper_SetStepping");
+        checkStatus(status, "ssStepper_SetStepping");
         if (status == SS_OK) w->stepping = ssStepper_Stepping(w->stepper);
         break;
       }
@@ -401,6 +401,6 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         break;
     }
   }
-  destroy_world(w);
+  destroyWorld(w);
   return 0;
 }

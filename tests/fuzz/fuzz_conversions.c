@@ -10,22 +10,22 @@ static const unsigned char CANARY = 0xA5;
 /* The call under test with its arguments, as C, for the report of a broken promise. */
 static char call[512];
 
-static void fill_canary(void* out, size_t size) { memset(out, CANARY, size); }
+static void fillCanary(void* out, size_t size) { memset(out, CANARY, size); }
 
-static int is_canary(const void* out, size_t size) {
+static int isCanary(const void* out, size_t size) {
   const unsigned char* bytes = out;
   for (size_t i = 0; i < size; ++i)
     if (bytes[i] != CANARY) return 0;
   return 1;
 }
 
-static void require_refused_cleanly(ssStatus status, const void* out, size_t size, const char* what) {
+static void requireRefusedCleanly(ssStatus status, const void* out, size_t size, const char* what) {
   FUZZ_REQUIRE(ssLastError()[0] != '\0', "%s refused (%s) without a message; %s", what, ssStatusName(status), call);
-  FUZZ_REQUIRE(is_canary(out, size), "%s refused (%s: %s) but wrote its output; %s", what, ssStatusName(status),
+  FUZZ_REQUIRE(isCanary(out, size), "%s refused (%s: %s) but wrote its output; %s", what, ssStatusName(status),
                ssLastError(), call);
 }
 
-static void require_valid_spring(ssSpring spring, const char* what) {
+static void requireValidSpring(ssSpring spring, const char* what) {
   FUZZ_REQUIRE(isfinite(spring.stiffness) && isfinite(spring.damping) && spring.stiffness >= 0 &&
                    spring.damping >= 0 && (spring.stiffness > 0 || spring.damping > 0),
                "%s returned OK with k = %g, c = %g; %s", what, spring.stiffness, spring.damping, call);
@@ -45,7 +45,7 @@ static void require_valid_spring(ssSpring spring, const char* what) {
 #endif
 
 /* A softness returned OK: finite, cfm in (0, SS_MAX_CFM], |erp| <= SS_MAX_ERP; implicit Euler's erp in [0, 1]. */
-static void require_valid_softness(ssSoftness softness, const char* what, ssSpring spring, double mass, double h,
+static void requireValidSoftness(ssSoftness softness, const char* what, ssSpring spring, double mass, double h,
                                    double previous, int spring_mapping) {
   FUZZ_REQUIRE(isfinite(softness.erp) && fabs(softness.erp) <= SS_MAX_ERP && isfinite(softness.cfm) &&
                    softness.cfm > 0 && softness.cfm <= SS_MAX_CFM &&
@@ -56,52 +56,52 @@ static void require_valid_softness(ssSoftness softness, const char* what, ssSpri
 }
 
 /* The outcome of a softness call: checked whichever way it went. */
-static void check_softness(ssStatus status, const ssSoftness* out, const char* what, ssSpring spring, double mass,
+static void checkSoftness(ssStatus status, const ssSoftness* out, const char* what, ssSpring spring, double mass,
                            double h, double previous, int spring_mapping) {
   if (status == SS_OK)
-    require_valid_softness(*out, what, spring, mass, h, previous, spring_mapping);
+    requireValidSoftness(*out, what, spring, mass, h, previous, spring_mapping);
   else
-    require_refused_cleanly(status, out, sizeof *out, what);
+    requireRefusedCleanly(status, out, sizeof *out, what);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzInput in = {data, size};
   uint8_t which = fuzz_byte(&in);
-  ssSpring spring = {fuzz_double(&in), fuzz_double(&in)};
-  double a = fuzz_double(&in), b = fuzz_double(&in), c = fuzz_double(&in);
+  ssSpring spring = {fuzzDouble(&in), fuzzDouble(&in)};
+  double a = fuzzDouble(&in), b = fuzzDouble(&in), c = fuzzDouble(&in);
   ssSoftness softness;
   ssSpring spring_out;
   snprintf(call, sizeof call, "case %d: spring = {%.17g, %.17g}, a = %.17g, b = %.17g, c = %.17g", which % 9,
            spring.stiffness, spring.damping, a, b, c);
   switch (which % 9) {
     case 0: {
-      fill_canary(&softness, sizeof softness);
-      check_softness(ssImplicitEulerSoftness(spring, a, &softness), &softness, "ssImplicitEulerSoftness", spring, 0,
+      fillCanary(&softness, sizeof softness);
+      checkSoftness(ssImplicitEulerSoftness(spring, a, &softness), &softness, "ssImplicitEulerSoftness", spring, 0,
                      a, 0, 1);
       break;
     }
     case 1: {
       ssSoftness given = {spring.stiffness, spring.damping};
-      fill_canary(&spring_out, sizeof spring_out);
+      fillCanary(&spring_out, sizeof spring_out);
       ssStatus status = ssSpringFromSoftness(given, a, &spring_out);
       if (status == SS_OK)
-        require_valid_spring(spring_out, "ssSpringFromSoftness");
+        requireValidSpring(spring_out, "ssSpringFromSoftness");
       else
-        require_refused_cleanly(status, &spring_out, sizeof spring_out, "ssSpringFromSoftness");
+        requireRefusedCleanly(status, &spring_out, sizeof spring_out, "ssSpringFromSoftness");
       break;
     }
     case 2: {
-      fill_canary(&spring_out, sizeof spring_out);
+      fillCanary(&spring_out, sizeof spring_out);
       ssStatus status = ssSpringFromFrequency(a, b, c, &spring_out);
       if (status == SS_OK)
-        require_valid_spring(spring_out, "ssSpringFromFrequency");
+        requireValidSpring(spring_out, "ssSpringFromFrequency");
       else
-        require_refused_cleanly(status, &spring_out, sizeof spring_out, "ssSpringFromFrequency");
+        requireRefusedCleanly(status, &spring_out, sizeof spring_out, "ssSpringFromFrequency");
       break;
     }
     case 3: {
       double results[2];
-      fill_canary(results, sizeof results);
+      fillCanary(results, sizeof results);
       ssStatus status = ssFrequencyFromSpring(spring, a, &results[0], &results[1]);
       if (status == SS_OK) {
         /* A pure damper has frequency 0 and an infinite damping ratio (documented); otherwise both finite. */
@@ -111,24 +111,24 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                      "ssFrequencyFromSpring(k = %.17g, c = %.17g, mass = %.17g) returned OK with f = %g, zeta = %g",
                      spring.stiffness, spring.damping, a, results[0], results[1]);
       } else {
-        require_refused_cleanly(status, results, sizeof results, "ssFrequencyFromSpring");
+        requireRefusedCleanly(status, results, sizeof results, "ssFrequencyFromSpring");
       }
       break;
     }
     case 4:
-      fill_canary(&softness, sizeof softness);
-      check_softness(ssMatchedSoftness(spring, a, b, &softness), &softness, "ssMatchedSoftness", spring, a, b, 0,
+      fillCanary(&softness, sizeof softness);
+      checkSoftness(ssMatchedSoftness(spring, a, b, &softness), &softness, "ssMatchedSoftness", spring, a, b, 0,
                      0);
       break;
     case 5:
-      fill_canary(&softness, sizeof softness);
-      check_softness(ssExactSoftness(spring, a, b, c, &softness), &softness, "ssExactSoftness", spring, a, b, c,
+      fillCanary(&softness, sizeof softness);
+      checkSoftness(ssExactSoftness(spring, a, b, c, &softness), &softness, "ssExactSoftness", spring, a, b, c,
                      0);
       break;
     case 6: {
-      int mapping = fuzz_int(&in);
-      fill_canary(&softness, sizeof softness);
-      check_softness(ssSoftnessFor((ssMapping)mapping, spring, a, b, c, &softness), &softness, "ssSoftnessFor",
+      int mapping = fuzzInt(&in);
+      fillCanary(&softness, sizeof softness);
+      checkSoftness(ssSoftnessFor((ssMapping)mapping, spring, a, b, c, &softness), &softness, "ssSoftnessFor",
                      spring, a, b, c, mapping == SS_MAPPING_IMPLICIT_EULER);
       const char* name = ssMappingName((ssMapping)mapping);
       FUZZ_REQUIRE((mapping >= 0 && mapping <= 2) == (name != NULL), "ssMappingName(%d) = %s", mapping,
@@ -146,16 +146,16 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     case 8: {
       /* A round trip: a spring accepted, turned into softness at h and back, is a valid spring again. */
-      fill_canary(&softness, sizeof softness);
+      fillCanary(&softness, sizeof softness);
       ssStatus status = ssImplicitEulerSoftness(spring, a, &softness);
-      check_softness(status, &softness, "ssImplicitEulerSoftness", spring, 0, a, 0, 1);
+      checkSoftness(status, &softness, "ssImplicitEulerSoftness", spring, 0, a, 0, 1);
       if (status == SS_OK && softness.erp > 0) {
-        fill_canary(&spring_out, sizeof spring_out);
+        fillCanary(&spring_out, sizeof spring_out);
         status = ssSpringFromSoftness(softness, a, &spring_out);
         if (status == SS_OK)
-          require_valid_spring(spring_out, "ssSpringFromSoftness(ssImplicitEulerSoftness)");
+          requireValidSpring(spring_out, "ssSpringFromSoftness(ssImplicitEulerSoftness)");
         else
-          require_refused_cleanly(status, &spring_out, sizeof spring_out, "ssSpringFromSoftness");
+          requireRefusedCleanly(status, &spring_out, sizeof spring_out, "ssSpringFromSoftness");
       }
       break;
     }

@@ -27,9 +27,9 @@ static inline uint8_t fuzz_byte(FuzzInput* in) {
   return byte;
 }
 
-static inline int fuzz_empty(const FuzzInput* in) { return in->size == 0; }
+static inline int fuzzEmpty(const FuzzInput* in) { return in->size == 0; }
 
-static inline double fuzz_raw_double(FuzzInput* in) {
+static inline double fuzzRawDouble(FuzzInput* in) {
   uint8_t bytes[8] = {0};
   for (int i = 0; i < 8; ++i) bytes[i] = fuzz_byte(in);
   double value;
@@ -38,7 +38,7 @@ static inline double fuzz_raw_double(FuzzInput* in) {
 }
 
 /* One byte chooses: below the table's length a table value (or its negation), otherwise raw bytes. */
-static inline double fuzz_double(FuzzInput* in) {
+static inline double fuzzDouble(FuzzInput* in) {
   static const double table[] = {
       0.0,     4.9406564584124654e-324, 2.2250738585072009e-308, DBL_MIN, 1e-300, 1e-200, 1e-100, 1e-20, 1e-12,
       1e-6,    1e-3,  1.0 / 60,  1.0 / 30, 0.1,  0.5,  1.0,    2.0,    10.0,   100.0,  1e3,    1e6,    1e12,
@@ -47,17 +47,17 @@ static inline double fuzz_double(FuzzInput* in) {
   enum { TABLE = sizeof table / sizeof table[0] };
   uint8_t choice = fuzz_byte(in);
   if (choice < 2 * TABLE) return choice % 2 ? -table[choice / 2] : table[choice / 2];
-  return fuzz_raw_double(in);
+  return fuzzRawDouble(in);
 }
 
 /* A value in [lo, hi] spread evenly on a log scale, from two bytes: for physical sizes (masses) that must stay
  * within what ODE itself is asked to handle by the program. */
-static inline double fuzz_log_range(FuzzInput* in, double lo, double hi) {
+static inline double fuzzLogRange(FuzzInput* in, double lo, double hi) {
   unsigned raw = ((unsigned)fuzz_byte(in) << 8) | fuzz_byte(in);
   return lo * pow(hi / lo, raw / 65535.0);
 }
 
-static inline int fuzz_int(FuzzInput* in) {
+static inline int fuzzInt(FuzzInput* in) {
   int value = 0;
   for (int i = 0; i < 4; ++i) value = (int)((unsigned)value << 8 | fuzz_byte(in));
   return value;

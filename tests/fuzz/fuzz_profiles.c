@@ -13,7 +13,7 @@ static char trace_path[64];
 /* One temporary trace file for the whole process, rewritten by every input. It is unlinked at once and read through
  * /proc/self/fd, so that no file is left behind even when the process dies on a crash; in memory (/dev/shm) when
  * there is one, because rewriting a file on disk made every input wait for the file system. */
-static const char* write_trace(const uint8_t* data, size_t size) {
+static const char* writeTrace(const uint8_t* data, size_t size) {
   static int fd = -1;
   if (fd < 0) {
     char name[64];
@@ -29,7 +29,7 @@ static const char* write_trace(const uint8_t* data, size_t size) {
 }
 
 /* Returns whether the profile was made. */
-static int check_profile(const char* spec, uint64_t seed) {
+static int checkProfile(const char* spec, uint64_t seed) {
   ssProfile* const canary = (ssProfile*)&trace_path; /* any address that is not a profile */
   ssProfile* profile = canary;
   ssStatus status = ssProfile_Create(spec, seed, &profile);
@@ -62,7 +62,7 @@ static int check_profile(const char* spec, uint64_t seed) {
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzInput in = {data, size};
   uint8_t mode = fuzz_byte(&in);
-  uint64_t seed = (uint64_t)(unsigned)fuzz_int(&in);
+  uint64_t seed = (uint64_t)(unsigned)fuzzInt(&in);
   if (mode % 2 == 0) {
     /* A spec as text, cut at the first NUL like a C string. trace:FILE is left to the other mode: a fuzzed path
      * could name a device or a huge file, which tests the machine rather than the parser. */
@@ -71,11 +71,11 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     memcpy(spec, in.data, length);
     spec[length] = '\0';
     if (strncmp(spec, "trace:", 6) == 0) return 0;
-    check_profile(spec, seed);
+    checkProfile(spec, seed);
   } else {
     char spec[96];
-    snprintf(spec, sizeof spec, "trace:%s", write_trace(in.data, in.size));
-    int accepted = check_profile(spec, seed);
+    snprintf(spec, sizeof spec, "trace:%s", writeTrace(in.data, in.size));
+    int accepted = checkProfile(spec, seed);
     /* A NUL byte is no part of a text file: "0.5\0garbage" must not read as 0.5. */
     FUZZ_REQUIRE(!(accepted && memchr(in.data, '\0', in.size) != NULL), "a trace holding a NUL byte was accepted");
   }

@@ -19,15 +19,15 @@
 
 enum { MAX_OPS = 48 };
 
-static void collide(void* context, ssStepper* stepper) { collide_all(context, stepper); }
+static void collide(void* context, ssStepper* stepper) { collideAll(context, stepper); }
 
 /* A program's before_step doing what the plan says, once. */
-static void before_step(void* context, ssStepper* stepper) {
+static void beforeStep(void* context, ssStepper* stepper) {
   World* w = context;
   if (w->plan.what == 0 || ssStepper_CurrentStep(stepper).index != w->plan.at) return;
   int what = w->plan.what;
   w->plan.what = 0;
-  int kind = pick_island(w, (uint8_t)w->plan.kind);
+  int kind = pickIsland(w, (uint8_t)w->plan.kind);
   if (kind < 0) return;
   Island* island = &w->islands[kind];
   dBodyID body = island->body_count > 0 ? island->bodies[0] : 0;
@@ -39,10 +39,10 @@ static void before_step(void* context, ssStepper* stepper) {
     case 3: if (body) dBodySetAngularVel(body, 0, 0, v); break;
     case 4: if (body) teleport(w, body, v, 0, 0.5); break;
     case 5: /* destroyed and built again inside the frame: the stepper must forget the one and find the other */
-      if (v > 0) destroy_island_bodies(w, kind);
-      destroy_island_joints(w, kind);
-      destroy_island_bodies(w, kind);
-      build_island(w, kind, NULL);
+      if (v > 0) destroyIslandBodies(w, kind);
+      destroyIslandJoints(w, kind);
+      destroyIslandBodies(w, kind);
+      buildIsland(w, kind, NULL);
       break;
     default: {
       ssFrameReport inner;
@@ -58,7 +58,7 @@ static void before_step(void* context, ssStepper* stepper) {
 
 /* One frame; returns 0 when the run must end (the world blew up). A frame beyond the step budget is not stepped. */
 static int frame(World* w, double frame_s, int op) {
-  if (!within_budget(w, frame_s)) return 1;
+  if (!withinBudget(w, frame_s)) return 1;
   BodyState before[STATE_CAPACITY], after[STATE_CAPACITY];
   int count = snapshot(w, before);
   int planned_destroy = w->plan.what == 5; /* bodies replaced in the frame: states are not compared */
@@ -75,7 +75,7 @@ static int frame(World* w, double frame_s, int op) {
   switch (status) {
     case SS_OK:
       w->steps_left -= report.steps;
-      FUZZ_REQUIRE(all_finite(after, count, &which), "op %d: frame %.17g s under %s reported OK but body %d is not "
+      FUZZ_REQUIRE(allFinite(after, count, &which), "op %d: frame %.17g s under %s reported OK but body %d is not "
                    "finite", op, frame_s, NAME_OR_UNKNOWN(ssMappingName(w->stepping.mapping)), which);
       FUZZ_REQUIRE(isfinite(report.simulated_s) && report.simulated_s >= 0 && report.steps >= 0,
                    "op %d: frame %.17g s: report simulated %g s in %d steps", op, frame_s, report.simulated_s,
@@ -112,19 +112,19 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   ssStepperDef def = ssDefaultStepperDef();
   def.collide = collide;
   def.collide_context = &w;
-  def.before_step = before_step;
+  def.before_step = beforeStep;
   def.before_step_context = &w;
-  make_world(&w, &in, &def);
-  for (int op = 0; op < MAX_OPS && !fuzz_empty(&in); ++op) {
+  makeWorld(&w, &in, &def);
+  for (int op = 0; op < MAX_OPS && !fuzzEmpty(&in); ++op) {
     uint8_t code = fuzz_byte(&in);
     if (verbose) fprintf(stderr, "op %d: code %d\n", op, code % 16);
     int bindings = ssRegistry_JointBindingCount(w.registry);
     switch (code % 16) {
       case 14: {
         /* A state or force the program sets between frames (a corrupt save, a teleport, a huge spin). */
-        dBodyID body = pick_body(&w, fuzz_byte(&in) & 0x7F);
+        dBodyID body = pickBody(&w, fuzz_byte(&in) & 0x7F);
         uint8_t which = fuzz_byte(&in);
-        double v = fuzz_double(&in);
+        double v = fuzzDouble(&in);
         if (body == 0) break;
         if (verbose) fprintf(stderr, "  set %d to %.17g\n", which % 5, v);
         switch (which % 5) {
@@ -141,15 +141,15 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         w.plan.what = 1 + fuzz_byte(&in) % 6;
         w.plan.at = fuzz_byte(&in) % 4;
         w.plan.kind = fuzz_byte(&in);
-        w.plan.value = fuzz_double(&in);
+        w.plan.value = fuzzDouble(&in);
         break;
       }
       case 0:
-        if (!frame(&w, fuzz_double(&in), op)) goto done;
+        if (!frame(&w, fuzzDouble(&in), op)) goto done;
         break;
       case 1: {
         int repeat = 1 + fuzz_byte(&in) % 16;
-        double frame_s = fuzz_double(&in);
+        double frame_s = fuzzDouble(&in);
         for (int i = 0; i < repeat; ++i)
           if (!frame(&w, frame_s, op)) goto done;
         break;
@@ -160,9 +160,9 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         ssStepping stepping = w.stepping;
         if (!(which & 0x80)) {
           const char* name = ssSteppingPolicyNameAt(which % (ssSteppingPolicyCount() + 1)); /* one past the end: NULL */
-          ssStatus status = ssSteppingForPolicy(name, fuzz_double(&in), &stepping);
+          ssStatus status = ssSteppingForPolicy(name, fuzzDouble(&in), &stepping);
           if (status != SS_OK) {
-            FUZZ_REQUIRE(ssLastError()[0] != '\0' && holds_stepping(&stepping, &w.stepping),
+            FUZZ_REQUIRE(ssLastError()[0] != '\0' && holdsStepping(&stepping, &w.stepping),
                          "ssSteppingForPolicy(%s) refused (%s) without a message or changed the stepping",
                          name ? name : "NULL", ssStatusName(status));
             break;
@@ -170,19 +170,19 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         } else {
           stepping.cut = (ssFrameCut)(int8_t)fuzz_byte(&in);
           stepping.mapping = (ssMapping)(int8_t)fuzz_byte(&in);
-          stepping.frozen_step_s = which & 1 ? fuzz_double(&in) : 0;
-          if (which & 2) stepping.max_step_s = fuzz_double(&in);
-          if (which & 4) stepping.fixed_step_s = fuzz_double(&in);
-          if (which & 8) stepping.max_speed = fuzz_double(&in);
-          if (which & 16) stepping.max_angular_speed = fuzz_double(&in);
+          stepping.frozen_step_s = which & 1 ? fuzzDouble(&in) : 0;
+          if (which & 2) stepping.max_step_s = fuzzDouble(&in);
+          if (which & 4) stepping.fixed_step_s = fuzzDouble(&in);
+          if (which & 8) stepping.max_speed = fuzzDouble(&in);
+          if (which & 16) stepping.max_angular_speed = fuzzDouble(&in);
         }
         ssStatus status = ssStepper_SetStepping(w.stepper, &stepping);
         ssStepping now = ssStepper_Stepping(w.stepper);
         if (status == SS_OK) {
-          FUZZ_REQUIRE(holds_stepping(&now, &stepping), "SetStepping OK but the stepping differs");
+          FUZZ_REQUIRE(holdsStepping(&now, &stepping), "SetStepping OK but the stepping differs");
           w.stepping = now;
         } else {
-          FUZZ_REQUIRE(ssLastError()[0] != '\0' && holds_stepping(&now, &w.stepping),
+          FUZZ_REQUIRE(ssLastError()[0] != '\0' && holdsStepping(&now, &w.stepping),
                        "SetStepping refused (%s) without a message or changed the stepping", ssStatusName(status));
         }
         if (verbose)
@@ -194,79 +194,79 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       case 3: {
         /* Rebind a row: a supported one (high bit clear) or any param and axis. */
         uint8_t how = fuzz_byte(&in);
-        dJointID joint = pick_joint(&w, fuzz_byte(&in));
+        dJointID joint = pickJoint(&w, fuzz_byte(&in));
         int param = how & 0x80 ? (int8_t)fuzz_byte(&in) : how % 4;
         int axis = how & 0x80 ? (int8_t)fuzz_byte(&in) : 1 + (how >> 2) % 3;
-        ssSpring spring = {fuzz_double(&in), fuzz_double(&in)};
-        double mass = how & 0x40 ? fuzz_double(&in) : 0;
+        ssSpring spring = {fuzzDouble(&in), fuzzDouble(&in)};
+        double mass = how & 0x40 ? fuzzDouble(&in) : 0;
         ssStatus status = ssRegistry_BindJoint(w.registry, joint, (ssJointParam)param, axis, spring, mass);
         if (verbose)
           fprintf(stderr, "  BindJoint(%s joint, param %d, axis %d, {%.17g, %.17g}, mass %.17g) = %s\n",
-                  joint_type_name(joint), param, axis, spring.stiffness, spring.damping, mass, ssStatusName(status));
-        check_registry_call(&w, status, bindings, "ssRegistry_BindJoint");
+                  jointTypeName(joint), param, axis, spring.stiffness, spring.damping, mass, ssStatusName(status));
+        checkRegistryCall(&w, status, bindings, "ssRegistry_BindJoint");
         break;
       }
       case 4: {
         uint8_t how = fuzz_byte(&in);
-        dJointID joint = pick_joint(&w, fuzz_byte(&in));
-        double load = fuzz_double(&in);
+        dJointID joint = pickJoint(&w, fuzz_byte(&in));
+        double load = fuzzDouble(&in);
         ssStatus status = ssRegistry_SetJointLoad(w.registry, joint, (ssJointParam)(how % 4), 1 + (how >> 2) % 3, load);
         if (verbose)
-          fprintf(stderr, "  SetJointLoad(%s joint, param %d, axis %d, %.17g) = %s\n", joint_type_name(joint), how % 4,
+          fprintf(stderr, "  SetJointLoad(%s joint, param %d, axis %d, %.17g) = %s\n", jointTypeName(joint), how % 4,
                   1 + (how >> 2) % 3, load, ssStatusName(status));
-        check_registry_call(&w, status, bindings, "ssRegistry_SetJointLoad");
+        checkRegistryCall(&w, status, bindings, "ssRegistry_SetJointLoad");
         break;
       }
       case 5: {
         uint8_t how = fuzz_byte(&in);
         /* Destroy one of the islands (joints first, or bodies first: 0x20), with a frame in between (0x40), and
          * build it again, with fuzzed tuned values on its main joint (0x80). */
-        int kind = pick_island(&w, how & 0x1F);
+        int kind = pickIsland(&w, how & 0x1F);
         if (kind < 0) break;
         double tuned[2] = {0.2, 1e-5};
         if (how & 0x80) {
-          tuned[0] = fuzz_double(&in);
-          tuned[1] = fuzz_double(&in);
+          tuned[0] = fuzzDouble(&in);
+          tuned[1] = fuzzDouble(&in);
         }
-        if (how & 0x20) destroy_island_bodies(&w, kind);
-        else destroy_island_joints(&w, kind);
+        if (how & 0x20) destroyIslandBodies(&w, kind);
+        else destroyIslandJoints(&w, kind);
         if ((how & 0x40) && !frame(&w, 1.0 / 60, op)) goto done;
-        destroy_island_joints(&w, kind);
-        destroy_island_bodies(&w, kind);
-        build_island(&w, kind, how & 0x80 ? tuned : NULL);
+        destroyIslandJoints(&w, kind);
+        destroyIslandBodies(&w, kind);
+        buildIsland(&w, kind, how & 0x80 ? tuned : NULL);
         break;
       }
       case 6: {
-        dBodyID body = pick_body(&w, fuzz_byte(&in));
-        double linear = fuzz_double(&in), angular = fuzz_double(&in);
+        dBodyID body = pickBody(&w, fuzz_byte(&in));
+        double linear = fuzzDouble(&in), angular = fuzzDouble(&in);
         ssStatus status = ssRegistry_BindDamping(w.registry, body, linear, angular);
         if (verbose) fprintf(stderr, "  BindDamping(%.17g, %.17g) = %s\n", linear, angular, ssStatusName(status));
-        check_registry_call(&w, status, bindings, "ssRegistry_BindDamping");
+        checkRegistryCall(&w, status, bindings, "ssRegistry_BindDamping");
         break;
       }
       case 7: {
         uint8_t flags = fuzz_byte(&in);
-        dBodyID body = pick_body(&w, fuzz_byte(&in));
-        double idle = fuzz_double(&in), window = fuzz_double(&in);
+        dBodyID body = pickBody(&w, fuzz_byte(&in));
+        double idle = fuzzDouble(&in), window = fuzzDouble(&in);
         ssStatus status = ssRegistry_BindAutoDisable(w.registry, body, idle, window);
         if (verbose) fprintf(stderr, "  BindAutoDisable(%.17g, %.17g) = %s\n", idle, window, ssStatusName(status));
-        check_registry_call(&w, status, bindings, "ssRegistry_BindAutoDisable");
+        checkRegistryCall(&w, status, bindings, "ssRegistry_BindAutoDisable");
         dWorldSetAutoDisableFlag(w.world, flags & 1);
         if (body != 0) dBodySetAutoDisableFlag(body, flags & 2);
         break;
       }
       case 8: {
-        ssSpring spring = {fuzz_double(&in), fuzz_double(&in)};
-        double mass = fuzz_double(&in);
+        ssSpring spring = {fuzzDouble(&in), fuzzDouble(&in)};
+        double mass = fuzzDouble(&in);
         ssStatus status = ssRegistry_BindWorld(w.registry, spring, mass);
         if (verbose)
           fprintf(stderr, "  BindWorld({%.17g, %.17g}, %.17g) = %s\n", spring.stiffness, spring.damping, mass,
                   ssStatusName(status));
-        check_registry_call(&w, status, bindings, "ssRegistry_BindWorld");
+        checkRegistryCall(&w, status, bindings, "ssRegistry_BindWorld");
         break;
       }
       case 9: {
-        double a = fuzz_double(&in), b = fuzz_double(&in);
+        double a = fuzzDouble(&in), b = fuzzDouble(&in);
         if (w.adopt) {
           w.contact_erp = a;
           w.contact_cfm = b;
@@ -284,10 +284,10 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         ssStepper_Reset(w.stepper);
         break;
       case 11: {
-        dBodyID body = pick_body(&w, fuzz_byte(&in));
+        dBodyID body = pickBody(&w, fuzz_byte(&in));
         if (body == 0) break;
         dMass mass;
-        double kg = fuzz_log_range(&in, 1e-3, 1e3);
+        double kg = fuzzLogRange(&in, 1e-3, 1e3);
         if (verbose) fprintf(stderr, "  mass %.17g kg\n", kg);
         dMassSetBoxTotal(&mass, kg, 0.2, 0.2, 0.2);
         dBodySetMass(body, &mass);
@@ -295,14 +295,14 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       }
       case 12: {
         /* Unbind a joint and bind its supported rows again with the default spring. */
-        dJointID joint = pick_joint(&w, fuzz_byte(&in));
+        dJointID joint = pickJoint(&w, fuzz_byte(&in));
         ssRegistry_UnbindJoint(w.registry, joint);
-        bind_defaults(&w, joint);
+        bindDefaults(&w, joint);
         break;
       }
     }
   }
 done:
-  destroy_world(&w);
+  destroyWorld(&w);
   return 0;
 }

@@ -96,7 +96,7 @@ static const ssSpring DEFAULT_SPRING = {40.0, 0.5};
 
 /* ---- the process's world ---- */
 
-static inline WorldSettings read_settings(dWorldID world) {
+static inline WorldSettings readSettings(dWorldID world) {
   WorldSettings s;
   memset(&s, 0, sizeof s);
   dWorldGetGravity(world, s.gravity);
@@ -120,7 +120,7 @@ static inline WorldSettings read_settings(dWorldID world) {
   return s;
 }
 
-static inline void write_settings(dWorldID world, const WorldSettings* s) {
+static inline void writeSettings(dWorldID world, const WorldSettings* s) {
   dWorldSetGravity(world, s->gravity[0], s->gravity[1], s->gravity[2]);
   dWorldSetERP(world, s->erp);
   dWorldSetCFM(world, s->cfm);
@@ -141,7 +141,7 @@ static inline void write_settings(dWorldID world, const WorldSettings* s) {
 }
 
 /* The process's world as saved: made at the first call, its settings put back at every later one. */
-static inline const Scene* scene_for_input(void) {
+static inline const Scene* sceneForInput(void) {
   static Scene scene;
   if (scene.world == 0) {
     dInitODE2(0);
@@ -151,10 +151,10 @@ static inline const Scene* scene_for_input(void) {
     scene.space = dSimpleSpaceCreate(0);
     dCreatePlane(scene.space, 0, 0, 1, 0);
     scene.contacts = dJointGroupCreate(0);
-    scene.settings = read_settings(scene.world);
+    scene.settings = readSettings(scene.world);
   } else {
-    write_settings(scene.world, &scene.settings);
-    WorldSettings now = read_settings(scene.world);
+    writeSettings(scene.world, &scene.settings);
+    WorldSettings now = readSettings(scene.world);
     FUZZ_REQUIRE(memcmp(&now, &scene.settings, sizeof now) == 0, "the world's settings were not restored");
   }
   dJointGroupEmpty(scene.contacts);
@@ -164,7 +164,7 @@ static inline const Scene* scene_for_input(void) {
 
 /* ---- islands ---- */
 
-static inline dBodyID make_body(World* w, double x, double z) {
+static inline dBodyID makeBody(World* w, double x, double z) {
   dBodyID body = dBodyCreate(w->world);
   dMass mass;
   dMassSetBoxTotal(&mass, 1.0, 0.2, 0.2, 0.2);
@@ -174,7 +174,7 @@ static inline dBodyID make_body(World* w, double x, double z) {
 }
 
 /* ODE has one parameter setter per joint type. */
-static inline void set_param(dJointID joint, int parameter, double value) {
+static inline void setParam(dJointID joint, int parameter, double value) {
   switch (dJointGetType(joint)) {
     case dJointTypeHinge: dJointSetHingeParam(joint, parameter, value); break;
     case dJointTypeSlider: dJointSetSliderParam(joint, parameter, value); break;
@@ -195,18 +195,18 @@ static inline void set_param(dJointID joint, int parameter, double value) {
   }
 }
 
-static inline void set_stops(dJointID joint, int axis_group, double lo, double hi) {
-  set_param(joint, dParamLoStop + axis_group, lo);
-  set_param(joint, dParamHiStop + axis_group, hi);
+static inline void setStops(dJointID joint, int axis_group, double lo, double hi) {
+  setParam(joint, dParamLoStop + axis_group, lo);
+  setParam(joint, dParamHiStop + axis_group, hi);
 }
 
-static inline void set_motor(dJointID joint, int axis_group) {
-  set_param(joint, dParamVel + axis_group, 0.5);
-  set_param(joint, dParamFMax + axis_group, 10.0);
+static inline void setMotor(dJointID joint, int axis_group) {
+  setParam(joint, dParamVel + axis_group, 0.5);
+  setParam(joint, dParamFMax + axis_group, 10.0);
 }
 
 /* Binds every (param, axis) the joint supports to the default spring. */
-static inline void bind_defaults(World* w, dJointID joint) {
+static inline void bindDefaults(World* w, dJointID joint) {
   if (joint == 0) return;
   for (int param = SS_PARAM_JOINT; param <= SS_PARAM_SUSPENSION; ++param)
     for (int axis = 1; axis <= 3; ++axis)
@@ -221,12 +221,12 @@ static inline void bind_defaults(World* w, dJointID joint) {
 
 /* Makes the island's bodies and joints. When tuned is given (adopt mode), the main joint's first soft row gets those
  * tuned ERP/CFM before adoption: values the program set, which adoption must either take or refuse by name. */
-static inline void build_island(World* w, int kind, const double* tuned) {
+static inline void buildIsland(World* w, int kind, const double* tuned) {
   Island* island = &w->islands[kind];
   memset(island, 0, sizeof *island);
   island->present = 1;
   double x = 2.0 * kind, z = 1.0;
-  dBodyID body = make_body(w, x, z);
+  dBodyID body = makeBody(w, x, z);
   island->bodies[island->body_count++] = body;
   dJointID joint = 0;
   switch (kind) {
@@ -240,13 +240,13 @@ static inline void build_island(World* w, int kind, const double* tuned) {
       dJointAttach(joint, body, 0);
       dJointSetHingeAnchor(joint, x + 0.5, 0, z);
       dJointSetHingeAxis(joint, 0, 1, 0);
-      set_stops(joint, dParamGroup1, -0.4, 0.4);
+      setStops(joint, dParamGroup1, -0.4, 0.4);
       break;
     case JOINT_SLIDER:
       joint = dJointCreateSlider(w->world, 0);
       dJointAttach(joint, body, 0);
       dJointSetSliderAxis(joint, 0, 0, 1);
-      set_stops(joint, dParamGroup1, 0, 0);
+      setStops(joint, dParamGroup1, 0, 0);
       break;
     case JOINT_UNIVERSAL:
       joint = dJointCreateUniversal(w->world, 0);
@@ -254,8 +254,8 @@ static inline void build_island(World* w, int kind, const double* tuned) {
       dJointSetUniversalAnchor(joint, x, 0, z + 0.5);
       dJointSetUniversalAxis1(joint, 1, 0, 0);
       dJointSetUniversalAxis2(joint, 0, 1, 0);
-      set_stops(joint, dParamGroup1, -0.4, 0.4);
-      set_stops(joint, dParamGroup2, -0.4, 0.4);
+      setStops(joint, dParamGroup1, -0.4, 0.4);
+      setStops(joint, dParamGroup2, -0.4, 0.4);
       break;
     case JOINT_HINGE2: {
       /* A chassis on a ball to the world and a wheel on hinge-2 with a spring suspension. */
@@ -263,15 +263,15 @@ static inline void build_island(World* w, int kind, const double* tuned) {
       dJointAttach(hold, body, 0);
       dJointSetBallAnchor(hold, x, 0, z + 0.3);
       island->joints[island->joint_count++] = hold;
-      dBodyID wheel = make_body(w, x + 0.4, z - 0.2);
+      dBodyID wheel = makeBody(w, x + 0.4, z - 0.2);
       island->bodies[island->body_count++] = wheel;
       joint = dJointCreateHinge2(w->world, 0);
       dJointAttach(joint, body, wheel);
       dJointSetHinge2Anchor(joint, x + 0.4, 0, z - 0.2);
       const dReal up[3] = {0, 0, 1}, side[3] = {0, 1, 0};
       dJointSetHinge2Axes(joint, up, side);
-      set_stops(joint, dParamGroup1, -0.3, 0.3);
-      set_motor(joint, dParamGroup2);
+      setStops(joint, dParamGroup1, -0.3, 0.3);
+      setMotor(joint, dParamGroup2);
       break;
     }
     case JOINT_FIXED:
@@ -291,9 +291,9 @@ static inline void build_island(World* w, int kind, const double* tuned) {
       dJointSetAMotorAxis(joint, 0, 1, 1, 0, 0);
       dJointSetAMotorAxis(joint, 1, 1, 0, 1, 0);
       dJointSetAMotorAxis(joint, 2, 1, 0, 0, 1);
-      set_motor(joint, dParamGroup1);
-      set_stops(joint, dParamGroup2, 0.1, 0.5); /* the angle is 0: this stop is active */
-      set_motor(joint, dParamGroup3);
+      setMotor(joint, dParamGroup1);
+      setStops(joint, dParamGroup2, 0.1, 0.5); /* the angle is 0: this stop is active */
+      setMotor(joint, dParamGroup3);
       break;
     case JOINT_LMOTOR:
       joint = dJointCreateLMotor(w->world, 0);
@@ -302,7 +302,7 @@ static inline void build_island(World* w, int kind, const double* tuned) {
       dJointSetLMotorAxis(joint, 0, 0, 1, 0, 0);
       dJointSetLMotorAxis(joint, 1, 0, 0, 1, 0);
       dJointSetLMotorAxis(joint, 2, 0, 0, 0, 1);
-      for (int group = 0; group < 3; ++group) set_motor(joint, group * dParamGroup2);
+      for (int group = 0; group < 3; ++group) setMotor(joint, group * dParamGroup2);
       break;
     case JOINT_PLANE2D:
       joint = dJointCreatePlane2D(w->world, 0);
@@ -316,8 +316,8 @@ static inline void build_island(World* w, int kind, const double* tuned) {
       dJointSetPRAnchor(joint, x, 0, z + 0.5);
       dJointSetPRAxis1(joint, 0, 0, 1);
       dJointSetPRAxis2(joint, 1, 0, 0);
-      set_stops(joint, dParamGroup1, -0.1, 0.1);
-      set_stops(joint, dParamGroup2, -0.4, 0.4);
+      setStops(joint, dParamGroup1, -0.1, 0.1);
+      setStops(joint, dParamGroup2, -0.4, 0.4);
       break;
     case JOINT_PU:
       joint = dJointCreatePU(w->world, 0);
@@ -326,16 +326,16 @@ static inline void build_island(World* w, int kind, const double* tuned) {
       dJointSetPUAxis1(joint, 1, 0, 0);
       dJointSetPUAxis2(joint, 0, 1, 0);
       dJointSetPUAxisP(joint, 0, 0, 1);
-      set_stops(joint, dParamGroup1, -0.4, 0.4);
-      set_stops(joint, dParamGroup3, -0.1, 0.1);
+      setStops(joint, dParamGroup1, -0.4, 0.4);
+      setStops(joint, dParamGroup3, -0.1, 0.1);
       break;
     case JOINT_PISTON:
       joint = dJointCreatePiston(w->world, 0);
       dJointAttach(joint, body, 0);
       dJointSetPistonAnchor(joint, x, 0, z + 0.5);
       dJointSetPistonAxis(joint, 0, 0, 1);
-      set_stops(joint, dParamGroup1, 0, 0);
-      set_stops(joint, dParamGroup2, -0.4, 0.4);
+      setStops(joint, dParamGroup1, 0, 0);
+      setStops(joint, dParamGroup2, -0.4, 0.4);
       break;
     case JOINT_DBALL:
       joint = dJointCreateDBall(w->world, 0);
@@ -352,7 +352,7 @@ static inline void build_island(World* w, int kind, const double* tuned) {
       break;
     case JOINT_TRANSMISSION: {
       /* Two gears, each on a hinge to the world, meshed by a transmission. */
-      dBodyID gear = make_body(w, x + 0.6, z);
+      dBodyID gear = makeBody(w, x + 0.6, z);
       island->bodies[island->body_count++] = gear;
       for (int i = 0; i < 2; ++i) {
         dJointID hinge = dJointCreateHinge(w->world, 0);
@@ -373,7 +373,7 @@ static inline void build_island(World* w, int kind, const double* tuned) {
     }
     case CONTACT_BOXES: {
       dBodySetPosition(body, x, 0, 0.3);
-      dBodyID other = make_body(w, x + 0.05, 0.65);
+      dBodyID other = makeBody(w, x + 0.05, 0.65);
       island->bodies[island->body_count++] = other;
       for (int i = 0; i < 2; ++i) {
         island->geoms[i] = dCreateBox(w->space, 0.2, 0.2, 0.2);
@@ -386,12 +386,12 @@ static inline void build_island(World* w, int kind, const double* tuned) {
   for (int i = 0; i < island->body_count; ++i) memcpy(island->built_at[i], dBodyGetPosition(island->bodies[i]),
                                                        sizeof island->built_at[i]);
   if (!w->adopt) {
-    for (int i = 0; i < island->joint_count; ++i) bind_defaults(w, island->joints[i]);
+    for (int i = 0; i < island->joint_count; ++i) bindDefaults(w, island->joints[i]);
   } else {
     if (tuned != NULL && joint != 0) {
       int stop = ssJointSupports(joint, SS_PARAM_STOP, 1);
-      set_param(joint, stop ? dParamStopERP : dParamERP, tuned[0]);
-      set_param(joint, stop ? dParamStopCFM : dParamCFM, tuned[1]);
+      setParam(joint, stop ? dParamStopERP : dParamERP, tuned[0]);
+      setParam(joint, stop ? dParamStopCFM : dParamCFM, tuned[1]);
     }
     int bindings = ssRegistry_JointBindingCount(w->registry);
     ssStatus status = ssRegistry_AdoptBody(w->registry, body, NULL);
@@ -404,8 +404,8 @@ static inline void build_island(World* w, int kind, const double* tuned) {
       if (tuned != NULL) {
         /* Put ODE's defaults back, as a program would after the refusal, and adopt those. */
         int stop = ssJointSupports(joint, SS_PARAM_STOP, 1);
-        set_param(joint, stop ? dParamStopERP : dParamERP, 0.2);
-        set_param(joint, stop ? dParamStopCFM : dParamCFM, 1e-5);
+        setParam(joint, stop ? dParamStopERP : dParamERP, 0.2);
+        setParam(joint, stop ? dParamStopCFM : dParamCFM, 1e-5);
         status = ssRegistry_AdoptBody(w->registry, body, NULL);
         FUZZ_REQUIRE(status == SS_OK || (ssLastError()[0] != '\0' && ssRegistry_JointBindingCount(w->registry) ==
                                          bindings), "AdoptBody refused (%s) but bound something or said nothing",
@@ -414,7 +414,7 @@ static inline void build_island(World* w, int kind, const double* tuned) {
       /* Still refused: a row took the world's CFM, which the input fuzzed (ODE copies it into every new joint).
        * The program binds the island's rows by hand. */
       if (status != SS_OK)
-        for (int i = 0; i < island->joint_count; ++i) bind_defaults(w, island->joints[i]);
+        for (int i = 0; i < island->joint_count; ++i) bindDefaults(w, island->joints[i]);
     }
   }
   for (int i = 0; i < island->body_count; ++i)
@@ -424,14 +424,14 @@ static inline void build_island(World* w, int kind, const double* tuned) {
 /* The documented way to destroy what the stepper knows: ssStepper_DestroyJoint for the island's joints, or
  * ssStepper_DestroyBody for its bodies (their geoms first). Joints first or bodies first are both valid (ODE then
  * detaches the joints, which stay bound until destroyed). */
-static inline void destroy_island_joints(World* w, int kind) {
+static inline void destroyIslandJoints(World* w, int kind) {
   Island* island = &w->islands[kind];
   for (int i = 0; i < island->joint_count; ++i)
     FUZZ_REQUIRE(ssStepper_DestroyJoint(w->stepper, island->joints[i]) == SS_OK, "DestroyJoint: %s", ssLastError());
   island->joint_count = 0;
 }
 
-static inline void destroy_island_bodies(World* w, int kind) {
+static inline void destroyIslandBodies(World* w, int kind) {
   Island* island = &w->islands[kind];
   for (int i = 0; i < island->body_count; ++i) {
     if (island->geoms[i] != 0) dGeomDestroy(island->geoms[i]);
@@ -442,7 +442,7 @@ static inline void destroy_island_bodies(World* w, int kind) {
 
 /* ---- contacts ---- */
 
-static inline void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
+static inline void nearCallback(void* data, dGeomID geom1, dGeomID geom2) {
   ssStepper* stepper = data;
   World* w = current_world;
   dBodyID body1 = dGeomGetBody(geom1), body2 = dGeomGetBody(geom2);
@@ -479,7 +479,7 @@ static inline void near_callback(void* data, dGeomID geom1, dGeomID geom2) {
   }
 }
 
-static inline void collide_all(World* w, ssStepper* stepper) { dSpaceCollide(w->space, stepper, near_callback); }
+static inline void collideAll(World* w, ssStepper* stepper) { dSpaceCollide(w->space, stepper, nearCallback); }
 
 /* ---- states ---- */
 
@@ -500,7 +500,7 @@ static inline int snapshot(const World* w, BodyState* out) {
   return count;
 }
 
-static inline int all_finite(const BodyState* states, int count, int* which) {
+static inline int allFinite(const BodyState* states, int count, int* which) {
   for (int i = 0; i < count; ++i) {
     const dReal* values = states[i].position;
     for (size_t j = 0; j < sizeof states[i] / sizeof(dReal); ++j)
@@ -515,7 +515,7 @@ static inline int all_finite(const BodyState* states, int count, int* which) {
 /* ---- choosing ---- */
 
 /* Physics steps the frame would take (an upper bound, to within the FIXED accumulator's one step). */
-static inline double steps_for(const World* w, double frame_s) {
+static inline double stepsFor(const World* w, double frame_s) {
   if (!(frame_s > 0) || !isfinite(frame_s)) return 0;
   switch (w->stepping.cut) {
     case SS_CUT_WHOLE_FRAME: return 1;
@@ -526,9 +526,9 @@ static inline double steps_for(const World* w, double frame_s) {
 }
 
 /* Whether the frame fits in what is left of the input's step budget. */
-static inline int within_budget(const World* w, double frame_s) { return steps_for(w, frame_s) <= w->steps_left; }
+static inline int withinBudget(const World* w, double frame_s) { return stepsFor(w, frame_s) <= w->steps_left; }
 
-static inline const char* joint_type_name(dJointID joint) {
+static inline const char* jointTypeName(dJointID joint) {
   static const char* names[] = {"none", "ball", "hinge", "slider", "contact", "universal", "hinge2", "fixed", "null",
                                 "amotor", "lmotor", "plane2d", "pr", "pu", "piston", "dball", "dhinge",
                                 "transmission"};
@@ -538,7 +538,7 @@ static inline const char* joint_type_name(dJointID joint) {
 }
 
 /* One of the input's joints, or 0 when it has none (which the library must refuse by name). */
-static inline dJointID pick_joint(World* w, uint8_t byte) {
+static inline dJointID pickJoint(World* w, uint8_t byte) {
   int count = 0;
   for (int k = 0; k < ISLAND_COUNT; ++k) count += w->islands[k].joint_count;
   if (count == 0) return 0;
@@ -551,7 +551,7 @@ static inline dJointID pick_joint(World* w, uint8_t byte) {
 }
 
 /* One of the input's bodies; 0xFF (or no body left) stands for the world's defaults. */
-static inline dBodyID pick_body(World* w, uint8_t byte) {
+static inline dBodyID pickBody(World* w, uint8_t byte) {
   if (byte == 0xFF) return 0;
   int count = 0;
   for (int k = 0; k < ISLAND_COUNT; ++k) count += w->islands[k].body_count;
@@ -565,7 +565,7 @@ static inline dBodyID pick_body(World* w, uint8_t byte) {
 }
 
 /* The island kind the byte names among those the input has, or -1. */
-static inline int pick_island(const World* w, uint8_t byte) {
+static inline int pickIsland(const World* w, uint8_t byte) {
   int count = 0;
   for (int k = 0; k < ISLAND_COUNT; ++k) count += w->islands[k].present;
   if (count == 0) return -1;
@@ -599,30 +599,30 @@ static inline void teleport(World* w, dBodyID body, double x, double y, double z
 /* ---- checks ---- */
 
 /* A refused registry call names something and keeps the bindings as they were. */
-static inline void check_registry_call(World* w, ssStatus status, int bindings_before, const char* what) {
+static inline void checkRegistryCall(World* w, ssStatus status, int bindings_before, const char* what) {
   if (status == SS_OK) return;
   FUZZ_REQUIRE(ssLastError()[0] != '\0', "%s refused (%s) without a message", what, ssStatusName(status));
   FUZZ_REQUIRE(ssRegistry_JointBindingCount(w->registry) == bindings_before, "%s refused (%s) but the binding count "
                "went from %d to %d", what, ssLastError(), bindings_before, ssRegistry_JointBindingCount(w->registry));
 }
 
-static inline int same_double(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+static inline int sameDouble(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
 
 /* Whether the stepper holds the stepping it was given: every field as given, except that a speed limit of 0 stands
  * for the guard ODE itself needs (stepping.h), and a step length of 0 for the tuned step, which the stepper fills
  * in. Field by field: padding is no state. */
-static inline int holds_stepping(const ssStepping* held, const ssStepping* given) {
+static inline int holdsStepping(const ssStepping* held, const ssStepping* given) {
   double max_step_s = given->max_step_s == 0 ? held->max_step_s : given->max_step_s;
   double fixed_step_s = given->fixed_step_s == 0 ? held->fixed_step_s : given->fixed_step_s;
   double max_speed = given->max_speed == 0 ? held->max_speed : given->max_speed;
   double max_angular_speed = given->max_angular_speed == 0 ? held->max_angular_speed : given->max_angular_speed;
   return held->cut == given->cut && held->mapping == given->mapping &&
-         same_double(held->frozen_step_s, given->frozen_step_s) && held->solver == given->solver &&
-         held->quick_iterations == given->quick_iterations && same_double(held->max_step_s, max_step_s) &&
-         same_double(held->fixed_step_s, fixed_step_s) &&
+         sameDouble(held->frozen_step_s, given->frozen_step_s) && held->solver == given->solver &&
+         held->quick_iterations == given->quick_iterations && sameDouble(held->max_step_s, max_step_s) &&
+         sameDouble(held->fixed_step_s, fixed_step_s) &&
          held->max_steps_per_frame == given->max_steps_per_frame && held->max_speed > 0 &&
-         held->max_angular_speed > 0 && same_double(held->max_speed, max_speed) &&
-         same_double(held->max_angular_speed, max_angular_speed);
+         held->max_angular_speed > 0 && sameDouble(held->max_speed, max_speed) &&
+         sameDouble(held->max_angular_speed, max_angular_speed);
 }
 
 /* ---- the input's world ---- */
@@ -630,8 +630,8 @@ static inline int holds_stepping(const ssStepping* held, const ssStepping* given
 /* Reads the input's header (islands, the stepper's fields, adoption) and makes its registry, stepper and islands in
  * the process's world. def_template gives the callbacks; the world, registry, collide and contact group are set
  * here. The header: [islands] [cut, mapping, solver] [fields] [the fields' values...]. */
-static inline void make_world(World* w, FuzzInput* in, const ssStepperDef* def_template) {
-  const Scene* scene = scene_for_input();
+static inline void makeWorld(World* w, FuzzInput* in, const ssStepperDef* def_template) {
+  const Scene* scene = sceneForInput();
   memset(w, 0, sizeof *w);
   current_world = w;
   w->world = scene->world;
@@ -658,14 +658,14 @@ static inline void make_world(World* w, FuzzInput* in, const ssStepperDef* def_t
   /* The steps the program's tuned for, unless fuzzed: 0 (the tuned step) is refused, the registry has none yet. */
   def.stepping.max_step_s = def.stepping.fixed_step_s = 1.0 / 60;
   uint8_t fields = fuzz_byte(in);
-  if (fields & 1) def.stepping.max_step_s = fuzz_double(in);
-  if (fields & 2) def.stepping.fixed_step_s = fuzz_double(in);
-  if (fields & 4) def.stepping.frozen_step_s = fuzz_double(in);
+  if (fields & 1) def.stepping.max_step_s = fuzzDouble(in);
+  if (fields & 2) def.stepping.fixed_step_s = fuzzDouble(in);
+  if (fields & 4) def.stepping.frozen_step_s = fuzzDouble(in);
   if (fields & 8) def.stepping.max_steps_per_frame = (int8_t)fuzz_byte(in);
   if (fields & 16) def.stepping.quick_iterations = (int8_t)fuzz_byte(in);
   w->adopt = (fields & 32) != 0;
-  double world_erp = fields & 64 ? fuzz_double(in) : 0.2, world_cfm = fields & 64 ? fuzz_double(in) : 1e-10;
-  double tuned_step_s = fields & 128 ? fuzz_double(in) : 1.0 / 60;
+  double world_erp = fields & 64 ? fuzzDouble(in) : 0.2, world_cfm = fields & 64 ? fuzzDouble(in) : 1e-10;
+  double tuned_step_s = fields & 128 ? fuzzDouble(in) : 1.0 / 60;
   w->contact_erp = 0.2;
   w->contact_cfm = 1e-5;
   ssStepper* const canary = (ssStepper*)w;
@@ -690,7 +690,7 @@ static inline void make_world(World* w, FuzzInput* in, const ssStepperDef* def_t
     FUZZ_REQUIRE(ssStepper_Create(&def, &w->stepper) == SS_OK, "default stepper: %s", ssLastError());
   }
   w->stepping = ssStepper_Stepping(w->stepper);
-  FUZZ_REQUIRE(holds_stepping(&w->stepping, &def.stepping), "the stepper's stepping is not the one it was made with");
+  FUZZ_REQUIRE(holdsStepping(&w->stepping, &def.stepping), "the stepper's stepping is not the one it was made with");
   if (w->adopt) {
     /* The program tuned the world (maybe badly) at a step (maybe bad): adopted, or refused by name with nothing
      * bound; then ODE's defaults at 1/60 s. */
@@ -708,15 +708,15 @@ static inline void make_world(World* w, FuzzInput* in, const ssStepperDef* def_t
       FUZZ_REQUIRE(ssRegistry_AdoptWorld(w->registry, 1.0 / 60, NULL) == SS_OK, "AdoptWorld: %s", ssLastError());
     }
   }
-  for (int i = 0; i < count; ++i) build_island(w, (first + i) % ISLAND_COUNT, NULL);
+  for (int i = 0; i < count; ++i) buildIsland(w, (first + i) % ISLAND_COUNT, NULL);
   if (verbose) fprintf(stderr, "islands %d to %d\n", first, (first + count - 1) % ISLAND_COUNT);
 }
 
 /* Destroys what the input made, leaving the process's world empty for the next one. */
-static inline void destroy_world(World* w) {
+static inline void destroyWorld(World* w) {
   for (int k = 0; k < ISLAND_COUNT; ++k) {
-    destroy_island_joints(w, k);
-    destroy_island_bodies(w, k);
+    destroyIslandJoints(w, k);
+    destroyIslandBodies(w, k);
   }
   ssStepper_Destroy(w->stepper);
   ssRegistry_Destroy(w->registry);
