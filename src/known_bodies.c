@@ -157,8 +157,18 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
   unsigned registry_generation = known->registry_generation, watched_generation = known->watched_generation;
   int carrying = known->carrying;
   ssKnownFree(known);
-  *known = (ssKnownBodies){bodies,      ids, values, first_joints, (int)count, pushed, 0, carrying, geared_ids,
-                           geared_count, 1,   registry_generation, watched_generation};
+  *known = (ssKnownBodies){.bodies = bodies,
+                           .ids = ids,
+                           .values = values,
+                           .first_joints = first_joints,
+                           .count = (int)count,
+                           .pushed = pushed,
+                           .carrying = carrying,
+                           .geared = geared_ids,
+                           .geared_count = geared_count,
+                           .valid = 1,
+                           .registry_generation = registry_generation,
+                           .watched_generation = watched_generation};
   listPushed(known);
   return SS_OK;
 }
