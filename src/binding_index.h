@@ -9,7 +9,7 @@
 typedef struct ssIndexSlot {
   const void* object;
   int tag;
-  int position_plus_one; /* the binding's position + 1; 0: empty, so that zeroed memory is an empty table */
+  int position; /* -1: empty */
 } ssIndexSlot;
 
 /* Open addressing with linear probing, kept at most half full. A zeroed index is empty and valid. */
