@@ -109,9 +109,11 @@ static int sharedLaw(const SharedSoftness* shared, const ssRowLaw* law, int law_
   return sameLaw(shared->law, law);
 }
 
-/* The softnesses one Apply computed, direct-mapped by law, mass and load: a row looks in one entry only (rows with
- * distinct masses, which never share, pay one comparison). */
-enum { kSharedSize = 16 };
+/* The softnesses one Apply computed, by law, mass and load: a row looks at its home entry and the kSharedProbes - 1
+ * after it, and stops at an unused one (nothing leaves the table within an Apply). Rows of distinct masses, which
+ * never share, pay a few comparisons of the mass; a handful of pairs (laws times the masses of identical links)
+ * each find their entry although two of them share a home (one entry a home thrashed: every row computed again). */
+enum { kSharedSize = 16, kSharedProbes = 4 };
 typedef struct SharedTable {
   unsigned char used[kSharedSize];
   SharedSoftness entries[kSharedSize];
@@ -134,13 +136,25 @@ static unsigned sharedSlot(const ssRowLaw* law, int law_slot, int any_mass, doub
 
 /* The softness computed in this Apply for the row's law and mass (any mass where the mapping reads none) with the
  * same load declared, or NULL. */
-static const SharedSoftness* findShared(const SharedTable* table, unsigned slot, const ssRowLaw* law, int law_slot,
+static const SharedSoftness* findShared(const SharedTable* table, unsigned home, const ssRowLaw* law, int law_slot,
                                         int any_mass, double mass, int load_declared) {
-  const SharedSoftness* entry = &table->entries[slot];
-  if (table->used[slot] && (any_mass || entry->mass == mass) && entry->load_declared == load_declared &&
-      sharedLaw(entry, law, law_slot))
-    return entry;
+  for (unsigned p = 0; p < kSharedProbes; ++p) {
+    unsigned slot = (home + p) & (kSharedSize - 1);
+    if (!table->used[slot]) return NULL;
+    const SharedSoftness* entry = &table->entries[slot];
+    if ((any_mass || entry->mass == mass) && entry->load_declared == load_declared && sharedLaw(entry, law, law_slot))
+      return entry;
+  }
   return NULL;
+}
+
+/* Where a new softness goes: the first unused entry from its home on, else (all probed entries used) its home. */
+static unsigned sharedFreeSlot(const SharedTable* table, unsigned home) {
+  for (unsigned p = 0; p < kSharedProbes; ++p) {
+    unsigned slot = (home + p) & (kSharedSize - 1);
+    if (!table->used[slot]) return slot;
+  }
+  return home;
 }
 
 /* Gives every row in the law table its written back from law_written: before a pass that reads the rows' own, and
@@ -366,6 +380,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
         return failBinding(status, binding);
       }
       if (!(registry->disabled_caches & SS_CACHE_SHARED)) {
+        slot = sharedFreeSlot(&shared, slot);
         shared.entries[slot] = (SharedSoftness){law, binding->law_slot, mass, binding->load != 0, binding->pending,
                                                 binding->computed_fallback};
         shared.used[slot] = 1;
