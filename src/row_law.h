@@ -21,8 +21,8 @@ typedef struct ssRowLaw {
 /* How a row's softness for one step was obtained, beyond the mapping asked for. */
 typedef struct ssRowFallback {
   /* flags of one byte each: the registry keeps one of these in every binding's hot cache line */
-  unsigned char exact_to_matched;  /* SS_MAPPING_EXACT had no finite softness for this pair of steps: matched was used */
-  unsigned char to_implicit_euler; /* an accurate mapping could not serve the row: the implicit-Euler mapping was used */
+  unsigned char exact_to_matched;  /* SS_MAPPING_EXACT had no finite softness for this pair of steps: matched used */
+  unsigned char to_implicit_euler; /* an accurate mapping could not serve the row: the implicit-Euler mapping used */
 } ssRowFallback;
 
 /* A spring's law (the spring is not checked here: bind time does). */
