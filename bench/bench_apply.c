@@ -86,16 +86,6 @@ static double stepBlock(Scene* scene, ssMapping mapping, const double* frames_s,
   return timed;
 }
 
-static int compareDoubles(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double* values, int count) {
-  qsort(values, (size_t)count, sizeof(double), compareDoubles);
-  return values[count / 2];
-}
-
 static void report(ssMapping mapping, int varying, int distinct, int frames, int repeats) {
   static double seconds[kConfigs][kMaxRepeats], ratios[kConfigs][kMaxRepeats], step_s[kMaxRepeats];
   unsigned random = 12345;
@@ -125,10 +115,10 @@ static void report(ssMapping mapping, int varying, int distinct, int frames, int
       dWorldDestroy(scenes[c].world);
     }
   }
-  double apply_us = 1e6 * median(seconds[0], repeats);
+  double apply_us = 1e6 * benchMedian(seconds[0], repeats);
   printf("  %-14s %-8s %-8s %8.2f %6.2f%%", ssMappingName(mapping), varying ? "varying" : "1/60 s",
-         distinct ? "distinct" : "shared", apply_us, 100 * apply_us / (1e6 * median(step_s, repeats)));
-  for (int c = 1; c < kConfigs; ++c) printf(" %10.2f", median(ratios[c], repeats));
+         distinct ? "distinct" : "shared", apply_us, 100 * apply_us / (1e6 * benchMedian(step_s, repeats)));
+  for (int c = 1; c < kConfigs; ++c) printf(" %10.2f", benchMedian(ratios[c], repeats));
   printf("\n");
 }
 

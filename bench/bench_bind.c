@@ -160,16 +160,6 @@ static Sample measure(int rows) {
   return sample;
 }
 
-static int compareDoubles(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double* values, int count) {
-  qsort(values, (size_t)count, sizeof(double), compareDoubles);
-  return values[count / 2];
-}
-
 /* The largest of the sizes' values over the smallest. */
 static double spread(const double* values) {
   double lo = values[0], hi = values[0];
@@ -203,18 +193,18 @@ int main(int argc, char** argv) {
       adopt_faults[s][r] = sample.adopt_faults;
     }
   }
-  double fault_us = 1e6 * median(fault_s, repeats);
+  double fault_us = 1e6 * benchMedian(fault_s, repeats);
   printf("bench_bind: hinge chains, a stop and a motor row a hinge; medians of %d repeats\n", repeats);
   printf("  %8s %12s %12s %12s %14s %14s %13s %15s\n", "rows", "bind us/row", "adopt us/row", "read us/row",
          "bind faults/k", "adopt faults/k", "QuickStep ms", "bind/QuickStep");
   double bind_us[kSizes], adopt_us[kSizes];
   for (int s = 0; s < kSizes; ++s) {
-    double bind_s = median(bind[s], repeats), adopt_s = median(adopt[s], repeats), step_s = median(step[s], repeats);
+    double bind_s = benchMedian(bind[s], repeats), adopt_s = benchMedian(adopt[s], repeats), step_s = benchMedian(step[s], repeats);
     bind_us[s] = 1e6 * bind_s / kRows[s];
     adopt_us[s] = 1e6 * adopt_s / kRows[s];
     printf("  %8d %12.3f %12.3f %12.3f %14.1f %14.1f %13.3f %15.3f\n", kRows[s], bind_us[s], adopt_us[s],
-           1e6 * median(read[s], repeats) / kRows[s], 1e3 * median(bind_faults[s], repeats) / kRows[s],
-           1e3 * median(adopt_faults[s], repeats) / kRows[s], 1e3 * step_s, bind_s / step_s);
+           1e6 * benchMedian(read[s], repeats) / kRows[s], 1e3 * benchMedian(bind_faults[s], repeats) / kRows[s],
+           1e3 * benchMedian(adopt_faults[s], repeats) / kRows[s], 1e3 * step_s, bind_s / step_s);
   }
   printf("  read: ODE's getters reading what binding reads of each row (the floor); faults/k: page faults a thousand "
          "rows,\n  %.2f us each (a first touch of fresh memory)\n",
@@ -223,8 +213,8 @@ int main(int argc, char** argv) {
          spread(adopt_us));
   double net_bind[kSizes], net_adopt[kSizes];
   for (int s = 0; s < kSizes; ++s) {
-    net_bind[s] = bind_us[s] - fault_us * median(bind_faults[s], repeats) / kRows[s];
-    net_adopt[s] = adopt_us[s] - fault_us * median(adopt_faults[s], repeats) / kRows[s];
+    net_bind[s] = bind_us[s] - fault_us * benchMedian(bind_faults[s], repeats) / kRows[s];
+    net_adopt[s] = adopt_us[s] - fault_us * benchMedian(adopt_faults[s], repeats) / kRows[s];
   }
   printf("  less the page faults' time: bind %.3f / %.3f / %.3f us/row (%.2f), adopt %.3f / %.3f / %.3f (%.2f)\n",
          net_bind[0], net_bind[1], net_bind[2], spread(net_bind), net_adopt[0], net_adopt[1], net_adopt[2],

@@ -1,4 +1,4 @@
-/* What every benchmark shares: the clock it times with, and how a failed call ends it. */
+/* What every benchmark shares: the clock it times with, how a failed call ends it, and the medians it prints. */
 #ifndef BENCH_COMMON_H
 #define BENCH_COMMON_H
 
@@ -21,6 +21,22 @@ static inline void benchCheck(const char* bench, ssStatus status, const char* wh
   if (status == SS_OK) return;
   fprintf(stderr, "%s: %s: %s\n", bench, what, ssLastError());
   exit(1);
+}
+
+static inline int benchCompareDoubles(const void* a, const void* b) {
+  double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
+/* Sorts values in place, smallest first (their range is then values[0] to values[count - 1]). */
+static inline void benchSort(double* values, int count) {
+  qsort(values, (size_t)count, sizeof(double), benchCompareDoubles);
+}
+
+/* The median of count > 0 values (the upper one of an even count), sorting them in place. */
+static inline double benchMedian(double* values, int count) {
+  benchSort(values, count);
+  return values[count / 2];
 }
 
 #endif

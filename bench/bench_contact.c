@@ -120,11 +120,6 @@ static double stepBlock(Stack* stack, const double* frames_s, int count) {
   return nowSeconds() - start;
 }
 
-static int compareDoubles(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
 /* The adopted world's time over the program's own, for each repeat; profile NULL: frames of 1/60 s. */
 static void report(int boxes, const char* profile_spec, int frames, int repeats) {
   double ratios[kMaxRepeats], own_us = 0;
@@ -148,7 +143,7 @@ static void report(int boxes, const char* profile_spec, int frames, int repeats)
     destroy(stacks[0]);
     destroy(stacks[1]);
   }
-  qsort(ratios, (size_t)repeats, sizeof(double), compareDoubles);
+  benchSort(ratios, repeats);
   /* the adopted world's numbers are the program's up to rounding (its tuned values go through springs and back), so
    * a large stack may drift into a few other contacts: both counts are printed */
   printf("  %3d boxes, %-16s own loop %7.1f us/frame; contacts/frame %.1f own, %.1f adopted; adopted naive: median "

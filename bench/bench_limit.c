@@ -170,16 +170,6 @@ static double clockCost(void) {
   return least;
 }
 
-static int compareDoubles(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double* values, int count) {
-  qsort(values, (size_t)count, sizeof(double), compareDoubles);
-  return values[count / 2];
-}
-
 /* One size: each repeat's costs a frame (s), each the median over its blocks. A timed interval holds about one clock
  * read's cost (clock_s): the limit's frame one; the library's block of k frames its 2k reads inside and one of its
  * own, less the k its ODE steps hold; ODE's step in the other world one. */
@@ -210,7 +200,7 @@ static void measure(int bodies, int frames, int repeats, double clock_s, double 
       per_block[kAcrossCost][blocks] =
           (parts[kLibraryFramesPart] - (kBlock + 1) * clock_s) / kBlock - parts[kOdePart] / kBlock;
     }
-    for (int c = 0; c < kCosts; ++c) costs[c][r] = median(per_block[c], blocks);
+    for (int c = 0; c < kCosts; ++c) costs[c][r] = benchMedian(per_block[c], blocks);
     ssProfile_Destroy(profile);
     for (int w = 0; w < kWays; ++w) destroy(&scenes[w]);
   }
@@ -251,10 +241,10 @@ int main(int argc, char** argv) {
       ratio[r] = costs[kLibraryCost][r] / costs[kLimitCost][r];
       across_ratio[r] = costs[kAcrossCost][r] / costs[kLimitCost][r];
     }
-    double ode_us = 1e6 * median(costs[kOdeCost], repeats);
-    double limit_us = 1e6 * median(costs[kLimitCost], repeats);
-    double library_us = 1e6 * median(costs[kLibraryCost], repeats);
-    double middle = median(ratio, repeats), across = median(across_ratio, repeats);
+    double ode_us = 1e6 * benchMedian(costs[kOdeCost], repeats);
+    double limit_us = 1e6 * benchMedian(costs[kLimitCost], repeats);
+    double library_us = 1e6 * benchMedian(costs[kLibraryCost], repeats);
+    double middle = benchMedian(ratio, repeats), across = benchMedian(across_ratio, repeats);
     printf("  %7d %12.2f %14.2f (%4.1f%%) %14.2f (%4.1f%%) %10.2f (%.2f to %.2f) %12.2f (%.2f to %.2f)\n", bodies,
            ode_us, limit_us, 100 * limit_us / ode_us, library_us, 100 * library_us / ode_us, middle, ratio[0],
            ratio[repeats - 1], across, across_ratio[0], across_ratio[repeats - 1]);

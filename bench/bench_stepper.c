@@ -150,11 +150,6 @@ static void measure(const char* profile_spec, int frames, double seconds[kWorlds
   }
 }
 
-static int compareDoubles(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
 /* Repeats the measurement and prints, for each stepped world, the median ratio to plain ODE and its range. */
 static void report(const char* title, const char* profile_spec, int frames, int repeats) {
   /* ratios[w]: world w against plain ODE; against_hand: implicit Euler against the same loop written by hand, the
@@ -169,11 +164,11 @@ static void report(const char* title, const char* profile_spec, int frames, int 
   }
   printf("%s\n  %-28s %8.1f us/frame\n", title, kWorldNames[0], plain_us);
   for (int w = 1; w < kWorlds; ++w) {
-    qsort(ratios[w], (size_t)repeats, sizeof(double), compareDoubles);
+    benchSort(ratios[w], repeats);
     printf("  %-28s median ratio %.3f   (%.3f to %.3f over %d repeats)\n", kWorldNames[w], ratios[w][repeats / 2],
            ratios[w][0], ratios[w][repeats - 1], repeats);
   }
-  qsort(against_hand, (size_t)repeats, sizeof(double), compareDoubles);
+  benchSort(against_hand, repeats);
   printf("  %-28s median ratio %.3f   (%.3f to %.3f) to the loop by hand\n", kWorldNames[2],
          against_hand[repeats / 2], against_hand[0], against_hand[repeats - 1]);
 }
@@ -210,7 +205,7 @@ static void reportInterpolation(int frames, int repeats) {
       dWorldDestroy(scenes[w].world);
     }
   }
-  qsort(ratios, (size_t)repeats, sizeof(double), compareDoubles);
+  benchSort(ratios, repeats);
   printf("fixed steps of 1/60 s, frames of 1/90 to 1/40 s: keeping the poses to draw (target <= 1.01)\n"
          "  %-28s median ratio %.4f   (%.4f to %.4f over %d repeats) to the same without\n",
          "ssStepper_Step, interpolated", ratios[repeats / 2], ratios[0], ratios[repeats - 1], repeats);
