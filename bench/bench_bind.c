@@ -10,9 +10,9 @@
  * faults a row (the registry's arrays and index are new memory the kernel hands out one 4 KB page at a time, zeroed)
  * with the time of one fault measured on a fresh mapping.
  *
- * What grows from 10,000 to 100,000 rows is mostly that first touch. A registry of 100,000 rows is 26 MB of joint
- * bindings (256 bytes a row) and a 4 MB index, all fresh at that size, where at 10,000 rows glibc serves the arrays
- * from memory the process freed before; at about 2 us a fault, ~100 faults a thousand rows are 0.2 us a row, more
+ * What grows from 10,000 to 100,000 rows is mostly that first touch. A registry of 100,000 rows is 19 MB of joint
+ * bindings (192 bytes a row) and a 4 MB index, all fresh at that size, where at 10,000 rows glibc serves the arrays
+ * from memory the process freed before; at about 2 us a fault, 70-120 faults a thousand rows are 0.15-0.25 us a row, more
  * than binding a row costs at 1,000 rows. The index's probes stay short (1.3 slots on average at 100,000 rows) and
  * the world's reads, cold at that size, cost 0.04-0.06 us a row against 0.01 (the read column); the rest is cache
  * misses on the larger arrays. The last line prints the time per row less the faults' time, and its spread.
