@@ -12,9 +12,9 @@
  *
  * What grows from 10,000 to 100,000 rows is mostly that first touch. A registry of 100,000 rows is 19 MB of joint
  * bindings (192 bytes a row) and a 4 MB index, all fresh at that size, where at 10,000 rows glibc serves the arrays
- * from memory the process freed before; at about 2 us a fault, 70-120 faults a thousand rows are 0.15-0.25 us a row, more
- * than binding a row costs at 1,000 rows. The index's probes stay short (1.3 slots on average at 100,000 rows) and
- * the world's reads, cold at that size, cost 0.04-0.06 us a row against 0.01 (the read column); the rest is cache
+ * from memory the process freed before; at about 2 us a fault, 70-120 faults a thousand rows are 0.15-0.25 us a row,
+ * more than binding a row costs at 1,000 rows. The index's probes stay short (1.3 slots on average at 100,000 rows)
+ * and the world's reads, cold at that size, cost 0.04-0.06 us a row against 0.01 (the read column); the rest is cache
  * misses on the larger arrays. The last line prints the time per row less the faults' time, and its spread.
  *
  *   bench_bind [repeats]      (default 5) */
@@ -199,7 +199,8 @@ int main(int argc, char** argv) {
          "bind faults/k", "adopt faults/k", "QuickStep ms", "bind/QuickStep");
   double bind_us[kSizes], adopt_us[kSizes];
   for (int s = 0; s < kSizes; ++s) {
-    double bind_s = benchMedian(bind[s], repeats), adopt_s = benchMedian(adopt[s], repeats), step_s = benchMedian(step[s], repeats);
+    double bind_s = benchMedian(bind[s], repeats), adopt_s = benchMedian(adopt[s], repeats);
+    double step_s = benchMedian(step[s], repeats);
     bind_us[s] = 1e6 * bind_s / kRows[s];
     adopt_us[s] = 1e6 * adopt_s / kRows[s];
     printf("  %8d %12.3f %12.3f %12.3f %14.1f %14.1f %13.3f %15.3f\n", kRows[s], bind_us[s], adopt_us[s],
