@@ -12,21 +12,21 @@ typedef struct ssBodyTuned {
   double damping_step_s; /* > 0: the damping scales were read for steps of this length (s); 0: bound by hand */
   double linear_scale, angular_scale;
   double auto_disable_step_s; /* > 0: the auto-disable numbers were read for steps of this length (s) */
-  int idle_steps;
   double idle_time_s;
+  int idle_steps;
   int average_samples;
 } ssBodyTuned;
 
-/* A body's damping and auto-disable, given in seconds. body 0 holds the world's defaults. */
+/* A body's damping and auto-disable, given in seconds. body 0 holds the world's defaults. Laid out without padding
+ * (104 bytes): adoption holds two of these a body, the plan's and the registry's. */
 typedef struct ssBodyBinding {
   dBodyID body;
-  int has_damping;
   double linear_rate_per_s, angular_rate_per_s;
-  int has_auto_disable;
   double idle_time_s, average_window_s;
+  double written_step_s;       /* the step the values were last written for; NAN after a (re)binding */
   ssBodyTuned tuned;           /* cleared by ssRegistry_BindDamping and ssRegistry_BindAutoDisable */
   int average_samples_written; /* ODE restarts its average whenever the count is set: write it only on change */
-  double written_step_s;       /* the step the values were last written for; NAN after a (re)binding */
+  unsigned char has_damping, has_auto_disable;
 } ssBodyBinding;
 
 /* A number that changes whenever a joint or body is bound or unbound: the stepper rebuilds its list on a change. */
