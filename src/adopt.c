@@ -20,13 +20,15 @@
 
 typedef struct PlannedRow {
   dJointID joint;
-  ssJointParam param;
-  int axis;
+  uint8_t joint_type; /* a dJointType, read once */
+  uint8_t param;      /* an ssJointParam */
+  uint8_t axis;
   ssRowLaw law;
 } PlannedRow;
 
-/* A body's binding as it will be made (body 0: the world's defaults), and the sample count the body holds, which is
- * not written again where it is already the one to write (ODE restarts the average when it is set). */
+/* A body's binding as it will be made (body 0: the world's defaults; any other body, whole, as the registry will
+ * hold it), and the sample count the body holds, which is not written again where it is already the one to write
+ * (ODE restarts the average when it is set). */
 typedef struct PlannedBody {
   ssBodyBinding binding;
   int samples_held;
@@ -227,6 +229,15 @@ static ssStatus planBody(Plan* plan, dBodyID body) {
     snprintf(what, sizeof what, "body %p", (void*)body);
     return autoDisableTimes(what, steps, seconds, samples, plan->tuned_step_s, binding);
   }
+  /* as the registry's own binding calls would leave it (see bindBody) */
+  binding->written_step_s = NAN;
+  if (binding->has_auto_disable) {
+    binding->average_samples_written = samples;
+  } else {
+    binding->idle_time_s = binding->average_window_s = 0;
+    binding->tuned.auto_disable_step_s = binding->tuned.idle_time_s = 0;
+    binding->tuned.idle_steps = binding->tuned.average_samples = 0;
+  }
   if (!ssReserveOne((void**)&plan->bodies, plan->body_count, &plan->body_capacity, sizeof planned))
     return outOfMemory();
   plan->bodies[plan->body_count++] = planned;
@@ -239,11 +250,11 @@ static ssStatus planRowLaw(const char* what, double erp, double cfm, double tune
   return status == SS_OK ? ssCheckLawForEveryStep(what, law) : status;
 }
 
-static ssStatus planRow(Plan* plan, dJointID joint, ssJointParam param, int axis) {
+static ssStatus planRow(Plan* plan, dJointID joint, int joint_type, ssJointParam param, int axis) {
   if (ssRegistryHasJointRow(plan->registry, joint, param, axis)) return SS_OK;
   double erp, cfm;
   ssJointReadSoftness(joint, param, axis, &erp, &cfm);
-  PlannedRow row = {.joint = joint, .param = param, .axis = axis};
+  PlannedRow row = {.joint = joint, .joint_type = (uint8_t)joint_type, .param = (uint8_t)param, .axis = (uint8_t)axis};
   ssRowLaw world_law;
   ssSoftness world_now = {dWorldGetERP(plan->world), dWorldGetCFM(plan->world)};
   /* a row still holding the world's current ERP/CFM (ODE copies them at creation; the registry rewrites them for
@@ -289,13 +300,13 @@ static ssStatus planJoint(Plan* plan, dJointID joint) {
   }
   plan->counts.joints += 1;
   ssStatus status = SS_OK;
-  if (ssJointSupports(joint, SS_PARAM_JOINT, 1)) status = planRow(plan, joint, SS_PARAM_JOINT, 1);
+  if (ssJointSupports(joint, SS_PARAM_JOINT, 1)) status = planRow(plan, joint, type, SS_PARAM_JOINT, 1);
   for (int axis = 1; axis <= ssJointLimitAxisCount(joint) && status == SS_OK; ++axis) {
-    status = planRow(plan, joint, SS_PARAM_STOP, axis);
-    if (status == SS_OK) status = planRow(plan, joint, SS_PARAM_MOTOR, axis);
+    status = planRow(plan, joint, type, SS_PARAM_STOP, axis);
+    if (status == SS_OK) status = planRow(plan, joint, type, SS_PARAM_MOTOR, axis);
   }
   if (status == SS_OK && ssJointSupports(joint, SS_PARAM_SUSPENSION, 1))
-    status = planRow(plan, joint, SS_PARAM_SUSPENSION, 1);
+    status = planRow(plan, joint, type, SS_PARAM_SUSPENSION, 1);
   for (int side = 0; side < 2 && status == SS_OK; ++side) {
     dBodyID body = dJointGetBody(joint, side);
     if (body == 0) continue;
@@ -333,7 +344,7 @@ static ssStatus planSpace(Plan* plan, dSpaceID space) {
   return SS_OK;
 }
 
-/* Binds one planned body (or the world's defaults), with what the program had for the tuned step. */
+/* Binds the world's planned defaults, with what the program had for the tuned step, over any bound by hand. */
 static void bindBody(ssRegistry* registry, const PlannedBody* planned) {
   const ssBodyBinding* binding = &planned->binding;
   ssRegistry_BindDamping(registry, binding->body, binding->linear_rate_per_s, binding->angular_rate_per_s);
@@ -362,11 +373,13 @@ static ssStatus commit(Plan* plan, ssAdoptReport* report) {
     plan->counts.world = 1;
     plan->counts.hard_rows += plan->world_law.hard;
   }
+  /* the plan holds only rows and bodies not bound before, each once */
   for (int i = 0; i < plan->row_count; ++i) {
     const PlannedRow* row = &plan->rows[i];
-    ssRegistryBindJointLaw(plan->registry, row->joint, row->param, row->axis, row->law, 0);
+    ssRegistryAppendJointLaw(plan->registry, row->joint, row->joint_type, (ssJointParam)row->param, row->axis,
+                             row->law);
   }
-  for (int i = 0; i < plan->body_count; ++i) bindBody(plan->registry, &plan->bodies[i]);
+  for (int i = 0; i < plan->body_count; ++i) ssRegistryAppendBody(plan->registry, &plan->bodies[i].binding);
   plan->counts.bodies += plan->body_count;
   if (report != NULL) {
     report->world += plan->counts.world;

@@ -154,13 +154,16 @@ void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* e
 
 int ssJointLimitAxisCount(dJointID joint) { return limitAxisCount(joint); }
 
-void ssJointRowWriterOf(dJointID joint, ssJointParam param, int axis, ssRowWriter* out) {
+void ssJointRowWriterOfType(int joint_type, ssJointParam param, int axis, ssRowWriter* out) {
   int erp_param, cfm_param;
   *out = (ssRowWriter){NULL, -1, -1};
   if (!softnessParams(param, &erp_param, &cfm_param)) return;
-  int type = dJointGetType(joint);
-  out->set = setterOf(type, axis, cfm_param, &out->cfm_number);
-  if (erp_param >= 0) setterOf(type, axis, erp_param, &out->erp_number);
+  out->set = setterOf(joint_type, axis, cfm_param, &out->cfm_number);
+  if (erp_param >= 0) setterOf(joint_type, axis, erp_param, &out->erp_number);
+}
+
+void ssJointRowWriterOf(dJointID joint, ssJointParam param, int axis, ssRowWriter* out) {
+  ssJointRowWriterOfType(dJointGetType(joint), param, axis, out);
 }
 
 static int isDynamic(dBodyID body) { return body != 0 && !dBodyIsKinematic(body); }

@@ -22,6 +22,8 @@ typedef struct ssRowWriter {
 } ssRowWriter;
 
 void ssJointRowWriterOf(dJointID joint, ssJointParam param, int axis, ssRowWriter* out);
+/* The same for a joint whose type (dJointGetType) was read already. */
+void ssJointRowWriterOfType(int joint_type, ssJointParam param, int axis, ssRowWriter* out);
 
 /* Writes the row's softness through its writer (MOTOR rows write only cfm): what the registry does for every row at
  * every Apply. */

@@ -143,10 +143,9 @@ int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam par
 
 static int reserve(void** items, int count, int more, int* capacity, size_t size);
 
-ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
-                                double effective_mass) {
-  ssApplyMaterializeWritten(registry); /* before the law slots or the rows move */
-  registry->revision += 1;
+/* A fresh binding of a joint row, nothing computed yet. */
+static JointBinding newBinding(dJointID joint, int joint_type, ssJointParam param, int axis, ssRowLaw law,
+                               double effective_mass) {
   JointBinding binding = {.joint = joint,
                           .pending = {0, 0},
                           .written = {NAN, NAN},
@@ -163,19 +162,40 @@ ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointPar
                           .load = 0,
                           .load_correction = 0,
                           .body_slot = {-1, -1},
-                          .joint_type = dJointGetType(joint)};
-  ssJointRowWriterOf(joint, param, axis, &binding.writer);
+                          .joint_type = (uint8_t)joint_type};
+  ssJointRowWriterOfType(joint_type, param, axis, &binding.writer);
+  return binding;
+}
+
+/* Appends a row not bound yet, with room reserved. */
+static void appendJoint(ssRegistry* registry, dJointID joint, int joint_type, ssJointParam param, int axis,
+                        ssRowLaw law, double effective_mass) {
+  ssIndexPut(&registry->joint_index, joint, rowTag(param, axis), registry->joint_count);
+  registry->joints[registry->joint_count++] = newBinding(joint, joint_type, param, axis, law, effective_mass);
+  registry->generation += 1;
+}
+
+ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
+                                double effective_mass) {
+  ssApplyMaterializeWritten(registry); /* before the law slots or the rows move */
+  registry->revision += 1;
+  int joint_type = dJointGetType(joint);
   JointBinding* existing = findJoint(registry, joint, param, axis);
   if (existing != NULL) {
-    *existing = binding;
+    *existing = newBinding(joint, joint_type, param, axis, law, effective_mass);
     return SS_OK;
   }
   if (!reserveJoints(registry, 1))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding a joint");
-  ssIndexPut(&registry->joint_index, joint, rowTag(param, axis), registry->joint_count);
-  registry->joints[registry->joint_count++] = binding;
-  registry->generation += 1;
+  appendJoint(registry, joint, joint_type, param, axis, law, effective_mass);
   return SS_OK;
+}
+
+void ssRegistryAppendJointLaw(ssRegistry* registry, dJointID joint, int joint_type, ssJointParam param, int axis,
+                              ssRowLaw law) {
+  ssApplyMaterializeWritten(registry);
+  registry->revision += 1;
+  appendJoint(registry, joint, joint_type, param, axis, law, 0);
 }
 
 ssStatus ssRegistry_BindJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssSpring spring,
@@ -256,6 +276,13 @@ static ssBodyBinding* bodyBinding(ssRegistry* registry, dBodyID body) {
   binding->body = body;
   binding->written_step_s = NAN;
   return binding;
+}
+
+void ssRegistryAppendBody(ssRegistry* registry, const ssBodyBinding* binding) {
+  ssIndexPut(&registry->body_index, binding->body, 0, registry->body_count);
+  registry->bodies[registry->body_count++] = *binding;
+  registry->generation += 1;
+  registry->revision += 1;
 }
 
 ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linear_rate_per_s,

@@ -39,6 +39,11 @@ int ssRegistryBodyBindingCount(const ssRegistry* registry);
 void ssRegistryBindWorldLaw(ssRegistry* registry, ssRowLaw law, double effective_mass);
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass);
+/* Adoption's commit, after ssRegistryReserve made the room: appends a row or a body known not to be bound (the
+ * joint's type read already, the body's binding whole), without looking either up again. */
+void ssRegistryAppendJointLaw(ssRegistry* registry, dJointID joint, int joint_type, ssJointParam param, int axis,
+                              ssRowLaw law);
+void ssRegistryAppendBody(ssRegistry* registry, const ssBodyBinding* binding);
 int ssRegistryHasJoint(const ssRegistry* registry, dJointID joint);
 int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam param, int axis);
 
