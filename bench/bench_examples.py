@@ -2,7 +2,7 @@
 quantities depend on the frame rate, how far they are from a fine-step reference, and what adopted stepping costs.
 
 Usage: .venv/bin/python bench/bench_examples.py [BUILD_DIR] [--repeats N] [--boxes N] [--cost-seconds S]
-       [--vehicle-seconds S] [--skip-cost | --cost-only] [--executor WHERE]
+       [--vehicle-seconds S] [--skip-cost | --cost-only] [--instructions] [--executor WHERE]
 
 1-2. Frame-rate spread and accuracy: `steadystep audit` (python/steadystep/audit.py, docs/audit.md) of each adopted
    program with its *_ode twin as its own stepping, under the profiles fixed:60, fixed:30 and uniform:15:45 (seeds 1,
@@ -25,6 +25,11 @@ Usage: .venv/bin/python bench/bench_examples.py [BUILD_DIR] [--repeats N] [--box
    time. Each repeat runs the own stepping and every policy once, in an order rotated from repeat to repeat, and the
    ratio policy / own is taken per repeat; printed: the median ratio over the repeats and its range, for both clocks
    (CPU time is the one a shared, busy machine disturbs least).
+   With --instructions (needs valgrind: apt-get install valgrind), the same variants' instructions are counted as
+   well, by callgrind: each variant runs once for the cost run's simulated time and once for twice that, and the
+   difference is the instructions of that much more stepping loop, start-up and world building taken off. A count
+   does not vary from run to run as times do on a shared machine (the vehicle's CPU-time ratios range over about
+   15 % here); it does not see cache misses, which the times do.
 Prints Markdown tables. Exit 1 when a run fails (a program the audit refuses: its one line, exit 1).
 """
 
@@ -32,6 +37,7 @@ from __future__ import annotations
 
 import argparse
 import pathlib
+import shutil
 import statistics
 import subprocess
 import sys
@@ -87,6 +93,38 @@ def loop_seconds(build: pathlib.Path, program: str, variant: str, seconds: float
     return wall_s, cpu_s
 
 
+def loop_instructions(build: pathlib.Path, program: str, variant: str, seconds: float, extra: list[str]) -> int:
+    """Instructions, counted by callgrind, of `seconds` of the program's stepping loop at fixed:60: a run twice as
+    long less a run as long."""
+    counts = []
+    for duration in (seconds, 2 * seconds):
+        command = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null"]
+        if variant == "own":
+            command += [str(build / f"steadystep_example_{program}_ode")]
+        else:
+            command += [str(build / f"steadystep_example_{program}_steadystep"), "--policy", variant,
+                        "--max-step", "1"]
+        command += ["--profile", "fixed:60", "--duration", str(duration), "--quiet"] + extra
+        done = subprocess.run(command, capture_output=True, text=True)
+        collected = [line for line in done.stderr.splitlines() if "Collected :" in line]
+        if done.returncode != 0 or not collected:
+            sys.exit(f"bench_examples: {' '.join(command)} exited {done.returncode}: {done.stderr.strip()[-400:]}")
+        counts.append(int(collected[-1].split(":")[-1]))
+    return counts[1] - counts[0]
+
+
+def instruction_table(build: pathlib.Path, program: str, policies: list[str], seconds: float, extra: list[str],
+                      title: str) -> None:
+    own = loop_instructions(build, program, "own", seconds, extra)
+    print()
+    print(f"| {title}, {seconds:g} s of the loop at fixed:60 | instructions (M) | ratio to own |")
+    print("|---|---|---|")
+    print(f"| own stepping loop | {own / 1e6:.1f} | 1 |")
+    for variant in policies:
+        count = loop_instructions(build, program, variant, seconds, extra)
+        print(f"| adopted, {variant} (one step a frame) | {count / 1e6:.1f} | {count / own:.4f} |")
+
+
 def cost_table(build: pathlib.Path, program: str, policies: list[str], repeats: int, seconds: float,
                extra: list[str], title: str) -> None:
     """Each repeat runs the program's own stepping and every policy once, in an order rotated from repeat to repeat;
@@ -133,6 +171,8 @@ def main() -> None:
                         help="simulated time of a vehicle cost run (s; default 300: its loop takes about 0.3 s)")
     parser.add_argument("--skip-cost", action="store_true", help="the frame-rate tables only")
     parser.add_argument("--cost-only", action="store_true", help="the cost tables only")
+    parser.add_argument("--instructions", action="store_true",
+                        help="also count the cost runs' instructions with callgrind (needs valgrind)")
     parser.add_argument("--executor", default="local", help="where the audit's runs go (study.py; default local)")
     args = parser.parse_args()
     build = pathlib.Path(args.build).resolve()
@@ -148,6 +188,12 @@ def main() -> None:
                    f"stack, {args.boxes} boxes")
         cost_table(build, "vehicle", ["implicit-euler", "matched", "exact"], args.repeats, args.vehicle_seconds, [],
                    "vehicle")
+    if args.instructions and not args.skip_cost:
+        if shutil.which("valgrind") is None:
+            sys.exit("bench_examples: --instructions needs valgrind (apt-get install valgrind)")
+        instruction_table(build, "stack", ["implicit-euler"], 1.0, ["--boxes", str(args.boxes)],
+                          f"stack, {args.boxes} boxes")
+        instruction_table(build, "vehicle", ["implicit-euler", "matched", "exact"], 60.0, [], "vehicle")
     diff_sizes(pathlib.Path(__file__).resolve().parent.parent)
 
 
