@@ -113,7 +113,7 @@ static int sharedLaw(const SharedSoftness* shared, const ssRowLaw* law, int law_
  * after it, and stops at an unused one (nothing leaves the table within an Apply). Rows of distinct masses, which
  * never share, pay a few comparisons of the mass; a handful of pairs (laws times the masses of identical links)
  * each find their entry although two of them share a home (one entry a home thrashed: every row computed again). */
-enum { kSharedSize = 16, kSharedProbes = 4 };
+enum { kSharedSize = 16, kSharedProbes = 4, kSharedTrial = 2 * kSharedSize };
 typedef struct SharedTable {
   unsigned char used[kSharedSize];
   SharedSoftness entries[kSharedSize];
@@ -257,8 +257,16 @@ static const ssBodyInverse* bodyInverse(ssRegistry* registry, int slot, dBodyID 
 static double rowMass(ssRegistry* registry, const JointBinding* binding) {
   dBodyID bodies[2] = {dJointGetBody(binding->joint, 0), 0};
   ssRowGeometry row;
-  if (bodies[0] == 0 || !ssJointRowGeometry(binding->joint, binding->joint_type, binding->param, binding->axis, &row))
+  if (bodies[0] == 0) return NAN;
+  if (binding->joint_type == dJointTypeHinge) { /* the commonest row, read directly: what ssJointRowGeometry reads */
+    dVector3 axis;
+    dJointGetHingeAxis(binding->joint, axis);
+    row.direction[0] = axis[0], row.direction[1] = axis[1], row.direction[2] = axis[2];
+    row.angular = 1;
+    row.has_point = 0;
+  } else if (!ssJointRowGeometry(binding->joint, binding->joint_type, binding->param, binding->axis, &row)) {
     return NAN;
+  }
   bodies[1] = dJointGetBody(binding->joint, 1);
   double inverse = 0;
   for (int side = 0; side < 2; ++side) {
@@ -329,6 +337,10 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
    * each distinct pair is computed once and shared. */
   SharedTable shared;
   memset(shared.used, 0, sizeof shared.used);
+  /* Rows of distinct masses (a ragdoll, links of their own masses) never share: after kSharedTrial computed rows
+   * that found fewer than one in four shared, the rest of this Apply computes every row without the probes (the
+   * softness is a pure function of law and mass, so the values are the same either way). */
+  int sharing = !(registry->disabled_caches & SS_CACHE_SHARED), shared_hits = 0, shared_computed = 0;
   double last_mass = NAN;
   LawFallbacks fallbacks;
   memset(fallbacks.known, 0, sizeof fallbacks.known);
@@ -365,25 +377,32 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       }
       binding->computed_fallback = (ssRowFallback){0, 1};
       countRow(&binding->computed_fallback, counts);
-    } else if ((slot = sharedSlot(law, binding->law_slot, any_mass, mass, binding->load != 0),
-                hit = findShared(&shared, slot, law, binding->law_slot, any_mass, mass, binding->load != 0)) != NULL) {
+    } else if (sharing && (slot = sharedSlot(law, binding->law_slot, any_mass, mass, binding->load != 0),
+                           hit = findShared(&shared, slot, law, binding->law_slot, any_mass, mass,
+                                            binding->load != 0)) != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
       countRow(&hit->fallback, counts);
+      shared_hits += 1;
     } else {
       status = softnessFor(law, mapping, mass, step_s, previous_s, binding->load != 0, counts,
                            &binding->computed_fallback, &binding->pending);
-      /* the boundary with ODE: nothing outside limits.h's ranges is ever written */
-      if (status == SS_OK) status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
+      /* the boundary with ODE: nothing outside limits.h's ranges is ever written. An accurate mapping's own
+       * softness passed a stricter check already (matched.c's finish: finite, |erp| <= SS_MAX_ERP, cfm in
+       * [SS_MIN_POSITIVE_CFM, SS_MAX_CFM]); what implicit Euler or a hard law gave is checked here. */
+      int checked = mapping != SS_MAPPING_IMPLICIT_EULER && !law->hard && !binding->computed_fallback.to_implicit_euler;
+      if (status == SS_OK && !checked)
+        status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
       if (status != SS_OK) {
         binding->computed_step_s = NAN;
         return failBinding(status, binding);
       }
-      if (!(registry->disabled_caches & SS_CACHE_SHARED)) {
+      if (sharing) {
         slot = sharedFreeSlot(&shared, slot);
         shared.entries[slot] = (SharedSoftness){law, binding->law_slot, mass, binding->load != 0, binding->pending,
                                                 binding->computed_fallback};
         shared.used[slot] = 1;
+        if (++shared_computed >= kSharedTrial && 4 * shared_hits < shared_computed) sharing = 0;
       }
     }
     *unwritten += !sameWrite(binding->writer.erp_number, &binding->pending, &binding->written);
