@@ -37,6 +37,7 @@
 #include <string.h>
 
 #include "error.h"
+#include "matched_internal.h"
 #include "ode_bounds.h"
 #include "registry_layout.h"
 #include "steadystep/limits.h"
@@ -85,6 +86,17 @@ static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass,
   ssStatus status = ssRowSoftness(law, mapping, mass, step_s, previous_step_s, load_declared, fallback, out);
   countRow(fallback, report);
   return status;
+}
+
+/* Whether an accurate mapping serves the row as a pure damper (a motor's friction), with its matched softness in
+ * *out: ssRowSoftness's tests for such a row in its order (a mass, c > 0; k = 0 is never above Nyquist; a finite
+ * softness; the static damping's rule), without its general path. Both mappings serve a damper with the matched
+ * softness (row_law.c: its velocity decays by e^(-c·h/m) a step whatever the steps before); a declared load on it
+ * has nothing to correct. 0: the general path decides (out may be written). */
+static int damperServed(const ssRowLaw* law, double mass, double step_s, ssSoftness* out) {
+  return !law->hard && law->spring.stiffness == 0 && mass > 0 && isfinite(mass) && law->spring.damping > 0 &&
+         ssMatchedDamper(law->spring.damping, mass, step_s, out) &&
+         ssDamperKeepsStaticResponse(law->spring.damping, out->cfm);
 }
 
 /* One softness an Apply computed, for the rows with the same law and mass that follow. */
@@ -385,8 +397,13 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       countRow(&hit->fallback, counts);
       shared_hits += 1;
     } else {
-      status = softnessFor(law, mapping, mass, step_s, previous_s, binding->load != 0, counts,
-                           &binding->computed_fallback, &binding->pending);
+      if (mapping != SS_MAPPING_IMPLICIT_EULER && damperServed(law, mass, step_s, &binding->pending)) {
+        binding->computed_fallback = (ssRowFallback){0, 0};
+        counts->rows.by_mapping += 1;
+      } else {
+        status = softnessFor(law, mapping, mass, step_s, previous_s, binding->load != 0, counts,
+                             &binding->computed_fallback, &binding->pending);
+      }
       /* the boundary with ODE: nothing outside limits.h's ranges is ever written. An accurate mapping's own
        * softness passed a stricter check already (matched.c's finish: finite, |erp| <= SS_MAX_ERP, cfm in
        * [SS_MIN_POSITIVE_CFM, SS_MAX_CFM]); what implicit Euler or a hard law gave is checked here. */

@@ -4,6 +4,8 @@
 #ifndef STEADYSTEP_ROW_LAW_H
 #define STEADYSTEP_ROW_LAW_H
 
+#include <math.h>
+
 #include "steadystep/spring.h"
 
 typedef struct ssRowLaw {
@@ -63,6 +65,12 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
  * F/k' instead of F/k), or for a pure damper (k = 0) its static damping 1/cfm against c (a load drives it at F·cfm
  * instead of F/c). The implicit-Euler mapping keeps both exactly (k' = k, 1/cfm = h·k + c). */
 int ssKeepsStaticResponse(ssSpring spring, ssSoftness softness, double step_s);
+
+/* ssKeepsStaticResponse for a pure damper (k = 0) of damping c (N·s/m): its static damping 1/cfm against c. Inline:
+ * Apply asks it of every motor row an accurate mapping serves. */
+static inline int ssDamperKeepsStaticResponse(double damping, double cfm) {
+  return fabs(damping * cfm - 1.0) <= SS_STATIC_RESPONSE_TOLERANCE;
+}
 
 /* Whether ssRowSoftness would hand the row to implicit Euler under an accurate mapping for its static response
  * alone, decided without the matched softness' arithmetic (no exp, sqrt or sin): 1 only when the matched
