@@ -15,7 +15,8 @@
  *      body_cache_stale. A slot's inverse is the body's for this Apply when its stamp == apply_stamp.
  *      laws[0..law_count) are distinct; joints[i].law_slot is the slot of a law equal to joints[i].law, or -1 (the
  *      table was full; rows_outside_laws counts those). loaded_rows counts the rows with a load.
- *      hot_rows[i] mirrors joints[i]'s joint, writer and law_slot.
+ *      hot_rows[i] mirrors joints[i]'s joint, writer and law_slot, and says whether joints[i] shares the row of
+ *      joints[i - 1] (sharesRow).
  *  - joints[i].written is what ODE holds for the row (NAN after a binding: written at the next Apply), except while
  *    written_by_law: then a row with law_slot >= 0 holds law_written[law_slot] (the by-law pass writes no row's
  *    own); ssApplyMaterializeWritten puts those back before anything reads or moves the rows' own. A row without
@@ -180,6 +181,15 @@ void ssApplyMaterializeWritten(ssRegistry* registry) {
   registry->written_by_law = 0;
 }
 
+/* Whether two bindings drive rows along the same axis of the same joint (a stop and a motor) and have the same mass:
+ * given alike, or measured for both (a hard row measures none, so its NAN is not the other's mass). */
+static int sharesRow(const JointBinding* a, const JointBinding* b) {
+  int a_limit = a->param == SS_PARAM_STOP || a->param == SS_PARAM_MOTOR;
+  int b_limit = b->param == SS_PARAM_STOP || b->param == SS_PARAM_MOTOR;
+  return a->joint == b->joint && a->axis == b->axis && a_limit && b_limit && a->effective_mass == b->effective_mass &&
+         !a->law.hard && !b->law.hard;
+}
+
 static int compareBodyCache(const void* a, const void* b) {
   uintptr_t x = (uintptr_t)((const BodyCache*)a)->body, y = (uintptr_t)((const BodyCache*)b)->body;
   return (x > y) - (x < y);
@@ -240,7 +250,8 @@ static void rebuildApplyCache(ssRegistry* registry) {
                                      .set = binding->writer.set,
                                      .erp_number = (int16_t)binding->writer.erp_number,
                                      .cfm_number = (int16_t)binding->writer.cfm_number,
-                                     .law_slot = (int16_t)binding->law_slot};
+                                     .law_slot = (int16_t)binding->law_slot,
+                                     .shares_previous_row = i > 0 && sharesRow(&registry->joints[i - 1], binding)};
   }
 }
 
@@ -300,15 +311,6 @@ static double bindingMass(ssRegistry* registry, const JointBinding* binding, con
   return measure ? rowMass(registry, binding) : binding->mass;
 }
 
-/* Whether two bindings drive rows along the same axis of the same joint (a stop and a motor) and have the same mass:
- * given alike, or measured for both (a hard row measures none, so its NAN is not the other's mass). */
-static int sharesRow(const JointBinding* a, const JointBinding* b) {
-  int a_limit = a->param == SS_PARAM_STOP || a->param == SS_PARAM_MOTOR;
-  int b_limit = b->param == SS_PARAM_STOP || b->param == SS_PARAM_MOTOR;
-  return a->joint == b->joint && a->axis == b->axis && a_limit && b_limit && a->effective_mass == b->effective_mass &&
-         !a->law.hard && !b->law.hard;
-}
-
 /* Whether writing b over a would change nothing in ODE (as it stores them: in float, doubles that round alike are
  * one value): a row without an erp (a motor) holds only its cfm. */
 static int sameWrite(int erp_number, const ssSoftness* a, const ssSoftness* b) {
@@ -356,19 +358,20 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
   double last_mass = NAN;
   LawFallbacks fallbacks;
   memset(fallbacks.known, 0, sizeof fallbacks.known);
+  const int same_axis = !(registry->disabled_caches & SS_CACHE_SAME_AXIS);
+  const int reuse = mapping != SS_MAPPING_IMPLICIT_EULER && !(registry->disabled_caches & SS_CACHE_REUSE);
+  const int sure_fallback = !(registry->disabled_caches & SS_CACHE_SURE_FALLBACK);
   for (int i = 0; i < registry->joint_count; ++i) {
     JointBinding* binding = &registry->joints[i];
     PREFETCH_ROWS(registry, i, 2);
     const ssRowLaw* law = binding->law_slot >= 0 ? &registry->laws[binding->law_slot] : &binding->law;
-    const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
     /* a stop and a motor on one axis move the same mass: computed once */
-    int same_row = before != NULL && !(registry->disabled_caches & SS_CACHE_SAME_AXIS) && sharesRow(before, binding);
+    int same_row = same_axis && registry->hot_rows[i].shares_previous_row;
     double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
     last_mass = mass;
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
-    if (mapping != SS_MAPPING_IMPLICIT_EULER && !(registry->disabled_caches & SS_CACHE_REUSE) &&
-        binding->computed_mapping == mapping && binding->mass == mass && binding->computed_step_s == step_s &&
+    if (reuse && binding->computed_mapping == mapping && binding->mass == mass && binding->computed_step_s == step_s &&
         binding->computed_previous_s == previous_s) {
       countRow(&binding->computed_fallback, counts);
       *unwritten += !sameWrite(binding->writer.erp_number, &binding->pending, &binding->written);
@@ -380,7 +383,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     unsigned slot = 0;
     /* a row the rule surely hands to implicit Euler gets the law's implicit-Euler softness, without the accurate
      * arithmetic whose only use would be to decide so (a declared load keeps the accurate softness instead) */
-    if (!any_mass && !(registry->disabled_caches & SS_CACHE_SURE_FALLBACK) &&
+    if (!any_mass && sure_fallback &&
         !(binding->load != 0 && law->spring.stiffness > 0) && ssSurelyFailsStaticResponse(law->spring, mass, step_s)) {
       status = lawFallback(law, binding->law_slot, step_s, &fallbacks, &binding->pending);
       if (status != SS_OK) {
