@@ -47,20 +47,20 @@
  * are asked for while this one is worked on. */
 enum { kPrefetchAhead = 8 };
 #if defined(__GNUC__)
-#define PREFETCH_ROWS(registry, i, lines)                                                  \
+#define PREFETCH_ROWS(joints, count, i, lines)                                                \
   do {                                                                                     \
-    if ((i) + kPrefetchAhead < (registry)->joint_count) {                                  \
-      const char* ahead = (const char*)&(registry)->joints[(i) + kPrefetchAhead];          \
+    if ((i) + kPrefetchAhead < (count)) {                                                  \
+      const char* ahead = (const char*)&(joints)[(i) + kPrefetchAhead];                    \
       for (int line = 0; line < (lines); ++line) __builtin_prefetch(ahead + 64 * line, 1); \
     }                                                                                      \
-    if ((i) + kPrefetchAhead / 2 < (registry)->joint_count) {                              \
-      const char* joint = (const char*)(registry)->joints[(i) + kPrefetchAhead / 2].joint; \
+    if ((i) + kPrefetchAhead / 2 < (count)) {                                              \
+      const char* joint = (const char*)(joints)[(i) + kPrefetchAhead / 2].joint;           \
       __builtin_prefetch(joint);                                                           \
       __builtin_prefetch(joint + 64);                                                      \
     }                                                                                      \
   } while (0)
 #else
-#define PREFETCH_ROWS(registry, i, lines) ((void)0)
+#define PREFETCH_ROWS(joints, count, i, lines) ((void)0)
 #endif
 
 /* Prefixes the current message with what failed, so that a caller of Apply learns which binding it was. */
@@ -361,12 +361,17 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
   const int same_axis = !(registry->disabled_caches & SS_CACHE_SAME_AXIS);
   const int reuse = mapping != SS_MAPPING_IMPLICIT_EULER && !(registry->disabled_caches & SS_CACHE_REUSE);
   const int sure_fallback = !(registry->disabled_caches & SS_CACHE_SURE_FALLBACK);
-  for (int i = 0; i < registry->joint_count; ++i) {
-    JointBinding* binding = &registry->joints[i];
-    PREFETCH_ROWS(registry, i, 2);
+  const int any_load = registry->loaded_rows > 0;
+  /* the rows and their count in locals: the calls into ODE could write *registry for all the compiler knows */
+  JointBinding* const joints = registry->joints;
+  const HotRow* const hot = registry->hot_rows;
+  const int count = registry->joint_count;
+  for (int i = 0; i < count; ++i) {
+    JointBinding* binding = &joints[i];
+    PREFETCH_ROWS(joints, count, i, 2);
     const ssRowLaw* law = binding->law_slot >= 0 ? &registry->laws[binding->law_slot] : &binding->law;
     /* a stop and a motor on one axis move the same mass: computed once */
-    int same_row = same_axis && registry->hot_rows[i].shares_previous_row;
+    int same_row = same_axis && hot[i].shares_previous_row;
     double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
     last_mass = mass;
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
@@ -378,13 +383,15 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       continue;
     }
     binding->mass = mass;
+    /* a row's load lies on a line of its own that the rows of a program without loads leave unread */
+    const int load_declared = any_load && binding->load != 0;
     int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
     const SharedSoftness* hit;
     unsigned slot = 0;
     /* a row the rule surely hands to implicit Euler gets the law's implicit-Euler softness, without the accurate
      * arithmetic whose only use would be to decide so (a declared load keeps the accurate softness instead) */
     if (!any_mass && sure_fallback &&
-        !(binding->load != 0 && law->spring.stiffness > 0) && ssSurelyFailsStaticResponse(law->spring, mass, step_s)) {
+        !(load_declared && law->spring.stiffness > 0) && ssSurelyFailsStaticResponse(law->spring, mass, step_s)) {
       status = lawFallback(law, binding->law_slot, step_s, &fallbacks, &binding->pending);
       if (status != SS_OK) {
         binding->computed_step_s = NAN;
@@ -392,9 +399,9 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       }
       binding->computed_fallback = (ssRowFallback){0, 1};
       countRow(&binding->computed_fallback, counts);
-    } else if (sharing && (slot = sharedSlot(law, binding->law_slot, any_mass, mass, binding->load != 0),
+    } else if (sharing && (slot = sharedSlot(law, binding->law_slot, any_mass, mass, load_declared),
                            hit = findShared(&shared, slot, law, binding->law_slot, any_mass, mass,
-                                            binding->load != 0)) != NULL) {
+                                            load_declared)) != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
       countRow(&hit->fallback, counts);
@@ -404,7 +411,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
         binding->computed_fallback = (ssRowFallback){0, 0};
         counts->rows.by_mapping += 1;
       } else {
-        status = softnessFor(law, mapping, mass, step_s, previous_s, binding->load != 0, counts,
+        status = softnessFor(law, mapping, mass, step_s, previous_s, load_declared, counts,
                              &binding->computed_fallback, &binding->pending);
       }
       /* the boundary with ODE: nothing outside limits.h's ranges is ever written. An accurate mapping's own
@@ -419,7 +426,7 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
       }
       if (sharing) {
         slot = sharedFreeSlot(&shared, slot);
-        shared.entries[slot] = (SharedSoftness){law, binding->law_slot, mass, binding->load != 0, binding->pending,
+        shared.entries[slot] = (SharedSoftness){law, binding->law_slot, mass, load_declared, binding->pending,
                                                 binding->computed_fallback};
         shared.used[slot] = 1;
         if (++shared_computed >= kSharedTrial && 4 * shared_hits < shared_computed) sharing = 0;
@@ -466,9 +473,11 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
  * written. */
 static int writeRows(ssRegistry* registry, ssMapping mapping) {
   int writes = 0;
-  for (int i = 0; i < registry->joint_count; ++i) {
-    JointBinding* binding = &registry->joints[i];
-    PREFETCH_ROWS(registry, i, 2);
+  JointBinding* const joints = registry->joints;
+  const int count = registry->joint_count;
+  for (int i = 0; i < count; ++i) {
+    JointBinding* binding = &joints[i];
+    PREFETCH_ROWS(joints, count, i, 2);
     if (sameWrite(binding->writer.erp_number, &binding->pending, &binding->written)) continue;
     ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
     binding->written = binding->pending;
