@@ -376,8 +376,8 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     last_mass = mass;
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
-    if (reuse && binding->computed_mapping == mapping && binding->mass == mass && binding->computed_step_s == step_s &&
-        binding->computed_previous_s == previous_s) {
+    if (reuse && binding->computed_step_s == step_s && binding->mass == mass && binding->computed_mapping == mapping &&
+        binding->computed_previous_s == previous_s) { /* the step first: under varying steps it differs at once */
       countRow(&binding->computed_fallback, counts);
       *unwritten += !sameWrite(binding->writer.erp_number, &binding->pending, &binding->written);
       continue;
@@ -477,7 +477,7 @@ static int writeRows(ssRegistry* registry, ssMapping mapping) {
   const int count = registry->joint_count;
   for (int i = 0; i < count; ++i) {
     JointBinding* binding = &joints[i];
-    PREFETCH_ROWS(joints, count, i, 2);
+    /* nothing prefetched: the first pass has just read these lines of the bindings and of the joints */
     if (sameWrite(binding->writer.erp_number, &binding->pending, &binding->written)) continue;
     ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
     binding->written = binding->pending;
