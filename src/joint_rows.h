@@ -45,12 +45,17 @@ int ssJointLimitAxisCount(dJointID joint);
  * otherwise (principal 0) I_world⁻¹ itself (row-major 3x3). All 0 for the static world (body 0) and kinematic
  * bodies (dynamic 0); the inertia part is 0 for an inertia that is not positive definite. */
 typedef struct ssBodyInverse {
-  double inverse_mass;
-  double inverse_inertia[9];                            /* principal 0 */
-  const dReal* rotation; double inverse_principal[3];   /* principal 1 */
-  double position[3];
   int dynamic;
   int principal;
+  double inverse_mass;
+  union {
+    double inverse_inertia[9]; /* principal 0 */
+    struct {
+      const dReal* rotation;
+      double inverse_principal[3];
+    }; /* principal 1: with the fields above, in the first cache line of the registry's BodyCache */
+  };
+  double position[3];
 } ssBodyInverse;
 
 void ssBodyInverseOf(dBodyID body, ssBodyInverse* out);
