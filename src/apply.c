@@ -386,40 +386,42 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
     /* a row's load lies on a line of its own that the rows of a program without loads leave unread */
     const int load_declared = any_load && binding->load != 0;
     int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
-    const SharedSoftness* hit;
+    const SharedSoftness* hit = NULL;
     unsigned slot = 0;
-    /* a row the rule surely hands to implicit Euler gets the law's implicit-Euler softness, without the accurate
-     * arithmetic whose only use would be to decide so (a declared load keeps the accurate softness instead) */
-    if (!any_mass && sure_fallback &&
-        !(load_declared && law->spring.stiffness > 0) && ssSurelyFailsStaticResponse(law->spring, mass, step_s)) {
-      status = lawFallback(law, binding->law_slot, step_s, &fallbacks, &binding->pending);
-      if (status != SS_OK) {
-        binding->computed_step_s = NAN;
-        return failBinding(status, binding);
-      }
-      binding->computed_fallback = (ssRowFallback){0, 1};
-      countRow(&binding->computed_fallback, counts);
-    } else if (sharing && (slot = sharedSlot(law, binding->law_slot, any_mass, mass, load_declared),
-                           hit = findShared(&shared, slot, law, binding->law_slot, any_mass, mass,
-                                            load_declared)) != NULL) {
+    if (sharing) {
+      slot = sharedSlot(law, binding->law_slot, any_mass, mass, load_declared);
+      hit = findShared(&shared, slot, law, binding->law_slot, any_mass, mass, load_declared);
+    }
+    if (hit != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
       countRow(&hit->fallback, counts);
       shared_hits += 1;
     } else {
-      if (mapping != SS_MAPPING_IMPLICIT_EULER && damperServed(law, mass, step_s, &binding->pending)) {
-        binding->computed_fallback = (ssRowFallback){0, 0};
-        counts->rows.by_mapping += 1;
+      if (!any_mass && sure_fallback && !(load_declared && law->spring.stiffness > 0) &&
+          ssSurelyFailsStaticResponse(law->spring, mass, step_s)) {
+        /* a row the rule surely hands to implicit Euler gets the law's implicit-Euler softness (checked), without
+         * the accurate arithmetic whose only use would be to decide so (a declared load keeps the accurate
+         * softness instead): what ssRowSoftness gives it, so it is shared like any other */
+        status = lawFallback(law, binding->law_slot, step_s, &fallbacks, &binding->pending);
+        binding->computed_fallback = (ssRowFallback){0, 1};
+        countRow(&binding->computed_fallback, counts);
       } else {
-        status = softnessFor(law, mapping, mass, step_s, previous_s, load_declared, counts,
-                             &binding->computed_fallback, &binding->pending);
+        if (mapping != SS_MAPPING_IMPLICIT_EULER && damperServed(law, mass, step_s, &binding->pending)) {
+          binding->computed_fallback = (ssRowFallback){0, 0};
+          counts->rows.by_mapping += 1;
+        } else {
+          status = softnessFor(law, mapping, mass, step_s, previous_s, load_declared, counts,
+                               &binding->computed_fallback, &binding->pending);
+        }
+        /* the boundary with ODE: nothing outside limits.h's ranges is ever written. An accurate mapping's own
+         * softness passed a stricter check already (matched.c's finish: finite, |erp| <= SS_MAX_ERP, cfm in
+         * [SS_MIN_POSITIVE_CFM, SS_MAX_CFM]); what implicit Euler or a hard law gave is checked here. */
+        int checked =
+            mapping != SS_MAPPING_IMPLICIT_EULER && !law->hard && !binding->computed_fallback.to_implicit_euler;
+        if (status == SS_OK && !checked)
+          status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
       }
-      /* the boundary with ODE: nothing outside limits.h's ranges is ever written. An accurate mapping's own
-       * softness passed a stricter check already (matched.c's finish: finite, |erp| <= SS_MAX_ERP, cfm in
-       * [SS_MIN_POSITIVE_CFM, SS_MAX_CFM]); what implicit Euler or a hard law gave is checked here. */
-      int checked = mapping != SS_MAPPING_IMPLICIT_EULER && !law->hard && !binding->computed_fallback.to_implicit_euler;
-      if (status == SS_OK && !checked)
-        status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
       if (status != SS_OK) {
         binding->computed_step_s = NAN;
         return failBinding(status, binding);
