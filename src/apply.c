@@ -291,12 +291,10 @@ static double rowMass(ssRegistry* registry, const JointBinding* binding) {
     return NAN;
   }
   bodies[1] = dJointGetBody(binding->joint, 1);
-  double inverse = 0;
-  for (int side = 0; side < 2; ++side) {
-    if (bodies[side] == 0) continue;
-    ssBodyInverse local;
-    inverse += ssRowInverseMass(bodyInverse(registry, binding->body_slot[side], bodies[side], &local), &row);
-  }
+  ssBodyInverse local; /* for a body the cache does not know: one at a time */
+  double inverse = ssRowInverseMass(bodyInverse(registry, binding->body_slot[0], bodies[0], &local), &row);
+  if (bodies[1] != 0)
+    inverse += ssRowInverseMass(bodyInverse(registry, binding->body_slot[1], bodies[1], &local), &row);
   double mass = inverse > 0 ? 1.0 / inverse : 0;
   return mass > 0 && isfinite(mass) ? mass : NAN;
 }
