@@ -47,7 +47,7 @@
  * are asked for while this one is worked on. */
 enum { kPrefetchAhead = 8 };
 #if defined(__GNUC__)
-#define PREFETCH_ROWS(joints, count, i, lines)                                                \
+#define PREFETCH_ROWS(joints, count, i, lines)                                             \
   do {                                                                                     \
     if ((i) + kPrefetchAhead < (count)) {                                                  \
       const char* ahead = (const char*)&(joints)[(i) + kPrefetchAhead];                    \

@@ -193,7 +193,6 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
   double a00 = I[0], a01 = I[1], a02 = I[2], a10 = I[4], a11 = I[5], a12 = I[6], a20 = I[8], a21 = I[9],
          a22 = I[10];
   const dReal* R = dBodyGetRotation(body); /* rows of 4 */
-  out->principal = 0;
   if (offDiagonalZero(a01, a02, a10, a12, a20, a21)) {
     /* principal axes along the body's (boxes, spheres, capsules, cylinders): I_world⁻¹ = R·diag(1/I)·Rᵀ, kept as
      * ODE's R and 1/I, not multiplied out (ssInverseInertiaAlong: d·I⁻¹d = Σ_k (Rᵀd)_k²/I_k, the same quantity):
@@ -205,7 +204,9 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
     }
     out->principal = 1;
     out->rotation = R;
-    out->inverse_principal[0] = 1.0 / a00, out->inverse_principal[1] = 1.0 / a11, out->inverse_principal[2] = 1.0 / a22;
+    out->inverse_principal[0] = 1.0 / a00;
+    out->inverse_principal[1] = 1.0 / a11;
+    out->inverse_principal[2] = 1.0 / a22;
     return;
   }
   double c0 = a11 * a22 - a12 * a21, c1 = a12 * a20 - a10 * a22, c2 = a10 * a21 - a11 * a20;
