@@ -15,7 +15,8 @@
  *      body_cache_stale. A slot's inverse is the body's for this Apply when its stamp == apply_stamp.
  *      laws[0..law_count) are distinct; joints[i].law_slot is the slot of a law equal to joints[i].law, or -1 (the
  *      table was full; rows_outside_laws counts those). loaded_rows counts the rows with a load.
- *      hot_rows[i] mirrors joints[i]'s joint, writer and law_slot.
+ *      hot_rows[i] mirrors joints[i]'s joint, writer and law_slot, and says whether joints[i] shares the row of
+ *      joints[i - 1] (sharesRow).
  *  - joints[i].written is what ODE holds for the row (NAN after a binding: written at the next Apply), except while
  *    written_by_law: then a row with law_slot >= 0 holds law_written[law_slot] (the by-law pass writes no row's
  *    own); ssApplyMaterializeWritten puts those back before anything reads or moves the rows' own. A row without
@@ -37,6 +38,7 @@
 #include <string.h>
 
 #include "error.h"
+#include "matched_internal.h"
 #include "ode_bounds.h"
 #include "registry_layout.h"
 #include "steadystep/limits.h"
@@ -45,20 +47,20 @@
  * are asked for while this one is worked on. */
 enum { kPrefetchAhead = 8 };
 #if defined(__GNUC__)
-#define PREFETCH_ROWS(registry, i, lines)                                                  \
+#define PREFETCH_ROWS(joints, count, i, lines)                                             \
   do {                                                                                     \
-    if ((i) + kPrefetchAhead < (registry)->joint_count) {                                  \
-      const char* ahead = (const char*)&(registry)->joints[(i) + kPrefetchAhead];          \
+    if ((i) + kPrefetchAhead < (count)) {                                                  \
+      const char* ahead = (const char*)&(joints)[(i) + kPrefetchAhead];                    \
       for (int line = 0; line < (lines); ++line) __builtin_prefetch(ahead + 64 * line, 1); \
     }                                                                                      \
-    if ((i) + kPrefetchAhead / 2 < (registry)->joint_count) {                              \
-      const char* joint = (const char*)(registry)->joints[(i) + kPrefetchAhead / 2].joint; \
+    if ((i) + kPrefetchAhead / 2 < (count)) {                                              \
+      const char* joint = (const char*)(joints)[(i) + kPrefetchAhead / 2].joint;           \
       __builtin_prefetch(joint);                                                           \
       __builtin_prefetch(joint + 64);                                                      \
     }                                                                                      \
   } while (0)
 #else
-#define PREFETCH_ROWS(registry, i, lines) ((void)0)
+#define PREFETCH_ROWS(joints, count, i, lines) ((void)0)
 #endif
 
 /* Prefixes the current message with what failed, so that a caller of Apply learns which binding it was. */
@@ -87,6 +89,17 @@ static ssStatus softnessFor(const ssRowLaw* law, ssMapping mapping, double mass,
   return status;
 }
 
+/* Whether an accurate mapping serves the row as a pure damper (a motor's friction), with its matched softness in
+ * *out: ssRowSoftness's tests for such a row in its order (a mass, c > 0; k = 0 is never above Nyquist; a finite
+ * softness; the static damping's rule), without its general path. Both mappings serve a damper with the matched
+ * softness (row_law.c: its velocity decays by e^(-c·h/m) a step whatever the steps before); a declared load on it
+ * has nothing to correct. 0: the general path decides (out may be written). */
+static int damperServed(const ssRowLaw* law, double mass, double step_s, ssSoftness* out) {
+  return !law->hard && law->spring.stiffness == 0 && mass > 0 && isfinite(mass) && law->spring.damping > 0 &&
+         ssMatchedDamper(law->spring.damping, mass, step_s, out) &&
+         ssDamperKeepsStaticResponse(law->spring.damping, out->cfm);
+}
+
 /* One softness an Apply computed, for the rows with the same law and mass that follow. */
 typedef struct SharedSoftness {
   const ssRowLaw* law;
@@ -113,7 +126,7 @@ static int sharedLaw(const SharedSoftness* shared, const ssRowLaw* law, int law_
  * after it, and stops at an unused one (nothing leaves the table within an Apply). Rows of distinct masses, which
  * never share, pay a few comparisons of the mass; a handful of pairs (laws times the masses of identical links)
  * each find their entry although two of them share a home (one entry a home thrashed: every row computed again). */
-enum { kSharedSize = 16, kSharedProbes = 4 };
+enum { kSharedSize = 16, kSharedProbes = 4, kSharedTrial = 2 * kSharedSize };
 typedef struct SharedTable {
   unsigned char used[kSharedSize];
   SharedSoftness entries[kSharedSize];
@@ -166,6 +179,15 @@ void ssApplyMaterializeWritten(ssRegistry* registry) {
     if (binding->law_slot >= 0) binding->written = registry->law_written[binding->law_slot];
   }
   registry->written_by_law = 0;
+}
+
+/* Whether two bindings drive rows along the same axis of the same joint (a stop and a motor) and have the same mass:
+ * given alike, or measured for both (a hard row measures none, so its NAN is not the other's mass). */
+static int sharesRow(const JointBinding* a, const JointBinding* b) {
+  int a_limit = a->param == SS_PARAM_STOP || a->param == SS_PARAM_MOTOR;
+  int b_limit = b->param == SS_PARAM_STOP || b->param == SS_PARAM_MOTOR;
+  return a->joint == b->joint && a->axis == b->axis && a_limit && b_limit && a->effective_mass == b->effective_mass &&
+         !a->law.hard && !b->law.hard;
 }
 
 static int compareBodyCache(const void* a, const void* b) {
@@ -228,7 +250,8 @@ static void rebuildApplyCache(ssRegistry* registry) {
                                      .set = binding->writer.set,
                                      .erp_number = (int16_t)binding->writer.erp_number,
                                      .cfm_number = (int16_t)binding->writer.cfm_number,
-                                     .law_slot = (int16_t)binding->law_slot};
+                                     .law_slot = (int16_t)binding->law_slot,
+                                     .shares_previous_row = i > 0 && sharesRow(&registry->joints[i - 1], binding)};
   }
 }
 
@@ -257,15 +280,21 @@ static const ssBodyInverse* bodyInverse(ssRegistry* registry, int slot, dBodyID 
 static double rowMass(ssRegistry* registry, const JointBinding* binding) {
   dBodyID bodies[2] = {dJointGetBody(binding->joint, 0), 0};
   ssRowGeometry row;
-  if (bodies[0] == 0 || !ssJointRowGeometry(binding->joint, binding->joint_type, binding->param, binding->axis, &row))
+  if (bodies[0] == 0) return NAN;
+  if (binding->joint_type == dJointTypeHinge) { /* the commonest row, read directly: what ssJointRowGeometry reads */
+    dVector3 axis;
+    dJointGetHingeAxis(binding->joint, axis);
+    row.direction[0] = axis[0], row.direction[1] = axis[1], row.direction[2] = axis[2];
+    row.angular = 1;
+    row.has_point = 0;
+  } else if (!ssJointRowGeometry(binding->joint, binding->joint_type, binding->param, binding->axis, &row)) {
     return NAN;
-  bodies[1] = dJointGetBody(binding->joint, 1);
-  double inverse = 0;
-  for (int side = 0; side < 2; ++side) {
-    if (bodies[side] == 0) continue;
-    ssBodyInverse local;
-    inverse += ssRowInverseMass(bodyInverse(registry, binding->body_slot[side], bodies[side], &local), &row);
   }
+  bodies[1] = dJointGetBody(binding->joint, 1);
+  ssBodyInverse local; /* for a body the cache does not know: one at a time */
+  double inverse = ssRowInverseMass(bodyInverse(registry, binding->body_slot[0], bodies[0], &local), &row);
+  if (bodies[1] != 0)
+    inverse += ssRowInverseMass(bodyInverse(registry, binding->body_slot[1], bodies[1], &local), &row);
   double mass = inverse > 0 ? 1.0 / inverse : 0;
   return mass > 0 && isfinite(mass) ? mass : NAN;
 }
@@ -278,15 +307,6 @@ static double bindingMass(ssRegistry* registry, const JointBinding* binding, con
   if (binding->effective_mass > 0) return binding->effective_mass;
   if (law->hard) return NAN;
   return measure ? rowMass(registry, binding) : binding->mass;
-}
-
-/* Whether two bindings drive rows along the same axis of the same joint (a stop and a motor) and have the same mass:
- * given alike, or measured for both (a hard row measures none, so its NAN is not the other's mass). */
-static int sharesRow(const JointBinding* a, const JointBinding* b) {
-  int a_limit = a->param == SS_PARAM_STOP || a->param == SS_PARAM_MOTOR;
-  int b_limit = b->param == SS_PARAM_STOP || b->param == SS_PARAM_MOTOR;
-  return a->joint == b->joint && a->axis == b->axis && a_limit && b_limit && a->effective_mass == b->effective_mass &&
-         !a->law.hard && !b->law.hard;
 }
 
 /* Whether writing b over a would change nothing in ODE (as it stores them: in float, doubles that round alike are
@@ -329,61 +349,87 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
    * each distinct pair is computed once and shared. */
   SharedTable shared;
   memset(shared.used, 0, sizeof shared.used);
+  /* Rows of distinct masses (a ragdoll, links of their own masses) never share: after kSharedTrial computed rows
+   * that found fewer than one in four shared, the rest of this Apply computes every row without the probes (the
+   * softness is a pure function of law and mass, so the values are the same either way). */
+  int sharing = !(registry->disabled_caches & SS_CACHE_SHARED), shared_hits = 0, shared_computed = 0;
   double last_mass = NAN;
   LawFallbacks fallbacks;
   memset(fallbacks.known, 0, sizeof fallbacks.known);
-  for (int i = 0; i < registry->joint_count; ++i) {
-    JointBinding* binding = &registry->joints[i];
-    PREFETCH_ROWS(registry, i, 2);
+  const int same_axis = !(registry->disabled_caches & SS_CACHE_SAME_AXIS);
+  const int reuse = mapping != SS_MAPPING_IMPLICIT_EULER && !(registry->disabled_caches & SS_CACHE_REUSE);
+  const int sure_fallback = !(registry->disabled_caches & SS_CACHE_SURE_FALLBACK);
+  const int any_load = registry->loaded_rows > 0;
+  /* the rows and their count in locals: the calls into ODE could write *registry for all the compiler knows */
+  JointBinding* const joints = registry->joints;
+  const HotRow* const hot = registry->hot_rows;
+  const int count = registry->joint_count;
+  for (int i = 0; i < count; ++i) {
+    JointBinding* binding = &joints[i];
+    PREFETCH_ROWS(joints, count, i, 2);
     const ssRowLaw* law = binding->law_slot >= 0 ? &registry->laws[binding->law_slot] : &binding->law;
-    const JointBinding* before = i > 0 ? &registry->joints[i - 1] : NULL;
     /* a stop and a motor on one axis move the same mass: computed once */
-    int same_row = before != NULL && !(registry->disabled_caches & SS_CACHE_SAME_AXIS) && sharesRow(before, binding);
+    int same_row = same_axis && hot[i].shares_previous_row;
     double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
     last_mass = mass;
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
      * (constant steps, masses that a motion leaves unchanged): equal inputs, equal softness */
-    if (mapping != SS_MAPPING_IMPLICIT_EULER && !(registry->disabled_caches & SS_CACHE_REUSE) &&
-        binding->computed_mapping == mapping && binding->mass == mass && binding->computed_step_s == step_s &&
-        binding->computed_previous_s == previous_s) {
+    if (reuse && binding->computed_step_s == step_s && binding->mass == mass && binding->computed_mapping == mapping &&
+        binding->computed_previous_s == previous_s) { /* the step first: under varying steps it differs at once */
       countRow(&binding->computed_fallback, counts);
       *unwritten += !sameWrite(binding->writer.erp_number, &binding->pending, &binding->written);
       continue;
     }
     binding->mass = mass;
+    /* a row's load lies on a line of its own that the rows of a program without loads leave unread */
+    const int load_declared = any_load && binding->load != 0;
     int any_mass = mapping == SS_MAPPING_IMPLICIT_EULER || law->hard;
-    const SharedSoftness* hit;
+    const SharedSoftness* hit = NULL;
     unsigned slot = 0;
-    /* a row the rule surely hands to implicit Euler gets the law's implicit-Euler softness, without the accurate
-     * arithmetic whose only use would be to decide so (a declared load keeps the accurate softness instead) */
-    if (!any_mass && !(registry->disabled_caches & SS_CACHE_SURE_FALLBACK) &&
-        !(binding->load != 0 && law->spring.stiffness > 0) && ssSurelyFailsStaticResponse(law->spring, mass, step_s)) {
-      status = lawFallback(law, binding->law_slot, step_s, &fallbacks, &binding->pending);
-      if (status != SS_OK) {
-        binding->computed_step_s = NAN;
-        return failBinding(status, binding);
-      }
-      binding->computed_fallback = (ssRowFallback){0, 1};
-      countRow(&binding->computed_fallback, counts);
-    } else if ((slot = sharedSlot(law, binding->law_slot, any_mass, mass, binding->load != 0),
-                hit = findShared(&shared, slot, law, binding->law_slot, any_mass, mass, binding->load != 0)) != NULL) {
+    if (sharing) {
+      slot = sharedSlot(law, binding->law_slot, any_mass, mass, load_declared);
+      hit = findShared(&shared, slot, law, binding->law_slot, any_mass, mass, load_declared);
+    }
+    if (hit != NULL) {
       binding->pending = hit->softness;
       binding->computed_fallback = hit->fallback;
       countRow(&hit->fallback, counts);
+      shared_hits += 1;
     } else {
-      status = softnessFor(law, mapping, mass, step_s, previous_s, binding->load != 0, counts,
-                           &binding->computed_fallback, &binding->pending);
-      /* the boundary with ODE: nothing outside limits.h's ranges is ever written */
-      if (status == SS_OK) status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
+      if (!any_mass && sure_fallback && !(load_declared && law->spring.stiffness > 0) &&
+          ssSurelyFailsStaticResponse(law->spring, mass, step_s)) {
+        /* a row the rule surely hands to implicit Euler gets the law's implicit-Euler softness (checked), without
+         * the accurate arithmetic whose only use would be to decide so (a declared load keeps the accurate
+         * softness instead): what ssRowSoftness gives it, so it is shared like any other */
+        status = lawFallback(law, binding->law_slot, step_s, &fallbacks, &binding->pending);
+        binding->computed_fallback = (ssRowFallback){0, 1};
+        countRow(&binding->computed_fallback, counts);
+      } else {
+        if (mapping != SS_MAPPING_IMPLICIT_EULER && damperServed(law, mass, step_s, &binding->pending)) {
+          binding->computed_fallback = (ssRowFallback){0, 0};
+          counts->rows.by_mapping += 1;
+        } else {
+          status = softnessFor(law, mapping, mass, step_s, previous_s, load_declared, counts,
+                               &binding->computed_fallback, &binding->pending);
+        }
+        /* the boundary with ODE: nothing outside limits.h's ranges is ever written. An accurate mapping's own
+         * softness passed a stricter check already (matched.c's finish: finite, |erp| <= SS_MAX_ERP, cfm in
+         * [SS_MIN_POSITIVE_CFM, SS_MAX_CFM]); what implicit Euler or a hard law gave is checked here. */
+        int checked =
+            mapping != SS_MAPPING_IMPLICIT_EULER && !law->hard && !binding->computed_fallback.to_implicit_euler;
+        if (status == SS_OK && !checked)
+          status = ssCheckSoftnessForOde("softness", binding->pending.erp, binding->pending.cfm);
+      }
       if (status != SS_OK) {
         binding->computed_step_s = NAN;
         return failBinding(status, binding);
       }
-      if (!(registry->disabled_caches & SS_CACHE_SHARED)) {
+      if (sharing) {
         slot = sharedFreeSlot(&shared, slot);
-        shared.entries[slot] = (SharedSoftness){law, binding->law_slot, mass, binding->load != 0, binding->pending,
+        shared.entries[slot] = (SharedSoftness){law, binding->law_slot, mass, load_declared, binding->pending,
                                                 binding->computed_fallback};
         shared.used[slot] = 1;
+        if (++shared_computed >= kSharedTrial && 4 * shared_hits < shared_computed) sharing = 0;
       }
     }
     *unwritten += !sameWrite(binding->writer.erp_number, &binding->pending, &binding->written);
@@ -427,9 +473,11 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
  * written. */
 static int writeRows(ssRegistry* registry, ssMapping mapping) {
   int writes = 0;
-  for (int i = 0; i < registry->joint_count; ++i) {
-    JointBinding* binding = &registry->joints[i];
-    PREFETCH_ROWS(registry, i, 2);
+  JointBinding* const joints = registry->joints;
+  const int count = registry->joint_count;
+  for (int i = 0; i < count; ++i) {
+    JointBinding* binding = &joints[i];
+    /* nothing prefetched: the first pass has just read these lines of the bindings and of the joints */
     if (sameWrite(binding->writer.erp_number, &binding->pending, &binding->written)) continue;
     ssRowWrite(&binding->writer, binding->joint, binding->pending.erp, binding->pending.cfm);
     binding->written = binding->pending;

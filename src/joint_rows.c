@@ -179,6 +179,7 @@ static int offDiagonalZero(double a, double b, double c, double d, double e, dou
 void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
   /* every field written without memset, whose startup costs more than the rest on the registry's path */
   out->dynamic = isDynamic(body);
+  out->principal = 0;
   if (!out->dynamic) {
     out->inverse_mass = 0;
     for (int i = 0; i < 9; ++i) out->inverse_inertia[i] = 0;
@@ -196,28 +197,19 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
          a22 = I[10];
   const dReal* R = dBodyGetRotation(body); /* rows of 4 */
   if (offDiagonalZero(a01, a02, a10, a12, a20, a21)) {
-    /* principal axes along the body's (boxes, spheres, capsules, cylinders): R·diag(1/I)·Rᵀ, symmetric, in half the
-     * products of the general case; entry (i, j) = (R[i][0]/I0)·R[j][0] + (R[i][1]/I1)·R[j][1]
-     * + (R[i][2]/I2)·R[j][2] in that order, each R[i][k]/I_k computed once (the registry asks this of every body
-     * at every Apply) */
+    /* principal axes along the body's (boxes, spheres, capsules, cylinders): I_world⁻¹ = R·diag(1/I)·Rᵀ, kept as
+     * ODE's R and 1/I, not multiplied out (ssInverseInertiaAlong: d·I⁻¹d = Σ_k (Rᵀd)_k²/I_k, the same quantity):
+     * the registry asks this of every body at every Apply of an accurate mapping, and most bodies serve one or two
+     * rows, whose few products cost less than the matrix's */
     if (!(a00 > 0 && a11 > 0 && a22 > 0)) {
       for (int i = 0; i < 9; ++i) out->inverse_inertia[i] = 0;
       return;
     }
-    double inverse[3] = {1.0 / a00, 1.0 / a11, 1.0 / a22};
-    double scaled[3][3]; /* R[i][k]·(1/I_k) */
-    for (int i = 0; i < 3; ++i)
-      for (int k = 0; k < 3; ++k) scaled[i][k] = R[4 * i + k] * inverse[k];
-    double* M = out->inverse_inertia;
-#define SS_PRINCIPAL_ENTRY(i, j) \
-  (scaled[i][0] * R[4 * (j)] + scaled[i][1] * R[4 * (j) + 1] + scaled[i][2] * R[4 * (j) + 2])
-    M[0] = SS_PRINCIPAL_ENTRY(0, 0);
-    M[1] = M[3] = SS_PRINCIPAL_ENTRY(0, 1);
-    M[2] = M[6] = SS_PRINCIPAL_ENTRY(0, 2);
-    M[4] = SS_PRINCIPAL_ENTRY(1, 1);
-    M[5] = M[7] = SS_PRINCIPAL_ENTRY(1, 2);
-    M[8] = SS_PRINCIPAL_ENTRY(2, 2);
-#undef SS_PRINCIPAL_ENTRY
+    out->principal = 1;
+    out->rotation = R;
+    out->inverse_principal[0] = 1.0 / a00;
+    out->inverse_principal[1] = 1.0 / a11;
+    out->inverse_principal[2] = 1.0 / a22;
     return;
   }
   double c0 = a11 * a22 - a12 * a21, c1 = a12 * a20 - a10 * a22, c2 = a10 * a21 - a11 * a20;

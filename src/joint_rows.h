@@ -41,13 +41,23 @@ void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* e
 int ssJointLimitAxisCount(dJointID joint);
 
 /* What a body opposes to a row's motion, read once per step and shared by all the rows on it: inverse mass (1/kg),
- * world-frame inverse inertia (1/(kg·m²), row-major 3x3) and centre (m). All 0 for the static world (body 0) and
- * kinematic bodies (dynamic 0); the inertia part is 0 for an inertia that is not positive definite. */
+ * inverse inertia and centre (m). The inverse inertia is, for a body whose inertia is diagonal in its own frame
+ * (principal 1: boxes, spheres, capsules, cylinders), ODE's rotation R of the body (rows of 4; valid until the body
+ * moves) and the inverses of its principal moments (1/(kg·m²)): I_world⁻¹ = R·diag(inverse_principal)·Rᵀ;
+ * otherwise (principal 0) I_world⁻¹ itself (row-major 3x3). All 0 for the static world (body 0) and kinematic
+ * bodies (dynamic 0); the inertia part is 0 for an inertia that is not positive definite. */
 typedef struct ssBodyInverse {
-  double inverse_mass;
-  double inverse_inertia[9];
-  double position[3];
   int dynamic;
+  int principal;
+  double inverse_mass;
+  union {
+    double inverse_inertia[9]; /* principal 0 */
+    struct {
+      const dReal* rotation;
+      double inverse_principal[3];
+    }; /* principal 1: with the fields above, in the first cache line of the registry's BodyCache */
+  };
+  double position[3];
 } ssBodyInverse;
 
 void ssBodyInverseOf(dBodyID body, ssBodyInverse* out);
@@ -66,8 +76,18 @@ typedef struct ssRowGeometry {
  * fewer axes now, or the type's mass is not defined (transmission). */
 int ssJointRowGeometry(dJointID joint, int type, ssJointParam param, int axis, ssRowGeometry* out);
 
-/* d·I⁻¹d in the world frame. */
+/* d·I⁻¹d in the world frame. For principal axes, with b = Rᵀd (d in the body's frame), Σ_k b_k²/I_k: that is
+ * dᵀ·R·diag(1/I)·Rᵀ·d itself, for any R, in exact arithmetic (only the roundings differ from forming the matrix). */
 static inline double ssInverseInertiaAlong(const ssBodyInverse* body, const double* d) {
+  if (body->principal) {
+    const dReal* R = body->rotation;
+    const double d0 = d[0], d1 = d[1], d2 = d[2];
+    const double b0 = R[0] * d0 + R[4] * d1 + R[8] * d2;
+    const double b1 = R[1] * d0 + R[5] * d1 + R[9] * d2;
+    const double b2 = R[2] * d0 + R[6] * d1 + R[10] * d2;
+    return b0 * b0 * body->inverse_principal[0] + b1 * b1 * body->inverse_principal[1] +
+           b2 * b2 * body->inverse_principal[2];
+  }
   const double* M = body->inverse_inertia;
   return d[0] * (M[0] * d[0] + M[1] * d[1] + M[2] * d[2]) + d[1] * (M[3] * d[0] + M[4] * d[1] + M[5] * d[2]) +
          d[2] * (M[6] * d[0] + M[7] * d[1] + M[8] * d[2]);

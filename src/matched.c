@@ -78,6 +78,7 @@ static ssStatus finish(double a, double erp, double step_s, double mass, int qui
  * terms are computed without cancellation, so erp keeps its digits at short steps (where it is O(h²)·k/c and the
  * closed form subtracts numbers near 1), and 1 - P = (1 - d)(1 + d) needs no second exponential. */
 static ssStatus matchedSoftness(ssSpring spring, double mass, double step_s, int quiet, ssSoftness* out) {
+  if (spring.stiffness == 0 && ssMatchedDamper(spring.damping, mass, step_s, out)) return SS_OK;
   double sigma = spring.damping / (2.0 * mass);
   double sigma_h = sigma * step_s;
   double one_minus_d = -expm1(-sigma_h);

@@ -50,6 +50,7 @@ typedef struct HotRow {
   ssParamSetter set; /* the row's writer: NULL for a row without softness */
   int16_t erp_number, cfm_number; /* ODE's parameter numbers (below 0x400); erp_number -1: none */
   int16_t law_slot;
+  uint8_t shares_previous_row; /* sharesRow(the binding before, this one): the general pass reuses its mass */
 } HotRow;
 
 /* A body's inverse mass and inertia, computed at most once per Apply for all the rows on it. */

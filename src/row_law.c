@@ -98,7 +98,7 @@ int ssKeepsStaticResponse(ssSpring spring, ssSoftness softness, double step_s) {
     double static_stiffness = softness.erp / (step_s * softness.cfm);
     return fabs(spring.stiffness / static_stiffness - 1.0) <= SS_STATIC_RESPONSE_TOLERANCE;
   }
-  return fabs(spring.damping * softness.cfm - 1.0) <= SS_STATIC_RESPONSE_TOLERANCE;
+  return ssDamperKeepsStaticResponse(spring.damping, softness.cfm);
 }
 
 ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, double step_s, double previous_step_s,

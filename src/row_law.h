@@ -4,6 +4,8 @@
 #ifndef STEADYSTEP_ROW_LAW_H
 #define STEADYSTEP_ROW_LAW_H
 
+#include <math.h>
+
 #include "steadystep/spring.h"
 
 typedef struct ssRowLaw {
@@ -64,6 +66,12 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
  * instead of F/c). The implicit-Euler mapping keeps both exactly (k' = k, 1/cfm = h·k + c). */
 int ssKeepsStaticResponse(ssSpring spring, ssSoftness softness, double step_s);
 
+/* ssKeepsStaticResponse for a pure damper (k = 0) of damping c (N·s/m): its static damping 1/cfm against c. Inline:
+ * Apply asks it of every motor row an accurate mapping serves. */
+static inline int ssDamperKeepsStaticResponse(double damping, double cfm) {
+  return fabs(damping * cfm - 1.0) <= SS_STATIC_RESPONSE_TOLERANCE;
+}
+
 /* Whether ssRowSoftness would hand the row to implicit Euler under an accurate mapping for its static response
  * alone, decided without the matched softness' arithmetic (no exp, sqrt or sin): 1 only when the matched
  * softness of (spring, mass, step_s), if it is finite, certainly fails ssKeepsStaticResponse, by bounds on the exact
@@ -90,15 +98,20 @@ static inline int ssSurelyFailsStaticResponse(ssSpring spring, double mass, doub
   double w = kh2_over_m - x * x;
   if (!(x >= 1e-8 && x <= 1.0 && w >= 0.0 && w <= 4.0)) return 0;
   double x2 = x * x;
+  const double margin = 1e-6; /* against this function's roundings and those of the softness and its check */
+  const double upper = kh2_over_m * ((1.0 + margin) / (1.0 - SS_STATIC_RESPONSE_TOLERANCE));
+  /* first a cruder lower bound of the numerator, which decides most rows the rule hands on (far too stiff: the
+   * static stiffness grows as 1 + σh) in a third of the arithmetic: (e^x - 1)² >= (x + x²/2)² >= x² + x³,
+   * e^x >= 1 + x, 1 - cos √w >= w/2 - w²/24 >= 0 (w <= 4). It is a lower bound as n_low is (and at most n_low):
+   * a 1 here has the same guarantee, and is a row the full bounds below would hand on too. */
+  if (x2 + x2 * x + (1.0 + x) * (w - w * w * (1.0 / 12.0)) > upper) return 1;
   double e_low = x * (1.0 + x * (0.5 + x * (1.0 / 6.0 + x * (1.0 / 24.0 + x * (1.0 / 120.0)))));
   double e_high = e_low + x2 * x2 * x2 * (1.0 / 240.0);
   double c_high = w * (0.5 - w * (1.0 / 24.0 - w * (1.0 / 720.0)));
   double c_low = c_high - w * w * w * w * (1.0 / 40320.0);
   double n_low = e_low * e_low + 2.0 * (1.0 + e_low) * c_low;
   double n_high = e_high * e_high + 2.0 * (1.0 + e_high) * c_high;
-  const double margin = 1e-6; /* against this function's roundings and those of the softness and its check */
-  return n_high < kh2_over_m * ((1.0 - margin) / (1.0 + SS_STATIC_RESPONSE_TOLERANCE)) ||
-         n_low > kh2_over_m * ((1.0 + margin) / (1.0 - SS_STATIC_RESPONSE_TOLERANCE));
+  return n_high < kh2_over_m * ((1.0 - margin) / (1.0 + SS_STATIC_RESPONSE_TOLERANCE)) || n_low > upper;
 }
 
 /* w·h > π, i.e. k·h² > π²·m: the spring's natural frequency is above half the step rate. False for a NAN

@@ -308,6 +308,60 @@ TEST_F(RegistryTest, EffectiveMassOfLinearAndAngularRows) {
   EXPECT_NE(std::string(ssLastError()).find("no dynamic body"), std::string::npos) << ssLastError();
 }
 
+// Two boxes of three different principal moments, rotated about skew axes, on a hinge about a skew axis: the mass
+// of the hinge's rows is 1/(a·I1⁻¹a + a·I2⁻¹a) with each world-frame inertia formed by ODE itself (dMassRotate:
+// R·I·Rᵀ) and solved here by Cramer's rule, independently of how the library computes it.
+TEST_F(RegistryTest, EffectiveMassOfRotatedAnisotropicBodies) {
+  dBodyID bodies[2] = {a, b};
+  const double sides[2][3] = {{0.4, 0.1, 0.2}, {0.05, 0.3, 0.15}};
+  const double axes[2][4] = {{1, 2, 3, 0.7}, {-2, 0.5, 1, 2.1}};
+  dMass masses[2];
+  for (int i = 0; i < 2; ++i) {
+    dMassSetBoxTotal(&masses[i], 2.0 + i, sides[i][0], sides[i][1], sides[i][2]);
+    dBodySetMass(bodies[i], &masses[i]);
+    dMatrix3 rotation;
+    dRFromAxisAndAngle(rotation, axes[i][0], axes[i][1], axes[i][2], axes[i][3]);
+    dBodySetRotation(bodies[i], rotation);
+    dMassRotate(&masses[i], dBodyGetRotation(bodies[i]));  // the world-frame inertia, about the centre
+  }
+  dJointID hinge = dJointCreateHinge(world, 0);
+  dJointAttach(hinge, a, b);
+  dJointSetHingeAxis(hinge, 0.3, -0.2, 0.9);
+  dVector3 axis;
+  dJointGetHingeAxis(hinge, axis);
+  double inverse = 0;
+  for (const dMass& mass : masses) {
+    auto I = [&](int row, int column) { return static_cast<double>(mass.I[4 * row + column]); };
+    auto det = [&](const double c0[3], const double c1[3], const double c2[3]) {
+      return c0[0] * (c1[1] * c2[2] - c1[2] * c2[1]) - c1[0] * (c0[1] * c2[2] - c0[2] * c2[1]) +
+             c2[0] * (c0[1] * c1[2] - c0[2] * c1[1]);
+    };
+    const double col[3][3] = {{I(0, 0), I(1, 0), I(2, 0)}, {I(0, 1), I(1, 1), I(2, 1)}, {I(0, 2), I(1, 2), I(2, 2)}};
+    const double d[3] = {axis[0], axis[1], axis[2]};
+    const double whole = det(col[0], col[1], col[2]);
+    const double x[3] = {det(d, col[1], col[2]) / whole, det(col[0], d, col[2]) / whole,
+                         det(col[0], col[1], d) / whole};
+    inverse += d[0] * x[0] + d[1] * x[1] + d[2] * x[2];  // a·I⁻¹a
+  }
+  double mass = 0;
+  ASSERT_EQ(ssJointEffectiveMass(hinge, SS_PARAM_STOP, 1, &mass), SS_OK);
+  EXPECT_NEAR(mass, 1.0 / inverse, ReadBackTolerance(1e-12, 1.0 / inverse));
+  // the registry's own pass measures the same: a spring that matched serves at this mass (c·h/2m = 0.01,
+  // k·h²/m = 0.1) is written with matched's softness for it
+  const double step_s = 1.0 / 60;
+  const ssSpring spring = {0.1 * mass / (step_s * step_s), 0.02 * mass / step_s};
+  ssRegistry* registry = ssRegistry_Create(world);
+  ASSERT_EQ(ssRegistry_BindJoint(registry, hinge, SS_PARAM_STOP, 1, spring, 0), SS_OK);
+  ssApplyReport report;
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_MATCHED, step_s, 0, &report), SS_OK);
+  EXPECT_EQ(report.rows.by_mapping, 1);
+  ssSoftness expected;
+  ASSERT_EQ(ssMatchedSoftness(spring, mass, step_s, &expected), SS_OK);
+  EXPECT_NEAR(dJointGetHingeParam(hinge, dParamStopERP), expected.erp, ReadBackTolerance(1e-12, expected.erp));
+  EXPECT_NEAR(dJointGetHingeParam(hinge, dParamStopCFM), expected.cfm, ReadBackTolerance(1e-12, expected.cfm));
+  ssRegistry_Destroy(registry);
+}
+
 TEST_F(RegistryTest, UnsupportedBindingsAreRefusedAtBindTime) {
   ssRegistry* registry = ssRegistry_Create(world);
   dJointID hinge = dJointCreateHinge(world, 0);
