@@ -40,12 +40,13 @@ typedef struct JointBinding {
 
 /* What implicit Euler's by-law pass reads of a row, packed apart from the bindings (rebuilt with the Apply cache):
  * after an ODE step has evicted the registry's arrays, it streams through 32 bytes a row instead of a binding's
- * first line. mass mirrors the binding's. */
+ * first line. Only rows with a writer and a law in the table have one, grouped by law (law_rows), so that the rows
+ * of a law whose softness did not change (a damper's, k = 0, at any step) are passed over without being read. */
 typedef struct HotRow {
   dJointID joint;
-  ssParamSetter set; /* the row's writer: NULL for a row without softness */
+  ssParamSetter set;              /* the row's writer */
   int16_t erp_number, cfm_number; /* ODE's parameter numbers (below 0x400); erp_number -1: none */
-  int16_t law_slot;
+  int binding;                    /* the row's position in joints */
 } HotRow;
 
 /* A body's inverse mass and inertia, computed at most once per Apply for all the rows on it. */
@@ -90,6 +91,7 @@ struct ssRegistry {
   /* the distinct laws of the bindings (programs bind many rows to a few springs), rebuilt with the body cache */
   ssRowLaw laws[kLawTableSize];
   int law_count;
+  int law_rows[kLawTableSize + 1]; /* hot_rows[law_rows[j] .. law_rows[j + 1]) are law j's rows with a writer */
   int rows_outside_laws; /* bindings whose law did not fit in the table */
   /* after a by-law pass, every row in the law table holds its law's softness in ODE: law_written stands for the
    * rows' written until the other passes (or a rebinding) need theirs back (materializeWritten) */
