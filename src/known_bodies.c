@@ -412,24 +412,6 @@ static int startBody(ssKnownBodies* known, int k, double max_speed2, double max_
   return 1;
 }
 
-/* One body at the frame's start, with its prefetches for the one kPrefetchAhead after it (prefetch): 0 when its first
- * joint changed (*joints_changed) or its state or forces fail the check. */
-static int startBodyAt(ssKnownBodies* known, int k, int prefetch, double max_speed2, double max_spin2,
-                       int* joints_changed) {
-  if (prefetch) {
-    const ssBodyValues* ahead = &known->values[k + kPrefetchAhead];
-    prefetchJoints(known, k + kPrefetchAhead);
-    prefetchState(ahead);
-    __builtin_prefetch(ahead->force);
-    __builtin_prefetch(ahead->torque);
-  }
-  if (jointsChangedAt(known, k)) {
-    *joints_changed = 1;
-    return 0;
-  }
-  return startBody(known, k, max_speed2, max_spin2);
-}
-
 ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBodyID* failed, int* joints_changed) {
   const double max_speed2 = bounds->max_speed * bounds->max_speed;
   const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
@@ -438,11 +420,21 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBo
   for (int p = 0; p < known->pushed_count; ++p) known->bodies[known->pushed[p]].pushed = 0;
   known->pushed_count = 0;
   const int count = known->count, until = prefetchUntil(count);
-  int k = 0;
-  while (k < until && startBodyAt(known, k, 1, max_speed2, max_spin2, joints_changed)) ++k;
-  if (k == until)
-    while (k < count && startBodyAt(known, k, 0, max_speed2, max_spin2, joints_changed)) ++k;
-  if (k == count || *joints_changed) return SS_OK;
-  *failed = known->ids[k];
-  return describe(known->ids[k], bounds, "before the frame");
+  for (int k = 0; k < count; ++k) { /* one loop: startBody inlined once */
+    if (k < until) {
+      const ssBodyValues* ahead = &known->values[k + kPrefetchAhead];
+      prefetchJoints(known, k + kPrefetchAhead);
+      prefetchState(ahead);
+      __builtin_prefetch(ahead->force);
+      __builtin_prefetch(ahead->torque);
+    }
+    if (jointsChangedAt(known, k)) {
+      *joints_changed = 1;
+      return SS_OK;
+    }
+    if (startBody(known, k, max_speed2, max_spin2)) continue;
+    *failed = known->ids[k];
+    return describe(known->ids[k], bounds, "before the frame");
+  }
+  return SS_OK;
 }
