@@ -514,8 +514,8 @@ static int writeLawRowsWithErp(const HotRow* from, const HotRow* end, const HotR
  * Returns the rows written. */
 static int writeRowsByLaw(ssRegistry* registry, const ssSoftness* softness) {
   int writes = 0;
-  const HotRow* hot = registry->hot_rows;
-  const HotRow* hot_end = hot + registry->law_rows[registry->law_count];
+  const HotRow* hot = registry->hot_rows; /* NULL before any binding: no law then */
+  const HotRow* hot_end = registry->law_count > 0 ? hot + registry->law_rows[registry->law_count] : hot;
   for (int j = 0; j < registry->law_count; ++j) {
     const HotRow *from = hot + registry->law_rows[j], *end = hot + registry->law_rows[j + 1];
     if (!registry->written_by_law) { /* each row holds its own written */
