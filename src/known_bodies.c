@@ -199,8 +199,8 @@ static int firstJointChanged(dJointID first, dJointID listed) {
  * or the program's frame, and the loads of several bodies then overlap instead of waiting one after the other. */
 enum { kPrefetchAhead = 8, kPrefetchFrom = 256 };
 
-/* Up to where a pass over count bodies asks for the body kPrefetchAhead ahead: none for a list that stays in cache.
- * The bodies from there on are done by the same pass without asking (no test a body). */
+/* Up to which body a pass over count bodies asks for the one kPrefetchAhead ahead: none for a list that stays in
+ * cache. */
 static int prefetchUntil(int count) { return count >= kPrefetchFrom ? count - kPrefetchAhead : 0; }
 
 /* The body and the head of its first joint (where ODE keeps its joint list): what dBodyGetJoint reads. */
@@ -215,17 +215,12 @@ static int jointsChangedAt(const ssKnownBodies* known, int k) {
 }
 
 int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body) {
-  const int count = known->count, until = prefetchUntil(count);
-  int k = 0;
-  for (; k < until; ++k) {
-    prefetchJoints(known, k + kPrefetchAhead);
-    if (jointsChangedAt(known, k)) break;
-  }
-  if (k == until)
-    while (k < count && !jointsChangedAt(known, k)) ++k;
-  if (k == count) return 0;
-  if (body != NULL) *body = known->ids[k];
-  return 1;
+  for (int k = 0; k < known->count; ++k)
+    if (jointsChangedAt(known, k)) {
+      if (body != NULL) *body = known->ids[k];
+      return 1;
+    }
+  return 0;
 }
 
 void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces) {
@@ -355,20 +350,10 @@ ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, co
   const ssBodyValues* values = known->values;
   /* the whole list first, with no branch a body (the usual case: all pass); the first failure is found after */
   int all = 1;
-  const int count = known->count, until = prefetchUntil(count);
-  int k = 0;
-  if (bounds->forces) {
-    for (; k < until; ++k) {
-      prefetchState(&values[k + kPrefetchAhead]);
-      all &= stateWithin(&values[k], max_speed2, max_spin2) & forcesWithin(&values[k]);
-    }
-    for (; k < count; ++k) all &= stateWithin(&values[k], max_speed2, max_spin2) & forcesWithin(&values[k]);
-  } else {
-    for (; k < until; ++k) {
-      prefetchState(&values[k + kPrefetchAhead]);
-      all &= stateWithin(&values[k], max_speed2, max_spin2);
-    }
-    for (; k < count; ++k) all &= stateWithin(&values[k], max_speed2, max_spin2);
+  const int count = known->count, until = prefetchUntil(count), forces = bounds->forces;
+  for (int k = 0; k < count; ++k) {
+    if (k < until) prefetchState(&values[k + kPrefetchAhead]);
+    all &= stateWithin(&values[k], max_speed2, max_spin2) & (!forces || forcesWithin(&values[k]));
   }
   char named[64];
   for (int k = 0; !all && k < known->count; ++k) {
