@@ -480,28 +480,18 @@ static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* s
   return SS_OK;
 }
 
-/* Law j's rows, from..end of the hot rows, written with its softness s: each row's erp where it has one, and its
- * cfm. Returns the rows written. */
-static int writeLawRows(const HotRow* from, const HotRow* end, const HotRow* hot_end, ssSoftness s) {
+/* A law's rows, from..end of the hot rows, written with its softness s: each row's erp where it has one, and its
+ * cfm; with erp_rows_only (only the law's erp changed) only the rows that hold an erp (a motor's row holds only its
+ * cfm). Returns the rows written. */
+static int writeLawRows(const HotRow* from, const HotRow* end, const HotRow* hot_end, ssSoftness s,
+                        int erp_rows_only) {
+  int writes = 0;
   for (const HotRow* row = from; row < end; ++row) {
+    if (erp_rows_only && row->erp_number < 0) continue;
 #if defined(__GNUC__)
     if (row + kPrefetchAhead / 2 < hot_end) __builtin_prefetch(row[kPrefetchAhead / 2].joint);
 #endif
     if (row->erp_number >= 0) row->set(row->joint, row->erp_number, s.erp);
-    row->set(row->joint, row->cfm_number, s.cfm);
-  }
-  return (int)(end - from);
-}
-
-/* As writeLawRows for the rows with an erp only (a motor's row holds only its cfm). */
-static int writeLawRowsWithErp(const HotRow* from, const HotRow* end, const HotRow* hot_end, ssSoftness s) {
-  int writes = 0;
-  for (const HotRow* row = from; row < end; ++row) {
-    if (row->erp_number < 0) continue;
-#if defined(__GNUC__)
-    if (row + kPrefetchAhead / 2 < hot_end) __builtin_prefetch(row[kPrefetchAhead / 2].joint);
-#endif
-    row->set(row->joint, row->erp_number, s.erp);
     row->set(row->joint, row->cfm_number, s.cfm);
     writes += 1;
   }
@@ -526,9 +516,9 @@ static int writeRowsByLaw(ssRegistry* registry, const ssSoftness* softness) {
         writes += 1;
       }
     } else if (!ssSameInOde(softness[j].cfm, registry->law_written[j].cfm)) {
-      writes += writeLawRows(from, end, hot_end, softness[j]);
+      writes += writeLawRows(from, end, hot_end, softness[j], 0);
     } else if (!ssSameInOde(softness[j].erp, registry->law_written[j].erp)) {
-      writes += writeLawRowsWithErp(from, end, hot_end, softness[j]);
+      writes += writeLawRows(from, end, hot_end, softness[j], 1);
     }
   }
   for (int j = 0; j < registry->law_count; ++j) registry->law_written[j] = softness[j];

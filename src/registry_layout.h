@@ -39,7 +39,7 @@ typedef struct JointBinding {
 } JointBinding;
 
 /* What implicit Euler's by-law pass reads of a row, packed apart from the bindings (rebuilt with the Apply cache):
- * after an ODE step has evicted the registry's arrays, it streams through 32 bytes a row instead of a binding's
+ * after an ODE step has evicted the registry's arrays, it streams through 24 bytes a row instead of a binding's
  * first line. Only rows with a writer and a law in the table have one, grouped by law (law_rows), so that the rows
  * of a law whose softness did not change (a damper's, k = 0, at any step) are passed over without being read. */
 typedef struct HotRow {
