@@ -15,7 +15,8 @@
  *      body_cache_stale. A slot's inverse is the body's for this Apply when its stamp == apply_stamp.
  *      laws[0..law_count) are distinct; joints[i].law_slot is the slot of a law equal to joints[i].law, or -1 (the
  *      table was full; rows_outside_laws counts those). loaded_rows counts the rows with a load.
- *      hot_rows[i] mirrors joints[i]'s joint, writer and law_slot, and says whether joints[i] shares the row of
+ *      hot_rows[law_rows[j] .. law_rows[j + 1]) mirror the joint and writer of law j's rows that have a writer,
+ *      each with its binding's position. joints[i].shares_previous_row says whether joints[i] shares the row of
  *      joints[i - 1] (sharesRow).
  *  - joints[i].written is what ODE holds for the row (NAN after a binding: written at the next Apply), except while
  *    written_by_law: then a row with law_slot >= 0 holds law_written[law_slot] (the by-law pass writes no row's
@@ -243,15 +244,29 @@ static void rebuildApplyCache(ssRegistry* registry) {
   registry->rows_outside_laws = 0;
   for (int i = 0; i < registry->joint_count; ++i) registry->rows_outside_laws += registry->joints[i].law_slot < 0;
   registry->loaded_rows = 0;
-  for (int i = 0; i < registry->joint_count; ++i) registry->loaded_rows += registry->joints[i].load != 0;
+  for (int i = 0; i < registry->joint_count; ++i) {
+    JointBinding* binding = &registry->joints[i];
+    registry->loaded_rows += binding->load != 0;
+    binding->shares_previous_row = i > 0 && sharesRow(&registry->joints[i - 1], binding);
+  }
+  /* the hot rows by law (a counting sort, in binding order within a law) */
+  int* next = registry->law_rows;
+  memset(next, 0, sizeof registry->law_rows);
   for (int i = 0; i < registry->joint_count; ++i) {
     const JointBinding* binding = &registry->joints[i];
-    registry->hot_rows[i] = (HotRow){.joint = binding->joint,
-                                     .set = binding->writer.set,
-                                     .erp_number = (int16_t)binding->writer.erp_number,
-                                     .cfm_number = (int16_t)binding->writer.cfm_number,
-                                     .law_slot = (int16_t)binding->law_slot,
-                                     .shares_previous_row = i > 0 && sharesRow(&registry->joints[i - 1], binding)};
+    if (binding->law_slot >= 0 && binding->writer.set != NULL) next[binding->law_slot + 1] += 1;
+  }
+  for (int j = 0; j < kLawTableSize; ++j) next[j + 1] += next[j];
+  int placed[kLawTableSize];
+  memcpy(placed, next, sizeof placed);
+  for (int i = 0; i < registry->joint_count; ++i) {
+    const JointBinding* binding = &registry->joints[i];
+    if (binding->law_slot < 0 || binding->writer.set == NULL) continue;
+    registry->hot_rows[placed[binding->law_slot]++] = (HotRow){.joint = binding->joint,
+                                                               .set = binding->writer.set,
+                                                               .erp_number = (int16_t)binding->writer.erp_number,
+                                                               .cfm_number = (int16_t)binding->writer.cfm_number,
+                                                               .binding = i};
   }
 }
 
@@ -362,14 +377,13 @@ static ssStatus computeRows(ssRegistry* registry, ssMapping mapping, double step
   const int any_load = registry->loaded_rows > 0;
   /* the rows and their count in locals: the calls into ODE could write *registry for all the compiler knows */
   JointBinding* const joints = registry->joints;
-  const HotRow* const hot = registry->hot_rows;
   const int count = registry->joint_count;
   for (int i = 0; i < count; ++i) {
     JointBinding* binding = &joints[i];
     PREFETCH_ROWS(joints, count, i, 2);
     const ssRowLaw* law = binding->law_slot >= 0 ? &registry->laws[binding->law_slot] : &binding->law;
     /* a stop and a motor on one axis move the same mass: computed once */
-    int same_row = same_axis && hot[i].shares_previous_row;
+    int same_row = same_axis && binding->shares_previous_row;
     double mass = same_row ? last_mass : bindingMass(registry, binding, law, measure);
     last_mass = mass;
     /* the accurate mappings depend on the mass, the step and (exact) the step before, all of which often repeat
@@ -516,33 +530,46 @@ static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* s
   return SS_OK;
 }
 
+/* A law's rows, from..end of the hot rows, written with its softness s: each row's erp where it has one, and its
+ * cfm; with erp_rows_only (only the law's erp changed) only the rows that hold an erp (a motor's row holds only its
+ * cfm). Returns the rows written. */
+static int writeLawRows(const HotRow* from, const HotRow* end, const HotRow* hot_end, ssSoftness s,
+                        int erp_rows_only) {
+  int writes = 0;
+  for (const HotRow* row = from; row < end; ++row) {
+    if (erp_rows_only && row->erp_number < 0) continue;
+#if defined(__GNUC__)
+    if (row + kPrefetchAhead / 2 < hot_end) __builtin_prefetch(row[kPrefetchAhead / 2].joint);
+#endif
+    if (row->erp_number >= 0) row->set(row->joint, row->erp_number, s.erp);
+    row->set(row->joint, row->cfm_number, s.cfm);
+    writes += 1;
+  }
+  return writes;
+}
+
 /* The one pass of lawSoftnesses' case: each row's law's softness written where it changed. Nothing here can
  * fail. It reads the rows' hot records and nothing else: where every row of a law was written by the last such
- * pass, law_written says what ODE holds. Returns the rows written. */
+ * pass, law_written says what ODE holds, and a law whose softness is what ODE holds has none of its rows read.
+ * Returns the rows written. */
 static int writeRowsByLaw(ssRegistry* registry, const ssSoftness* softness) {
   int writes = 0;
-  int by_law = registry->written_by_law;
-  int erp_changed[kLawTableSize], cfm_changed[kLawTableSize];
+  const HotRow* hot = registry->hot_rows; /* NULL before any binding: no law then */
+  const HotRow* hot_end = registry->law_count > 0 ? hot + registry->law_rows[registry->law_count] : hot;
   for (int j = 0; j < registry->law_count; ++j) {
-    erp_changed[j] = !ssSameInOde(softness[j].erp, registry->law_written[j].erp);
-    cfm_changed[j] = !ssSameInOde(softness[j].cfm, registry->law_written[j].cfm);
-  }
-  HotRow* hot = registry->hot_rows;
-  for (int i = 0; i < registry->joint_count; ++i) {
-    HotRow* row = &hot[i];
-#if defined(__GNUC__)
-    if (i + kPrefetchAhead / 2 < registry->joint_count) __builtin_prefetch(hot[i + kPrefetchAhead / 2].joint);
-#endif
-    const ssSoftness* law_softness = &softness[row->law_slot];
-    if (by_law) {
-      if (!cfm_changed[row->law_slot] && (row->erp_number < 0 || !erp_changed[row->law_slot])) continue;
-    } else if (sameWrite(row->erp_number, law_softness, &registry->joints[i].written)) {
-      continue;
+    const HotRow *from = hot + registry->law_rows[j], *end = hot + registry->law_rows[j + 1];
+    if (!registry->written_by_law) { /* each row holds its own written */
+      for (const HotRow* row = from; row < end; ++row) {
+        if (sameWrite(row->erp_number, &softness[j], &registry->joints[row->binding].written)) continue;
+        if (row->erp_number >= 0) row->set(row->joint, row->erp_number, softness[j].erp);
+        row->set(row->joint, row->cfm_number, softness[j].cfm);
+        writes += 1;
+      }
+    } else if (!ssSameInOde(softness[j].cfm, registry->law_written[j].cfm)) {
+      writes += writeLawRows(from, end, hot_end, softness[j], 0);
+    } else if (!ssSameInOde(softness[j].erp, registry->law_written[j].erp)) {
+      writes += writeLawRows(from, end, hot_end, softness[j], 1);
     }
-    if (row->set == NULL) continue;
-    if (row->erp_number >= 0) row->set(row->joint, row->erp_number, law_softness->erp);
-    row->set(row->joint, row->cfm_number, law_softness->cfm);
-    writes += 1;
   }
   for (int j = 0; j < registry->law_count; ++j) registry->law_written[j] = softness[j];
   registry->written_by_law = 1;

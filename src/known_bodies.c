@@ -195,10 +195,29 @@ static int firstJointChanged(dJointID first, dJointID listed) {
   return first != listed && (first == 0 || dJointGetType(first) != dJointTypeContact);
 }
 
+/* How many bodies ahead the passes ask for a body's memory: a large world's bodies are out of cache after ODE's step
+ * or the program's frame, and the loads of several bodies then overlap instead of waiting one after the other. */
+enum { kPrefetchAhead = 8, kPrefetchFrom = 256 };
+
+/* Up to which body a pass over count bodies asks for the one kPrefetchAhead ahead: none for a list that stays in
+ * cache. */
+static int prefetchUntil(int count) { return count >= kPrefetchFrom ? count - kPrefetchAhead : 0; }
+
+/* The body and the head of its first joint (where ODE keeps its joint list): what dBodyGetJoint reads. */
+static void prefetchJoints(const ssKnownBodies* known, int k) {
+  const char* joint = (const char*)known->first_joints[k];
+  __builtin_prefetch(known->ids[k]);
+  if (joint != NULL) __builtin_prefetch(joint), __builtin_prefetch(joint + 64);
+}
+
+static int jointsChangedAt(const ssKnownBodies* known, int k) {
+  return firstJointChanged(dBodyGetJoint(known->ids[k], 0), known->first_joints[k]);
+}
+
 int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body) {
-  for (int i = 0; i < known->count; ++i)
-    if (firstJointChanged(dBodyGetJoint(known->ids[i], 0), known->first_joints[i])) {
-      if (body != NULL) *body = known->ids[i];
+  for (int k = 0; k < known->count; ++k)
+    if (jointsChangedAt(known, k)) {
+      if (body != NULL) *body = known->ids[k];
       return 1;
     }
   return 0;
@@ -318,13 +337,6 @@ static int forcesWithin(const ssBodyValues* v) {
   return (f > t ? f : t) <= magnitudeBits(SS_MAX_FORCE_N);
 }
 
-/* How many bodies ahead the checks ask for a body's values: a large world's bodies are out of cache after ODE's step
- * or the program's frame, and the loads of several bodies then overlap instead of waiting one after the other. */
-enum { kPrefetchAhead = 8, kPrefetchFrom = 256 };
-
-/* How far ahead a pass over count bodies asks for them: past the end (none) for a list that stays in cache. */
-static int prefetchDistance(int count) { return count >= kPrefetchFrom ? kPrefetchAhead : count; }
-
 static void prefetchState(const ssBodyValues* v) {
   __builtin_prefetch(v->position);
   __builtin_prefetch(v->linear_vel);
@@ -338,11 +350,10 @@ ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, co
   const ssBodyValues* values = known->values;
   /* the whole list first, with no branch a body (the usual case: all pass); the first failure is found after */
   int all = 1;
-  const int count = known->count, ahead = prefetchDistance(count);
+  const int count = known->count, until = prefetchUntil(count), forces = bounds->forces;
   for (int k = 0; k < count; ++k) {
-    if (k + ahead < count) prefetchState(&values[k + ahead]);
-    all &= stateWithin(&values[k], max_speed2, max_spin2);
-    if (bounds->forces) all &= forcesWithin(&values[k]);
+    if (k < until) prefetchState(&values[k + kPrefetchAhead]);
+    all &= stateWithin(&values[k], max_speed2, max_spin2) & (!forces || forcesWithin(&values[k]));
   }
   char named[64];
   for (int k = 0; !all && k < known->count; ++k) {
@@ -364,16 +375,26 @@ ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, co
   return SS_OK;
 }
 
-/* Whether a vector of finite values is not all zeros (-0 is zero), as integers: no floating-point comparison. */
-static int anyBitBesidesSign(const dReal* v) {
-  double x = v[0], y = v[1], z = v[2];
-  uint64_t a, b, c;
-  memcpy(&a, &x, sizeof a), memcpy(&b, &y, sizeof b), memcpy(&c, &z, sizeof c);
-  return ((a | b | c) << 1) != 0;
-}
-
 static int anyNonZero(const double* values) {
   return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
+}
+
+/* One body at the frame's start: 0 when its state or forces fail the check; else, with a force or torque (not all
+ * zeros, -0 included: the largest magnitude is not 0) or carried momentum, its frame force read and the body marked
+ * pushed. */
+static int startBody(ssKnownBodies* known, int k, double max_speed2, double max_spin2) {
+  const ssBodyValues* values = &known->values[k];
+  uint64_t force = largestOf(values->force), torque = largestOf(values->torque);
+  uint64_t largest = force > torque ? force : torque;
+  if (!(stateWithin(values, max_speed2, max_spin2) & (largest <= magnitudeBits(SS_MAX_FORCE_N)))) return 0;
+  ssKnownBody* body = &known->bodies[k];
+  if (largest == 0 && !(known->carrying && anyNonZero(body->carried))) return 1;
+  const dReal *f = values->force, *t = values->torque;
+  double* frame = body->frame_force;
+  frame[0] = f[0], frame[1] = f[1], frame[2] = f[2], frame[3] = t[0], frame[4] = t[1], frame[5] = t[2];
+  body->pushed = 1;
+  known->pushed[known->pushed_count++] = k;
+  return 1;
 }
 
 ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBodyID* failed, int* joints_changed) {
@@ -383,33 +404,22 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBo
   /* last frame's pushed bodies are unmarked through their list: only a pushed body's entry is written */
   for (int p = 0; p < known->pushed_count; ++p) known->bodies[known->pushed[p]].pushed = 0;
   known->pushed_count = 0;
-  const int count = known->count, ahead = prefetchDistance(count);
-  for (int k = 0; k < count; ++k) {
-    const ssBodyValues* values = &known->values[k];
-    if (k + ahead < count) { /* the body, the head of its first joint (where ODE keeps its joint list), its values */
-      const char* joint = (const char*)known->first_joints[k + ahead];
-      __builtin_prefetch(known->ids[k + ahead]);
-      if (joint != NULL) __builtin_prefetch(joint), __builtin_prefetch(joint + 64);
-      prefetchState(&values[ahead]);
-      __builtin_prefetch(values[ahead].force);
-      __builtin_prefetch(values[ahead].torque);
+  const int count = known->count, until = prefetchUntil(count);
+  for (int k = 0; k < count; ++k) { /* one loop: startBody inlined once */
+    if (k < until) {
+      const ssBodyValues* ahead = &known->values[k + kPrefetchAhead];
+      prefetchJoints(known, k + kPrefetchAhead);
+      prefetchState(ahead);
+      __builtin_prefetch(ahead->force);
+      __builtin_prefetch(ahead->torque);
     }
-    if (firstJointChanged(dBodyGetJoint(known->ids[k], 0), known->first_joints[k])) {
+    if (jointsChangedAt(known, k)) {
       *joints_changed = 1;
       return SS_OK;
     }
-    if (!(stateWithin(values, max_speed2, max_spin2) & forcesWithin(values))) {
-      *failed = known->ids[k];
-      return describe(known->ids[k], bounds, "before the frame");
-    }
-    const dReal *force = values->force, *torque = values->torque;
-    int pushing = anyBitBesidesSign(force) | anyBitBesidesSign(torque);
-    if (!pushing && !(known->carrying && anyNonZero(known->bodies[k].carried))) continue;
-    ssKnownBody* body = &known->bodies[k];
-    double* f = body->frame_force;
-    f[0] = force[0], f[1] = force[1], f[2] = force[2], f[3] = torque[0], f[4] = torque[1], f[5] = torque[2];
-    body->pushed = 1;
-    known->pushed[known->pushed_count++] = k;
+    if (startBody(known, k, max_speed2, max_spin2)) continue;
+    *failed = known->ids[k];
+    return describe(known->ids[k], bounds, "before the frame");
   }
   return SS_OK;
 }

@@ -32,6 +32,7 @@ typedef struct JointBinding {
   uint8_t joint_type;       /* a dJointType (below 256), resolved at bind time: a joint's type never changes */
   uint8_t computed_mapping; /* an ssMapping */
   ssRowFallback computed_fallback;
+  uint8_t shares_previous_row; /* sharesRow(the binding before, this one), with the Apply cache: its mass is reused */
   double load_correction; /* the force this Apply adds along the row for the load (N or N·m), with pending */
 
   ssRowLaw law;
@@ -43,14 +44,14 @@ typedef struct JointBinding {
 _Static_assert(sizeof(JointBinding) == 3 * 64, "a joint binding is three cache lines");
 
 /* What implicit Euler's by-law pass reads of a row, packed apart from the bindings (rebuilt with the Apply cache):
- * after an ODE step has evicted the registry's arrays, it streams through 32 bytes a row instead of a binding's
- * first line. mass mirrors the binding's. */
+ * after an ODE step has evicted the registry's arrays, it streams through 24 bytes a row instead of a binding's
+ * first line. Only rows with a writer and a law in the table have one, grouped by law (law_rows), so that the rows
+ * of a law whose softness did not change (a damper's, k = 0, at any step) are passed over without being read. */
 typedef struct HotRow {
   dJointID joint;
-  ssParamSetter set; /* the row's writer: NULL for a row without softness */
+  ssParamSetter set;              /* the row's writer */
   int16_t erp_number, cfm_number; /* ODE's parameter numbers (below 0x400); erp_number -1: none */
-  int16_t law_slot;
-  uint8_t shares_previous_row; /* sharesRow(the binding before, this one): the general pass reuses its mass */
+  int binding;                    /* the row's position in joints */
 } HotRow;
 
 /* A body's inverse mass and inertia, computed at most once per Apply for all the rows on it. */
@@ -95,6 +96,7 @@ struct ssRegistry {
   /* the distinct laws of the bindings (programs bind many rows to a few springs), rebuilt with the body cache */
   ssRowLaw laws[kLawTableSize];
   int law_count;
+  int law_rows[kLawTableSize + 1]; /* hot_rows[law_rows[j] .. law_rows[j + 1]) are law j's rows with a writer */
   int rows_outside_laws; /* bindings whose law did not fit in the table */
   /* after a by-law pass, every row in the law table holds its law's softness in ODE: law_written stands for the
    * rows' written until the other passes (or a rebinding) need theirs back (materializeWritten) */
