@@ -530,6 +530,12 @@ static ssStatus lawSoftnesses(ssRegistry* registry, double step_s, ssSoftness* s
   return SS_OK;
 }
 
+/* Writes s into one packed row: its erp where it has one, and its cfm. */
+static void writeHotRow(const HotRow* row, ssSoftness s) {
+  if (row->erp_number >= 0) row->set(row->joint, row->erp_number, s.erp);
+  row->set(row->joint, row->cfm_number, s.cfm);
+}
+
 /* A law's rows, from..end of the hot rows, written with its softness s: each row's erp where it has one, and its
  * cfm; with erp_rows_only (only the law's erp changed) only the rows that hold an erp (a motor's row holds only its
  * cfm). Returns the rows written. */
@@ -541,8 +547,7 @@ static int writeLawRows(const HotRow* from, const HotRow* end, const HotRow* hot
 #if defined(__GNUC__)
     if (row + kPrefetchAhead / 2 < hot_end) __builtin_prefetch(row[kPrefetchAhead / 2].joint);
 #endif
-    if (row->erp_number >= 0) row->set(row->joint, row->erp_number, s.erp);
-    row->set(row->joint, row->cfm_number, s.cfm);
+    writeHotRow(row, s);
     writes += 1;
   }
   return writes;
@@ -561,8 +566,7 @@ static int writeRowsByLaw(ssRegistry* registry, const ssSoftness* softness) {
     if (!registry->written_by_law) { /* each row holds its own written */
       for (const HotRow* row = from; row < end; ++row) {
         if (sameWrite(row->erp_number, &softness[j], &registry->joints[row->binding].written)) continue;
-        if (row->erp_number >= 0) row->set(row->joint, row->erp_number, softness[j].erp);
-        row->set(row->joint, row->cfm_number, softness[j].cfm);
+        writeHotRow(row, softness[j]);
         writes += 1;
       }
     } else if (!ssSameInOde(softness[j].cfm, registry->law_written[j].cfm)) {

@@ -140,11 +140,12 @@ static ssStatus exactSoftness(ssSpring spring, double mass, double step_s, doubl
   double alpha = now.decayed_c + now.decayed_s * before.c_over_s;
   double beta = -now.decayed_s * exp(-2.0 * sigma * previous_step_s) / before.decayed_s;
   double ratio = step_s / previous_step_s;
-  if (!(ratio + beta > 0 && beta < 0) && quiet) return SS_ERROR_NO_FINITE_MAPPING;
-  if (!(ratio + beta > 0 && beta < 0))
+  if (!(ratio + beta > 0 && beta < 0)) {
+    if (quiet) return SS_ERROR_NO_FINITE_MAPPING;
     return ssFail(SS_ERROR_NO_FINITE_MAPPING,
                   "step_s = %g s after previous_step_s = %g s: the exact step would need cfm <= 0", step_s,
                   previous_step_s);
+  }
   double a = -beta / (ratio + beta);
   return finish(a, a * ratio - (alpha - 1.0) * (1.0 + a), step_s, mass, quiet, out);
 }
