@@ -77,15 +77,20 @@ def frame_rate_tables(build: pathlib.Path, executor: str) -> None:
             sys.exit(f"bench_examples: {program}: {len(failed)} runs failed: {failed[0]['status']}")
 
 
-def loop_seconds(build: pathlib.Path, program: str, variant: str, seconds: float,
-                 extra: list[str]) -> tuple[float, float]:
-    """The stepping loop's (wall, CPU) seconds of one run of the program at fixed:60: its own stepping ("own") or
-    adopted under the policy `variant` with one step a frame."""
+def loop_command(build: pathlib.Path, program: str, variant: str, seconds: float, extra: list[str]) -> list[str]:
+    """The command of one cost run of the program at fixed:60: its own stepping ("own") or adopted under the policy
+    `variant` with one step a frame."""
     if variant == "own":
         command = [str(build / f"steadystep_example_{program}_ode")]
     else:
         command = [str(build / f"steadystep_example_{program}_steadystep"), "--policy", variant, "--max-step", "1"]
-    command += ["--profile", "fixed:60", "--duration", str(seconds), "--quiet"] + extra
+    return command + ["--profile", "fixed:60", "--duration", str(seconds), "--quiet"] + extra
+
+
+def loop_seconds(build: pathlib.Path, program: str, variant: str, seconds: float,
+                 extra: list[str]) -> tuple[float, float]:
+    """The stepping loop's (wall, CPU) seconds of one cost run (loop_command)."""
+    command = loop_command(build, program, variant, seconds, extra)
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
         sys.exit(f"bench_examples: {' '.join(command)} exited {done.returncode}: {done.stderr.strip()}")
@@ -98,13 +103,8 @@ def loop_instructions(build: pathlib.Path, program: str, variant: str, seconds: 
     long less a run as long."""
     counts = []
     for duration in (seconds, 2 * seconds):
-        command = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null"]
-        if variant == "own":
-            command += [str(build / f"steadystep_example_{program}_ode")]
-        else:
-            command += [str(build / f"steadystep_example_{program}_steadystep"), "--policy", variant,
-                        "--max-step", "1"]
-        command += ["--profile", "fixed:60", "--duration", str(duration), "--quiet"] + extra
+        command = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null"] + \
+            loop_command(build, program, variant, duration, extra)
         done = subprocess.run(command, capture_output=True, text=True)
         collected = [line for line in done.stderr.splitlines() if "Collected :" in line]
         if done.returncode != 0 or not collected:
