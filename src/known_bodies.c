@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "error.h"
+#include "gears.h"
 #include "steadystep/limits.h"
 
 void ssKnownFree(ssKnownBodies* known) {
@@ -92,13 +93,6 @@ static void listPushed(ssKnownBodies* known) {
     if (known->bodies[i].pushed) known->pushed[known->pushed_count++] = i;
 }
 
-/* Whether a transmission joint gears the body. */
-static int geared(dBodyID body) {
-  for (int i = dBodyGetNumJoints(body) - 1; i >= 0; --i)
-    if (dJointGetType(dBodyGetJoint(body, i)) == dJointTypeTransmission) return 1;
-  return 0;
-}
-
 ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const dBodyID* watched, int watched_count) {
   BodyWalk walk = {.slots = calloc(64, sizeof(dBodyID)), .mask = 63};
   if (walk.slots == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
@@ -142,7 +136,7 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
   }
   free(walk.list);
   int geared_count = 0;
-  for (size_t i = 0; i < count; ++i) geared_count += geared(ids[i]);
+  for (size_t i = 0; i < count; ++i) geared_count += ssGeared(ids[i]);
   dBodyID* geared_ids = geared_count > 0 ? malloc((size_t)geared_count * sizeof *geared_ids) : NULL;
   if (geared_count > 0 && geared_ids == NULL) {
     free(bodies);
@@ -153,7 +147,7 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
   }
   for (size_t i = 0, g = 0; i < count; ++i)
-    if (geared(ids[i])) geared_ids[g++] = ids[i];
+    if (ssGeared(ids[i])) geared_ids[g++] = ids[i];
   unsigned registry_generation = known->registry_generation, watched_generation = known->watched_generation;
   int carrying = known->carrying;
   ssKnownFree(known);
@@ -291,23 +285,6 @@ static ssStatus describe(dBodyID body, const ssBodyBounds* bounds, const char* w
   return ssFail(SS_ERROR_BLOWUP, "body %p: failed a check %s", (void*)body, when); /* not reached */
 }
 
-/* How far a geared body turns its gear in a step of step_s (rad): its spin, and its speed over the gear's radius (a
- * gear moved sideways by its radius turns the point where the gears mesh as far as a turn of one radian would). The
- * largest over its transmission joints. */
-static double gearTurn(dBodyID body, double step_s) {
-  double spin = sqrt(squared(dBodyGetAngularVel(body))), speed = sqrt(squared(dBodyGetLinearVel(body)));
-  double turn = 0;
-  for (int i = dBodyGetNumJoints(body) - 1; i >= 0; --i) {
-    dJointID joint = dBodyGetJoint(body, i);
-    if (dJointGetType(joint) != dJointTypeTransmission) continue;
-    double radius = dJointGetBody(joint, 0) == body ? dJointGetTransmissionRadius1(joint)
-                                                    : dJointGetTransmissionRadius2(joint);
-    double slide = radius > 0 ? speed / radius : 0; /* a radius ODE has not computed yet: the spin alone */
-    turn = fmax(turn, (spin + slide) * step_s);
-  }
-  return turn;
-}
-
 /* A double's magnitude as an integer: non-negative doubles order as their bit patterns do, and a NaN's or an
  * infinity's lies above every finite number's, so one integer comparison tests finiteness and a bound together. */
 static uint64_t magnitudeBits(dReal value) {
@@ -364,7 +341,7 @@ ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, co
   }
   for (int g = 0; g < known->geared_count && bounds->gear_step_s > 0; ++g) {
     dBodyID body = known->geared[g];
-    double turn = gearTurn(body, bounds->gear_step_s);
+    double turn = ssGearTurn(body, bounds->gear_step_s);
     if (turn <= SS_MAX_GEAR_TURN_RAD) continue;
     *failed = body;
     snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);

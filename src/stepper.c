@@ -9,6 +9,7 @@
 
 #include "array.h"
 #include "error.h"
+#include "gears.h"
 #include "interpolation_internal.h"
 #include "known_bodies.h"
 #include "ode_bounds.h"
@@ -45,6 +46,7 @@ struct ssStepper {
   int apply_due;         /* bindings were added within the frame: the next step applies whatever the mapping */
   int in_step;           /* inside ssStepper_Step: its callbacks are running */
   int destroy_requested; /* ssStepper_Destroy was called from a callback: done when ssStepper_Step returns */
+  int rebase_gears;      /* ssStepper_Reset was called: the next frame has ODE measure its gears afresh (gears.h) */
   ssStepInfo current;
   ssContactCache contact_cache; /* a program softens many contacts with the same numbers */
   ssFrameReport* report; /* the frame being stepped, for ssStepper_SoftenContact's counts */
@@ -251,6 +253,7 @@ void ssStepper_Reset(ssStepper* stepper) {
   stepper->previous_step_s = 0;
   stepper->accumulator_s = 0;
   stepper->short_frame_s = 0;
+  stepper->rebase_gears = 1;
   forgetCarried(stepper);
   ssPoseHistoryForget(stepper->poses);
   describeNextStep(stepper);
@@ -619,6 +622,11 @@ static ssStatus startFrame(ssStepper* stepper, ssFrameReport* report) {
       return latch(stepper, status);
     }
     if (joints_changed) status = findNew(stepper, 1);
+  }
+  /* after the check, on the list it passed: the bodies are those the program repaired, within every bound */
+  if (status == SS_OK && stepper->rebase_gears) {
+    ssGearsRebase(stepper->known.geared, stepper->known.geared_count);
+    stepper->rebase_gears = 0;
   }
   return status;
 }

@@ -193,6 +193,10 @@ SS_API ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport
 /** After a failure, once the program has repaired or restored its bodies: accepts frames again. Also forgets the
  *  step history, the FIXED accumulator and the momentum carried for the next frame. NULL is a no-op. A body left as
  *  it failed (still too fast, or beyond a bound) is refused again, by name, before the next frame touches it.
+ *  Every transmission joint on a known body is measured afresh at the next frame's first step: the gears' angles
+ *  then are their phase 0 (ODE 0.16 predicts each gear's phase from its spin and aborts when the gear has turned
+ *  otherwise by pi: a runaway step followed by a repair does that, and so does a program that turns a gear itself,
+ *  which should call this before the next frame). The phase error the gears had is forgotten; each keeps its axis.
  *  From the stepper's own callback: does nothing, and records SS_ERROR_REENTERED's message for ssLastError. */
 SS_API void ssStepper_Reset(ssStepper* stepper);
 
