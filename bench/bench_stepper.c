@@ -8,9 +8,12 @@
  *
  * Every link weighs 1 kg by default, so that the rows share two effective masses (a chain's first link and the
  * others), as in a chain, a stack of crates or a field of identical props; with "distinct" every link weighs its
- * own mass (1 to 1.5 kg), as in a ragdoll, so that matched and exact compute every row's softness by itself.
+ * own mass (1 to 1.5 kg), as in a ragdoll, so that matched and exact compute every row's softness by itself. Both
+ * bind the rows with effective_mass 0: the registry measures each row's mass from its bodies at every Apply. With
+ * "given" every link has its own mass too, and each row's mass is given at binding (ssJointEffectiveMass, once), as
+ * a program that knows its masses passes them: what the accurate mappings cost without the measuring.
  *
- *   bench_stepper [frames] [repeats] [distinct]      (default 300 frames, 7 repeats, shared masses) */
+ *   bench_stepper [frames] [repeats] [distinct|given]      (default 300 frames, 7 repeats, shared masses) */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,6 +30,7 @@ static const ssSpring kLimit = {5.0, 0.05}; /* about 6 Hz on a link of 0.0035 kg
 static const ssSpring kFriction = {0.0, 0.01}; /* a pure damper on each hinge motor row */
 static const double kFrame_s = 1.0 / 60.0;
 static int distinct_masses; /* every link its own mass (see the top) */
+static int given_masses;    /* and each row's effective mass given at binding */
 
 typedef struct Scene {
   dWorldID world;
@@ -67,8 +71,13 @@ static Scene build(int with_stepper) {
       dJointSetHingeParam(hinge, dParamFMax, 0); /* the motor row only carries the damper's cfm */
       scene.hinges[chain * kLinks + link] = hinge;
       if (with_stepper) {
-        check(ssRegistry_BindJoint(scene.registry, hinge, SS_PARAM_STOP, 1, kLimit, 0), "bind stop");
-        check(ssRegistry_BindJoint(scene.registry, hinge, SS_PARAM_MOTOR, 1, kFriction, 0), "bind motor");
+        double stop_kg_m2 = 0, motor_kg_m2 = 0; /* 0: measured at every Apply */
+        if (given_masses) {
+          check(ssJointEffectiveMass(hinge, SS_PARAM_STOP, 1, &stop_kg_m2), "stop's mass");
+          check(ssJointEffectiveMass(hinge, SS_PARAM_MOTOR, 1, &motor_kg_m2), "motor's mass");
+        }
+        check(ssRegistry_BindJoint(scene.registry, hinge, SS_PARAM_STOP, 1, kLimit, stop_kg_m2), "bind stop");
+        check(ssRegistry_BindJoint(scene.registry, hinge, SS_PARAM_MOTOR, 1, kFriction, motor_kg_m2), "bind motor");
       } else { /* what a program without the library does: the values for its one frame rate, set once */
         dJointSetHingeParam(hinge, dParamStopERP, limit.erp);
         dJointSetHingeParam(hinge, dParamStopCFM, limit.cfm);
@@ -214,9 +223,10 @@ static void reportInterpolation(int frames, int repeats) {
 int main(int argc, char** argv) {
   int frames = argc > 1 ? atoi(argv[1]) : 300;
   int repeats = argc > 2 ? atoi(argv[2]) : 7;
-  distinct_masses = argc > 3 && strcmp(argv[3], "distinct") == 0;
+  given_masses = argc > 3 && strcmp(argv[3], "given") == 0;
+  distinct_masses = given_masses || (argc > 3 && strcmp(argv[3], "distinct") == 0);
   if (frames <= 0 || repeats <= 0 || repeats > 64 || (argc > 3 && !distinct_masses) || argc > 4) {
-    fprintf(stderr, "usage: bench_stepper [frames > 0] [repeats 1..64] [distinct]\n");
+    fprintf(stderr, "usage: bench_stepper [frames > 0] [repeats 1..64] [distinct|given]\n");
     return 2;
   }
   dInitODE2(0);
@@ -224,7 +234,9 @@ int main(int argc, char** argv) {
   printf("bench_stepper: %d bodies in %d chains, %d soft parameter sets, %d frames a repeat, QuickStep 20 iterations, "
          "%s\ntargets: implicit Euler <= 1.02, matched and exact <= 1.05\n",
          kChains * kLinks, kChains, 2 * kChains * kLinks, frames,
-         distinct_masses ? "every link its own mass (1 to 1.5 kg)" : "links of 1 kg (two effective masses)");
+         given_masses      ? "every link its own mass (1 to 1.5 kg), each row's mass given at binding"
+         : distinct_masses ? "every link its own mass (1 to 1.5 kg), measured at every Apply"
+                           : "links of 1 kg (two effective masses)");
   report("frames of 1/60 s:", NULL, frames, repeats);
   report("frames of 1/90 to 1/60 s (every value rewritten every frame):", "uniform:60:90", frames, repeats);
   reportInterpolation(frames, repeats);
