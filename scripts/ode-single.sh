@@ -6,8 +6,10 @@
 # machine has installed (libode-dev, 2:0.16.2-1 on bookworm), fetched with `apt-get source` through a private
 # deb-src list made from the machine's own Debian deb entries (/etc/apt/sources.list*), with its own lists and
 # cache under build/: the machine's apt configuration and state are not touched. Nothing is vendored, nothing comes
-# from anywhere else. It is built with ODE's CMake build (Release, -DODE_DOUBLE_PRECISION=OFF, no demos, no tests)
-# into build/ode-single/prefix, which is reused as long as its stamp names the same source version and options.
+# from anywhere else. It is built with ODE's CMake build (-DODE_DOUBLE_PRECISION=OFF, no demos, no tests) into
+# build/ode-single/prefix, which is reused as long as its stamp names the same source version and options. The
+# configuration is Debug compiled at -O2: ODE's CMake defines dNODEBUG in every other one, which compiles its asserts
+# out, and the tests must see ODE abort where it would (as Debian's double build, which keeps them, does).
 #
 # Usage: scripts/ode-single.sh            (prints the prefix; build with -DSTEADYSTEP_ODE_PREFIX=<prefix>)
 # Needs: apt-get, dpkg-source (dpkg-dev), cmake, ninja, g++, and the network to reach the Debian mirror.
@@ -22,8 +24,8 @@ case "$version" in
   *:0.16.2-*) ;;
   *) echo "ode-single: needs Debian's libode-dev 0.16.2 installed (found '${version:-none}')" >&2; exit 1 ;;
 esac
-options=(-DCMAKE_BUILD_TYPE=Release -DODE_DOUBLE_PRECISION=OFF -DODE_WITH_DEMOS=OFF -DODE_WITH_TESTS=OFF
-         -DBUILD_SHARED_LIBS=ON -DCMAKE_INSTALL_LIBDIR=lib)
+options=(-DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_FLAGS_DEBUG=-O2 -DCMAKE_CXX_FLAGS_DEBUG=-O2 -DODE_DOUBLE_PRECISION=OFF
+         -DODE_WITH_DEMOS=OFF -DODE_WITH_TESTS=OFF -DBUILD_SHARED_LIBS=ON -DCMAKE_INSTALL_LIBDIR=lib)
 stamp="ode $version ${options[*]}"
 if [ -f "$prefix/stamp" ] && [ "$(cat "$prefix/stamp")" = "$stamp" ] && [ -f "$prefix/lib/pkgconfig/ode.pc" ]; then
   echo "$prefix"
