@@ -289,7 +289,8 @@ class Stepper:
 
     def reset(self) -> None:
         """After a failure, once the program repaired or restored its bodies: accepts frames again. Also forgets
-        the step history, the FIXED accumulator and the momentum carried over."""
+        the step history, the FIXED accumulator and the momentum carried over, and has ODE measure every
+        transmission joint on a known body afresh at the next frame (see ssStepper_Reset)."""
         lib.ssStepper_Reset(self._between_frames("reset"))
 
     def reset_history(self) -> None:
