@@ -34,8 +34,7 @@
  *   The bounds sit many orders of magnitude inside those edges, at values no physical program needs to pass, so
  *   that products with a state that has not (yet) blown up stay finite too.
  *
- * Single precision (ODE 0.16.2 from Debian's source package, CMake Debug at -O2 so that its asserts stay, as in
- * Debian's double build; the edges below were probed on a Release build, -DODE_DOUBLE_PRECISION=OFF): float's
+ * Single precision (ODE 0.16.2 from Debian's source package, CMake Release, -DODE_DOUBLE_PRECISION=OFF): float's
  * range (1.2e-38 to 3.4e38) leaves less room; the masses, speeds and forces are narrower, the rest is kept.
  *   step length   non-finite at h <= 1e-22 s and at h >= 1e10 s (nominal); finite from 1e-20 s to 1e6 s. Kept:
  *                 1e-9 s to an hour, finite at every corner below.
@@ -46,8 +45,8 @@
  *                 |erp| = 1e18 (the largest tried). Kept: 1e9.
  *   mass          non-finite at 1e-40 kg (a denormal), finite from 1e-38 kg (nominal). The heavy edge is a mass
  *                 times a squared displacement: one step from 1e5 m/s at h = 3600 s is finite to 1e5 kg, not at
- *                 3e5 kg (from 1e4 m/s: finite to 1e6 kg). With ODE's asserts (a Debug build), a principal
- *                 inertia of about 1e-13 kg·m² or less aborts in dxNormalize4. Bounds: 1e-6 kg to 1e4 kg.
+ *                 3e5 kg (from 1e4 m/s: finite to 1e6 kg). Built with its asserts (CMake Debug), ODE aborts
+ *                 in dxNormalize4 from a principal inertia of about 1e-13 kg·m². Bounds: 1e-6 kg to 1e4 kg.
  *   speed         one step at every corner (1e4 kg, h = 3600 s) is finite from 1e6 m/s, not from 1e7. Bound: 1e5,
  *                 above an hour's fall (3.5e4 m/s).
  *   force         one step from 1e5 m/s at every corner is finite with 1e18 N on every body, not with 1e21

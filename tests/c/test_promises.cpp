@@ -21,9 +21,9 @@ namespace {
 
 bool Names(const char* text) { return std::string(ssLastError()).find(text) != std::string::npos; }
 
-// Whether this ODE keeps its asserts: Debian's build and scripts/ode-single.sh's (Debug at -O2) do; ODE's own CMake
-// build defines dNODEBUG in every other configuration. Asked in a child: a transmission's per-gear axis set in the
-// wrong mode.
+// Whether this ODE keeps its asserts: Debian's build and `scripts/ode-single.sh --asserts` (CMake Debug) do; ODE's
+// CMake build defines dNODEBUG in every other configuration (the tests' single-precision build is Release). Asked in
+// a child: a transmission's per-gear axis set in the wrong mode.
 bool OdeAsserts() {
   pid_t child = fork();
   if (child == 0) {
