@@ -90,6 +90,27 @@ class PromiseTest : public OdeTest {
   }
   ssStatus Make(ssStepperDef def) { return ssStepper_Create(&def, &stepper); }
 
+  // Two gears (boxes) on hinges about y to the static world, 0.6 m apart at z = 1, geared 2:1 by a transmission.
+  dJointID Gears(dBodyID gears[2]) {
+    gears[0] = Box(0, 0, 1);
+    gears[1] = Box(0.6, 0, 1);
+    for (int i = 0; i < 2; ++i) {
+      dJointID hinge = dJointCreateHinge(world, 0);
+      dJointAttach(hinge, gears[i], 0);
+      const dReal* p = dBodyGetPosition(gears[i]);
+      dJointSetHingeAnchor(hinge, p[0], p[1], p[2]);
+      dJointSetHingeAxis(hinge, 0, 1, 0);
+    }
+    dJointID transmission = dJointCreateTransmission(world, 0);
+    dJointAttach(transmission, gears[0], gears[1]);
+    dJointSetTransmissionMode(transmission, dTransmissionParallelAxes);
+    dJointSetTransmissionAxis(transmission, 0, 1, 0);
+    dJointSetTransmissionAnchor1(transmission, 0, 0, 1);
+    dJointSetTransmissionAnchor2(transmission, 0.6, 0, 1);
+    dJointSetTransmissionRatio(transmission, 2.0);
+    return transmission;
+  }
+
   dSpaceID space = nullptr;
   dJointGroupID contacts = nullptr;
   ssStepper* stepper = nullptr;
@@ -268,21 +289,8 @@ void DestroyBodyOnce(void* context, ssStepper* stepper) {
 // within the speed guard (at 1/60 s, 188 rad/s turn pi) is stopped by name after the step that spun it, not stepped
 // again; the frame before it, at a modest spin, is stepped as usual.
 TEST_F(PromiseTest, AGearSpunPastHalfATurnAStepIsStoppedBeforeODEsTransmissionAborts) {
-  dBodyID gears[2] = {Box(0, 0, 1), Box(0.6, 0, 1)};
-  for (dBodyID gear : gears) {
-    dJointID hinge = dJointCreateHinge(world, 0);
-    dJointAttach(hinge, gear, 0);
-    const dReal* p = dBodyGetPosition(gear);
-    dJointSetHingeAnchor(hinge, p[0], p[1], p[2]);
-    dJointSetHingeAxis(hinge, 0, 1, 0);
-  }
-  dJointID transmission = dJointCreateTransmission(world, 0);
-  dJointAttach(transmission, gears[0], gears[1]);
-  dJointSetTransmissionMode(transmission, dTransmissionParallelAxes);
-  dJointSetTransmissionAxis(transmission, 0, 1, 0);
-  dJointSetTransmissionAnchor1(transmission, 0, 0, 1);
-  dJointSetTransmissionAnchor2(transmission, 0.6, 0, 1);
-  dJointSetTransmissionRatio(transmission, 2.0);
+  dBodyID gears[2];
+  Gears(gears);
   dBodySetAngularVel(gears[0], 0, 1, 0);
   ssStepperDef def = Def();
   def.stepping.solver = SS_SOLVER_STEP;
@@ -320,21 +328,8 @@ TEST_F(PromiseTest, AGearSpunPastHalfATurnAStepIsStoppedBeforeODEsTransmissionAb
 TEST_F(PromiseTest, AGearTurnedHalfATurnAndResetIsMeasuredAfreshNotAborted) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   auto program = [this](bool reset) {
-    dBodyID gears[2] = {Box(0, 0, 1), Box(0.6, 0, 1)};
-    for (dBodyID gear : gears) {
-      dJointID hinge = dJointCreateHinge(world, 0);
-      dJointAttach(hinge, gear, 0);
-      const dReal* p = dBodyGetPosition(gear);
-      dJointSetHingeAnchor(hinge, p[0], p[1], p[2]);
-      dJointSetHingeAxis(hinge, 0, 1, 0);
-    }
-    dJointID transmission = dJointCreateTransmission(world, 0);
-    dJointAttach(transmission, gears[0], gears[1]);
-    dJointSetTransmissionMode(transmission, dTransmissionParallelAxes);
-    dJointSetTransmissionAxis(transmission, 0, 1, 0);
-    dJointSetTransmissionAnchor1(transmission, 0, 0, 1);
-    dJointSetTransmissionAnchor2(transmission, 0.6, 0, 1);
-    dJointSetTransmissionRatio(transmission, 2.0);
+    dBodyID gears[2];
+    dJointID transmission = Gears(gears);
     ssStepperDef def = Def();
     def.stepping.solver = SS_SOLVER_STEP;
     int refused = Make(def) != SS_OK || ssStepper_Step(stepper, 1.0 / 60, nullptr) != SS_OK;
