@@ -357,7 +357,7 @@ static int anyNonZero(const double* values) {
 }
 
 /* One body at the frame's start: 0 when its state or forces fail the check; else, with a force or torque (not all
- * zeros, -0 included: the largest magnitude is not 0) or carried momentum, its frame force read and the body marked
+ * zeros, -0 included: the largest magnitude is not 0) or a carried force, its frame force read and the body marked
  * pushed. */
 static int startBody(ssKnownBodies* known, int k, double max_speed2, double max_spin2) {
   const ssBodyValues* values = &known->values[k];
@@ -365,7 +365,7 @@ static int startBody(ssKnownBodies* known, int k, double max_speed2, double max_
   uint64_t largest = force > torque ? force : torque;
   if (!(stateWithin(values, max_speed2, max_spin2) & (largest <= magnitudeBits(SS_MAX_FORCE_N)))) return 0;
   ssKnownBody* body = &known->bodies[k];
-  if (largest == 0 && !(known->carrying && anyNonZero(body->carried))) return 1;
+  if (largest == 0 && !(known->carrying && anyNonZero(body->carried_force))) return 1;
   const dReal *f = values->force, *t = values->torque;
   double* frame = body->frame_force;
   frame[0] = f[0], frame[1] = f[1], frame[2] = f[2], frame[3] = t[0], frame[4] = t[1], frame[5] = t[2];

@@ -15,9 +15,11 @@
 
 typedef struct ssKnownBody {
   dBodyID body;
-  int pushed;            /* has a frame force or carried momentum this frame */
+  int pushed;            /* has a frame force or a carried force this frame */
   double frame_force[6]; /* force (N) and torque (N·m) the program added for this frame */
-  double carried[6];     /* momentum (N·s, N·m·s) of frames that took no step, delivered with the next steps */
+  /* the force and torque held over the time carried into this frame (FIXED's accumulator, a frame too short to
+   * step): the mean of the forces of the frames that time came from */
+  double carried_force[6];
 } ssKnownBody;
 
 /* Where ODE keeps a body's checked values: its getters return pointers into the body, which stay put for its life,
@@ -31,14 +33,14 @@ typedef struct ssBodyValues {
 } ssBodyValues;
 
 typedef struct ssKnownBodies {
-  ssKnownBody* bodies;    /* at a step, read for pushed bodies only (and for all while momentum is carried) */
+  ssKnownBody* bodies;    /* at a step, read for pushed bodies only (and for all while a force is carried) */
   dBodyID* ids;           /* bodies[i].body, packed */
   ssBodyValues* values;   /* bodies[i]'s values, packed: the checks read nothing else */
   dJointID* first_joints; /* each body's first joint when listed */
   int count;
   int* pushed; /* indices into bodies of those with pushed set, and only those */
   int pushed_count;
-  int carrying; /* whether any body may carry momentum */
+  int carrying; /* whether any body may carry a force */
   dBodyID* geared; /* the listed bodies a transmission joint gears (ODE aborts when one turns by pi in a step) */
   int geared_count;
   int valid;
@@ -48,7 +50,7 @@ typedef struct ssKnownBodies {
 void ssKnownFree(ssKnownBodies* known);
 
 /* Builds the list again from the registry's bodies (registry may be NULL) and the watched ones, with what they reach
- * through joints; a body that stays known keeps its frame force and carried momentum. Errors, with the list as it
+ * through joints; a body that stays known keeps its frame force and carried force. Errors, with the list as it
  * was: SS_ERROR_OUT_OF_MEMORY. */
 ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const dBodyID* watched, int watched_count);
 
@@ -85,7 +87,7 @@ ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, co
 
 /* Before a frame, one pass: *joints_changed says whether a body's first joint changed (then nothing else was done:
  * the caller rebuilds the list and calls again); else every body is checked as ssKnownCheck with state and forces,
- * and, all passing, its accumulators become its frame force (pushed marks a force or carried momentum). */
+ * and, all passing, its accumulators become its frame force (pushed marks a force or a carried force). */
 ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBodyID* failed, int* joints_changed);
 
 #endif

@@ -35,6 +35,8 @@ struct ssStepper {
   double tuned_step_s;         /* 0: none */
   ssAdoptReport adopted;       /* what adoption reached, summed */
   double previous_step_s; /* 0: no usable history */
+  double time_s;          /* simulated since ssStepper_Create: every step taken, added in order */
+  unsigned long row_order_seed; /* what ODE's generator is set to before each step (stepping.step_seed >= 0) */
   double accumulator_s;   /* FIXED: time not yet stepped */
   double short_frame_s;   /* other policies: frames too short to step, carried */
   dBodyID* watched;
@@ -101,8 +103,16 @@ static void describeNextStep(ssStepper* stepper) {
   const ssStepping* stepping = &stepper->def.stepping;
   double step_s = stepping->cut == SS_CUT_FIXED ? stepping->fixed_step_s : stepping->max_step_s;
   if (step_s == 0) step_s = stepping->cut == SS_CUT_FIXED ? stepping->max_step_s : stepping->fixed_step_s;
-  stepper->current =
-      (ssStepInfo){stepping->mapping, step_s, softnessStep(stepping, step_s), stepper->previous_step_s, 0, 1};
+  stepper->current = (ssStepInfo){stepping->mapping, step_s,           softnessStep(stepping, step_s),
+                                   stepper->previous_step_s, 0, 1, stepper->time_s};
+}
+
+/* A seed of its own for ODE's generator (splitmix64's finalizer): nearby seeds give unrelated row orders. */
+static unsigned long rowOrderSeed(uint64_t step_seed) {
+  uint64_t z = step_seed + 0x9e3779b97f4a7c15u;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
+  return (unsigned long)((z ^ (z >> 31)) & 0xffffffffu); /* ODE's generator keeps 32 bits */
 }
 
 /* The speed guard: 0 stands for the bound ODE itself needs. */
@@ -142,6 +152,7 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
     stepper->def.registry = registry;
   }
   resolveSpeeds(&stepper->def.stepping);
+  stepper->row_order_seed = rowOrderSeed(stepping.step_seed);
   stepper->contact_cache = ssContactCacheEmpty();
   describeNextStep(stepper);
   *out = stepper;
@@ -233,7 +244,7 @@ ssStatus ssStepper_DestroyJoint(ssStepper* stepper, dJointID joint) {
 
 static void forgetCarried(ssStepper* stepper) {
   for (int i = 0; i < stepper->known.count; ++i)
-    memset(stepper->known.bodies[i].carried, 0, sizeof stepper->known.bodies[i].carried);
+    memset(stepper->known.bodies[i].carried_force, 0, sizeof stepper->known.bodies[i].carried_force);
   stepper->known.carrying = 0;
 }
 
@@ -268,9 +279,11 @@ ssStatus ssStepper_SetStepping(ssStepper* stepper, const ssStepping* stepping) {
   if ((status = resolveSteps(&resolved, stepper->tuned_step_s)) != SS_OK) return status;
   stepper->def.stepping = resolved;
   resolveSpeeds(&stepper->def.stepping);
+  stepper->row_order_seed = rowOrderSeed(resolved.step_seed);
   stepper->previous_step_s = 0;
   stepper->accumulator_s = 0;
   stepper->short_frame_s = 0;
+  forgetCarried(stepper);
   ssPoseHistoryForget(stepper->poses);
   describeNextStep(stepper);
   return SS_OK;
@@ -287,7 +300,7 @@ ssStepping ssStepper_Stepping(const ssStepper* stepper) {
 ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper) {
   if (stepper != NULL) return stepper->current;
   ssFail(SS_ERROR_OUT_OF_RANGE, "stepper = NULL: a stepper is required");
-  return (ssStepInfo){SS_MAPPING_IMPLICIT_EULER, 0, 0, 0, 0, 0};
+  return (ssStepInfo){SS_MAPPING_IMPLICIT_EULER, 0, 0, 0, 0, 0, 0};
 }
 
 ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
@@ -404,46 +417,53 @@ static ssStatus findNew(ssStepper* stepper, int look_at_joints) {
   return status;
 }
 
-/* ---- the frame's forces ---- */
+/* ---- the frame's forces: held from one frame to the next (zero-order hold) ----
+ * A force the program adds once a frame is its input for that frame's time, as any input sampled once a frame: it
+ * acts at every step until the next frame's forces replace it. The time carried into a frame (FIXED's accumulator,
+ * a frame too short to step) belongs to the frames before, so the step that covers it gets their force for that
+ * share of its length: F·dt is exact over the run under every cut, and a force that does not change acts as itself,
+ * to the bit, at every step. */
 
-static int anyNonZero(const double* values) {
-  return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
-}
+/* a + (b - a)·w, and exactly b when w is 1 or b equals a. */
+static double blend(double a, double b, double w) { return w >= 1 || a == b ? b : a + (b - a) * w; }
 
-/* Before each of a frame's `steps` steps of step_s: each pushed body gets the force that delivers its frame's
- * momentum F·frame_s (plus what was carried) evenly over the frame's simulated time. A frame of one step of its own
- * length with nothing carried leaves the program's forces as it added them (F·h/h may differ from F in its last
- * bit): a naive stepper is then the program's own stepping bit for bit. */
-static void putForces(ssStepper* stepper, double frame_s, int steps, double step_s) {
-  double simulated_s = steps * step_s;
+/* Before the frame's step `index` of step_s: each pushed body gets its frame force; the first step, which covers
+ * carried_s of the frames before, gets the carried force for that share. The first step of a frame with nothing
+ * carried leaves the accumulators as the program set them (a naive stepper is its own stepping bit for bit). */
+static void putForces(ssStepper* stepper, int index, double step_s, double carried_s) {
+  if (index == 0 && carried_s == 0) return;
+  double carried_share = index == 0 ? carried_s / step_s : 0;
   for (int p = 0; p < stepper->known.pushed_count; ++p) {
     ssKnownBody* known = &stepper->known.bodies[stepper->known.pushed[p]];
-    if (steps == 1 && simulated_s == frame_s && !(stepper->known.carrying && anyNonZero(known->carried))) continue;
     double f[6];
-    for (int j = 0; j < 6; ++j) f[j] = (known->frame_force[j] * frame_s + known->carried[j]) / simulated_s;
+    for (int j = 0; j < 6; ++j) f[j] = blend(known->frame_force[j], known->carried_force[j], carried_share);
     dBodySetForce(known->body, f[0], f[1], f[2]);
     dBodySetTorque(known->body, f[3], f[4], f[5]);
   }
 }
 
-/* A frame that takes no step: its forces' momentum waits for the next steps (F·0 = 0 for a frame of 0 s), and the
- * accumulators are emptied so that the program's next additions are not counted twice. */
-static void carryForces(ssStepper* stepper, double frame_s) {
+/* A frame that takes no step: its time joins the carried time, and its force the carried force (their mean, by
+ * time), and the accumulators are emptied so that the program's next additions are not counted twice. */
+static void carryForces(ssStepper* stepper, double carried_s, double frame_s) {
+  double share = carried_s + frame_s > 0 ? frame_s / (carried_s + frame_s) : 0;
   for (int p = 0; p < stepper->known.pushed_count; ++p) {
     ssKnownBody* known = &stepper->known.bodies[stepper->known.pushed[p]];
-    for (int j = 0; j < 6; ++j) known->carried[j] += known->frame_force[j] * frame_s;
+    for (int j = 0; j < 6; ++j) known->carried_force[j] = blend(known->carried_force[j], known->frame_force[j], share);
     stepper->known.carrying = 1;
     dBodySetForce(known->body, 0, 0, 0);
     dBodySetTorque(known->body, 0, 0, 0);
   }
 }
 
-/* After a frame's steps: every body that carried momentum was pushed for them (ssKnownStartFrame), so none carries
- * now. */
-static void clearCarried(ssStepper* stepper) {
-  for (int p = 0; p < stepper->known.pushed_count; ++p)
-    memset(stepper->known.bodies[stepper->known.pushed[p]].carried, 0, sizeof stepper->known.bodies[0].carried);
-  stepper->known.carrying = 0;
+/* After a frame's steps: the time it leaves unstepped (remaining_s) carries its force; every body that carried a
+ * force was pushed (ssKnownStartFrame), so no other body carries one. */
+static void holdForces(ssStepper* stepper, double remaining_s) {
+  for (int p = 0; p < stepper->known.pushed_count; ++p) {
+    ssKnownBody* known = &stepper->known.bodies[stepper->known.pushed[p]];
+    if (remaining_s > 0) memcpy(known->carried_force, known->frame_force, sizeof known->carried_force);
+    else memset(known->carried_force, 0, sizeof known->carried_force);
+  }
+  stepper->known.carrying = remaining_s > 0 && stepper->known.pushed_count > 0;
 }
 
 /* ---- the checks at the boundary ---- */
@@ -492,10 +512,25 @@ static ssStatus refuseStep(ssStepper* stepper, ssStatus status, int index) {
   return latch(stepper, status);
 }
 
+/* ODE's step, with its generator set to the stepping's seed for it and put back after it (stepping.step_seed). */
+static int odeStep(ssStepper* stepper, double step_s) {
+  const ssStepping* stepping = &stepper->def.stepping;
+  dWorldID world = stepper->def.world;
+  if (stepping->step_seed < 0)
+    return stepping->solver == SS_SOLVER_STEP ? dWorldStep(world, step_s) : dWorldQuickStep(world, step_s);
+  unsigned long program_seed = dRandGetSeed();
+  uint64_t time_bits;
+  memcpy(&time_bits, &stepper->time_s, sizeof time_bits);
+  dRandSetSeed(rowOrderSeed(stepper->row_order_seed ^ time_bits));
+  int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(world, step_s) : dWorldQuickStep(world, step_s);
+  dRandSetSeed(program_seed);
+  return stepped;
+}
+
 /* Takes a frame's `steps` steps of step_s: everything else about them (mapping, the softness' step, history)
- * follows from the stepping. frame_s is the time whose forces' momentum the steps deliver. Errors of Apply leave
- * the world as the previous step left it; a failed check latches. */
-static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double frame_s, ssFrameReport* report) {
+ * follows from the stepping. carried_s is the time of earlier frames the first step covers (putForces). Errors of
+ * Apply leave the world as the previous step left it; a failed check latches. */
+static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double carried_s, ssFrameReport* report) {
   const ssStepperDef* def = &stepper->def;
   const ssStepping* stepping = &def->stepping;
   ssMapping mapping = stepping->mapping;
@@ -510,13 +545,13 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
     /* bodies made in the last step's callbacks (joints made there are found before the next frame) */
     ssStatus status = i == 0 ? SS_OK : findNew(stepper, 0);
     if (status != SS_OK) return status;
-    putForces(stepper, frame_s, steps, step_s);
+    putForces(stepper, i, step_s, carried_s);
     if (i == 0 || apply_every_step || stepper->apply_due) {
       stepper->apply_due = 0;
       if ((status = apply(stepper, mapping, softness_step_s, previous_step_s, &applied, report)) != SS_OK)
         return status;
     }
-    stepper->current = (ssStepInfo){mapping, step_s, softness_step_s, previous_step_s, i, steps};
+    stepper->current = (ssStepInfo){mapping, step_s, softness_step_s, previous_step_s, i, steps, stepper->time_s};
     if (def->before_step) def->before_step(def->before_step_context, stepper);
     if (!stepper->destroy_requested && def->collide) def->collide(def->collide_context, stepper);
     if (stepper->destroy_requested) { /* the frame stops here: this step is not taken */
@@ -532,14 +567,15 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
                         (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistoryBeforeLastStep(stepper->poses);
-    int stepped = stepping->solver == SS_SOLVER_STEP ? dWorldStep(def->world, step_s)
-                                                      : dWorldQuickStep(def->world, step_s);
+    int stepped = odeStep(stepper, step_s);
     if (def->contact_group) dJointGroupEmpty(def->contact_group);
     if (!stepped) return latch(stepper, ssFail(SS_ERROR_OUT_OF_MEMORY, "ODE ran out of memory in its step"));
     report->steps += 1;
     addServed(&report->rows, &applied.rows);
     report->step_s = step_s;
     report->simulated_s += step_s;
+    stepper->time_s += step_s;
+    report->time_s = stepper->time_s;
     if ((status = checkKnown(stepper, 0, "after", i, steps, step_s, report)) != SS_OK) return latch(stepper, status);
     stepper->previous_step_s = use_history ? step_s : 0;
     if (def->step_done) def->step_done(def->step_done_context, step_s);
@@ -551,32 +587,35 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double f
 /* x, or 0 for a negative x (fmax(x, 0) without a call into libm). */
 static double atLeastZero(double x) { return x > 0 ? x : 0; }
 
-/* WHOLE_FRAME: one step of the frame. SUBSTEPS: n equal substeps no longer than max_step_s, at most
- * max_steps_per_frame. A frame too short to step waits for the next one. */
+/* WHOLE_FRAME: one step of the frame. SUBSTEPS: one step up to (1 + max_step_slack)·max_step_s, else n equal
+ * substeps no longer than max_step_s, at most max_steps_per_frame (a longer frame, a breakpoint or a hitch, is cut
+ * off like the fixed cut's: the rest is dropped, and reported). A frame too short to step waits for the next one. */
 static ssStatus stepFrame(ssStepper* stepper, double frame_s, ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
-  double total_s = frame_s + stepper->short_frame_s;
+  double carried_s = stepper->short_frame_s;
+  double total_s = frame_s + carried_s;
   if (total_s < SS_MIN_STEP_S) {
     stepper->short_frame_s = total_s;
     report->carried_s = total_s;
-    carryForces(stepper, frame_s);
+    carryForces(stepper, carried_s, frame_s);
     return SS_OK;
   }
   int steps = 1;
-  /* a frame no longer than max_step_s is one step (the division would say so: total_s / max_step_s <= 1) */
-  if (stepping->cut == SS_CUT_SUBSTEPS && total_s > stepping->max_step_s) {
+  double step_s = total_s;
+  if (stepping->cut == SS_CUT_SUBSTEPS && total_s > stepping->max_step_s * (1 + stepping->max_step_slack)) {
     double count = ceil(total_s / stepping->max_step_s - kStepCountSlack);
-    steps = count < 1 ? 1 : count > stepping->max_steps_per_frame ? stepping->max_steps_per_frame : (int)count;
+    if (count > stepping->max_steps_per_frame) {
+      steps = stepping->max_steps_per_frame;
+      step_s = stepping->max_step_s;
+      report->dropped_s = total_s - steps * step_s;
+    } else if (count > 1) {
+      steps = (int)count;
+      step_s = total_s / steps;
+    }
   }
   stepper->short_frame_s = 0;
-  double step_s = steps == 1 ? total_s : total_s / steps;
-  if (stepping->cut == SS_CUT_SUBSTEPS && step_s > stepping->max_step_s * (1 + kStepCountSlack)) {
-    /* a long frame (a breakpoint, a hitch) is cut off like the fixed cut's: the rest is dropped, and reported */
-    step_s = stepping->max_step_s;
-    report->dropped_s = total_s - steps * step_s;
-  }
-  ssStatus status = takeSteps(stepper, steps, step_s, atLeastZero(frame_s - report->dropped_s), report);
-  clearCarried(stepper);
+  ssStatus status = takeSteps(stepper, steps, step_s, carried_s, report);
+  holdForces(stepper, 0);
   return status;
 }
 
@@ -586,7 +625,8 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
   double step_s = stepping->fixed_step_s;
   ssStatus status = ssPoseHistoryBeginFrame(&stepper->poses, stepper->known.ids, stepper->known.count);
   if (status != SS_OK) return status;
-  double accumulator_s = stepper->accumulator_s + frame_s;
+  double carried_s = stepper->accumulator_s;
+  double accumulator_s = carried_s + frame_s;
   double due = floor(accumulator_s / step_s + kStepCountSlack);
   int cap = stepping->max_steps_per_frame;
   if (due > cap) {
@@ -595,12 +635,12 @@ static ssStatus stepFixed(ssStepper* stepper, double frame_s, ssFrameReport* rep
     due = cap;
   }
   if (due == 0) {
-    carryForces(stepper, frame_s);
+    carryForces(stepper, carried_s, frame_s);
   } else {
-    status = takeSteps(stepper, (int)due, step_s, atLeastZero(frame_s - report->dropped_s), report);
-    clearCarried(stepper);
+    status = takeSteps(stepper, (int)due, step_s, carried_s, report);
   }
   stepper->accumulator_s = atLeastZero(accumulator_s - report->steps * step_s);
+  if (due > 0) holdForces(stepper, stepper->accumulator_s);
   report->carried_s = stepper->accumulator_s;
   report->interpolation = fmin(stepper->accumulator_s / step_s, nextafter(1.0, 0.0));
   ssPoseHistoryEndFrame(stepper->poses, report->steps, report->interpolation);
@@ -652,6 +692,7 @@ ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* repor
   }
   ssStatus status = startFrame(stepper, report);
   if (status != SS_OK) return status;
+  report->time_s = stepper->time_s;
   stepper->report = report;
   stepper->in_step = 1;
   status = stepper->def.stepping.cut == SS_CUT_FIXED ? stepFixed(stepper, frame_s, report)

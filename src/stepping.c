@@ -16,6 +16,8 @@ ssStepping ssDefaultStepping(void) {
       .quick_iterations = 0,
       .max_step_s = 0,
       .fixed_step_s = 0,
+      .max_step_slack = 0.25,
+      .step_seed = 0,
       .max_steps_per_frame = 32,
       .max_speed = 1e4,
       .max_angular_speed = 1e4,
@@ -58,7 +60,14 @@ ssStatus ssValidateStepping(const ssStepping* stepping) {
   if (stepping->max_steps_per_frame <= 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.max_steps_per_frame = %d: must be positive",
                   stepping->max_steps_per_frame);
-  ssStatus status = SS_OK;
+  if (stepping->step_seed < -1)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.step_seed = %d: must be >= 0 (a seed) or -1 (ODE's generator left "
+                  "alone)", stepping->step_seed);
+  ssStatus status = ssCheckNonNegative("stepping.max_step_slack", "(a fraction of max_step_s)", stepping->max_step_slack);
+  if (status == SS_OK && stepping->max_step_slack > 1)
+    status = ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.max_step_slack = %g: must be at most 1 (a step at most twice "
+                    "max_step_s)", stepping->max_step_slack);
+  if (status != SS_OK) return status;
   /* 0: the tuned step, resolved (or refused) by the stepper */
   if (stepping->max_step_s != 0) status = ssCheckStepLength("stepping.max_step_s", stepping->max_step_s);
   if (status == SS_OK && stepping->fixed_step_s != 0)
@@ -108,6 +117,9 @@ ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssSteppi
     stepping->cut = policies[i].cut;
     stepping->mapping = policies[i].mapping;
     stepping->frozen_step_s = policies[i].frozen ? reference_step_s : 0;
+    /* naive is the program's own loop, which leaves ODE's generator alone; the others make each step replayable */
+    if (policies[i].cut == SS_CUT_WHOLE_FRAME) stepping->step_seed = -1;
+    else if (stepping->step_seed < 0) stepping->step_seed = 0;
     return SS_OK;
   }
   char known[160] = "";

@@ -1,7 +1,9 @@
 /* steadystep: the stepper, one call per rendered frame instead of dWorldQuickStep.
  *
  * A frame of dt seconds becomes n = ceil(dt / max_step_s) equal substeps of h = dt / n (the article: "make sure to
- * specify a largest time step the simulation can handle"), at most stepping.max_steps_per_frame. Before each
+ * specify a largest time step the simulation can handle"), at most stepping.max_steps_per_frame; a frame at most
+ * stepping.max_step_slack longer than max_step_s is one step. Under SS_CUT_FIXED it becomes steps of fixed_step_s
+ * from an accumulator, the one way of stepping that makes motion identical at every frame rate. Before each
  * substep the stepper puts back the forces the program added for the frame, the registry rewrites every soft thing
  * for h, the program's callbacks run, the known bodies are checked, ODE steps with the ODE step the program named
  * and its own solver settings, the contact group is emptied and the known bodies are checked again.
@@ -12,7 +14,7 @@
  *     def.collide = collide; def.contact_group = contacts;   // collide calls dSpaceCollide(space, stepper, near)
  *     ssStepper* stepper; ssStepper_Create(&def, &stepper);
  *     for (;;) {
- *       add_forces();                                          // once a frame: they act for the whole frame
+ *       add_forces();                                          // once a frame: held until the next frame's
  *       ssFrameReport report;
  *       if (ssStepper_Step(stepper, frame_seconds, &report) != SS_OK) { ...repair or restore...;
  *                                                                        ssStepper_Reset(stepper); }
@@ -92,9 +94,14 @@ typedef struct ssStepInfo {
   double previous_step_s; /* the step before, for SS_MAPPING_EXACT (s); 0 when there is no usable history */
   int index;              /* 0-based index of this step within the frame */
   int count;              /* steps this frame takes */
+  /* the simulated time at this step's start (s): every step the stepper took since ssStepper_Create, added in
+   * order. Under SS_CUT_FIXED the n-th step starts at the same time, to the bit, whatever the frame rate: compute
+   * inputs that change with time (a motor's target, a script, a controller's set point) from it in before_step */
+  double time_s;
 } ssStepInfo;
 
-/** A callback before each physics step; ssStepper_CurrentStep(stepper) tells the step. */
+/** A callback before each physics step; ssStepper_CurrentStep(stepper) tells the step: its length (step_s) and the
+ *  simulated time at its start (time_s). */
 typedef void ssStepCallback(void* context, ssStepper* stepper);
 
 /** Called after each physics step that passed the checks, with its length (s); for recording. */
@@ -116,9 +123,11 @@ typedef struct ssStepperDef {
   ssRegistry* registry;
   /* How frames become steps (stepping.h); default ssDefaultStepping(), whose solver must be set. */
   ssStepping stepping;
-  /* Before each step, after the frame's forces were put back and the registry applied: add forces that depend on
-   * the state (PD controllers, drag, buoyancy). Forces that are constant over a frame can simply be added before
-   * ssStepper_Step. May be NULL. */
+  /* Before each step, after the frame's forces were put back and the registry applied: the program's per-step logic.
+   * Everything that depends on the state or on the simulated time belongs here (PD controllers, drag, buoyancy, a
+   * motor's target, a scripted event, input applied at a time), computed from ssStepper_CurrentStep's time_s and
+   * step_s: run once a frame instead, it makes the motion depend on the frame rate under every policy. Forces
+   * constant over a frame may be added before ssStepper_Step instead: they are held (ssStepper_Step). May be NULL. */
   ssStepCallback* before_step;
   void* before_step_context;
   /* Before each step, after before_step: run collision detection, e.g. dSpaceCollide(space, stepper, near), create
@@ -135,6 +144,9 @@ typedef struct ssFrameReport {
   int steps;                  /* physics steps taken */
   double step_s;              /* length of the last step taken (s); 0 when none */
   double simulated_s;         /* time simulated this frame (s) */
+  double time_s;              /* the stepper's simulated time after this frame (s): ssStepInfo.time_s of the next
+                               * step. Under SS_CUT_FIXED the same bits after the same number of steps whatever
+                               * the frame rate: the time to label a frame's state with */
   double carried_s;           /* time not simulated yet, carried to the next frame (s): FIXED's accumulator, or a
                                * frame shorter than SS_MIN_STEP_S */
   double dropped_s;           /* time dropped by stepping.max_steps_per_frame (s), never simulated */
@@ -169,14 +181,20 @@ SS_API void ssStepper_Destroy(ssStepper* stepper);
 
 /** Advances the world by one frame of frame_s seconds (0 <= frame_s <= SS_MAX_FRAME_S; 0 takes no step). report may
  *  be NULL.
- *  Forces and torques that the program added to known bodies before this call act for the whole frame: they are
- *  put back before every substep (ODE clears them after each step), and under SS_CUT_FIXED they are scaled so
- *  that the frame's steps deliver the momentum F·frame_s (carried to the next frame when this one takes no step).
- *  A frame of 0 s (or shorter than SS_MIN_STEP_S) takes no step: its forces are read and cleared (F·0 = 0 for 0 s;
- *  a shorter frame's momentum is carried), so they never act again with the next frame. A frame of one step of
- *  exactly its own length with nothing carried leaves the forces in ODE's accumulators as the program added them.
- *  Under SUBSTEPS and FIXED, time beyond max_steps_per_frame steps is dropped (report->dropped_s), with its share
- *  of the forces' momentum.
+ *  Held forces. Forces and torques that the program added to known bodies before this call are its input for this
+ *  frame's time, held like any input sampled once a frame (a zero-order hold): they act, unchanged, at every
+ *  physics step until the next frame's forces replace them (ODE clears its accumulators after each step: the
+ *  stepper puts them back). Time a frame leaves unstepped (FIXED's accumulator, a frame shorter than SS_MIN_STEP_S)
+ *  carries its force with it, and the step that later covers that time gets it for that share of its length. So
+ *  F·dt is exact over the run under every cut, frames with no step included, and a force added every frame with
+ *  the same value acts as itself at every step: under SS_CUT_FIXED the motion is then the same, to the bit, at every
+ *  frame rate. What this cannot hold is an input that varies within a frame (a force that follows the state or the
+ *  time): compute it per step in before_step, from ssStepper_CurrentStep's time_s and step_s. A frame that takes
+ *  no step clears the accumulators (its force is carried), so the program's next additions are not counted twice;
+ *  a frame's first step with nothing carried leaves them as the program added them. Time beyond
+ *  max_steps_per_frame steps is dropped (report->dropped_s) with its force.
+ *  QuickStep's row order: unless stepping.step_seed is -1 (naive), each step starts from the same state of ODE's
+ *  random generator (stepping.h), so a step depends only on the world.
  *  Errors, with the world left as it was: SS_ERROR_OUT_OF_RANGE (stepper NULL, frame_s out of range),
  *  SS_ERROR_NOT_FINITE (frame_s); SS_ERROR_REENTERED (called from one of its own callbacks; report untouched);
  *  errors of ssRegistry_Apply (found at the frame's first step: what can fail depends on the step length and the

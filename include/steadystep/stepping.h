@@ -52,6 +52,21 @@ typedef struct ssStepping {
    * (ssStepperDef.tuned_step_s, or the registry's), refused when it has none */
   double max_step_s;
   double fixed_step_s;     /* FIXED: the constant step (s), in the same range; default 0: the tuned step, as above */
+  /* SUBSTEPS: a frame up to (1 + max_step_slack)·max_step_s long is one step; a longer one is cut into
+   * n = ceil(frame / max_step_s) equal substeps as before, so no step is ever longer than that. In [0, 1]; default
+   * 0.25: a 60 fps frame with ordinary jitter (a 2 ms spread), a 59 Hz vsync frame or a frame time kept in a float
+   * (1/60 s as a float is 7e-10 s longer) takes one step of the tuned length's neighbourhood, not two; a frame a
+   * quarter longer than the step a program was tuned for is well inside what ODE steps stably. 0: every frame longer
+   * than max_step_s is split. */
+  double max_step_slack;
+  /* QuickStep's row order. >= 0: before every step ODE's global random generator (dRandSetSeed) is set to a value
+   * derived from this seed and the step's simulated start time (ssStepInfo.time_s), and put back as it was after the
+   * step, so that a step depends only on the world's state and its time: not on how many QuickSteps ran before it
+   * (in this world or any other in the process), and the program's own dRand sequence is neither read nor advanced
+   * by the stepper. Under SS_CUT_FIXED the n-th step has the same row order at every frame rate; each step's order
+   * differs from the last, as QuickStep's shuffling means it to (one order for every step biases a resting stack). -1: ODE's generator is left alone, as a program's own
+   * loop leaves it (the naive policy, the program's own stepping bit for bit). Default 0. */
+  int step_seed;
   /* SUBSTEPS and FIXED: the most physics steps a frame takes, > 0, against the spiral of death and a long frame
    * (a breakpoint, a hitch): the frame's time beyond them is dropped and reported (ssFrameReport.dropped_s).
    * Default 32: 0.53 s of simulated time a frame at 1/60 s steps (no frame of the lab's profiles comes near: its
@@ -92,14 +107,16 @@ SS_API int ssSteppingPolicyCount(void);
 /** The name of policy index (0 <= index < ssSteppingPolicyCount()), or NULL. */
 SS_API const char* ssSteppingPolicyNameAt(int index);
 
-/** Sets stepping's cut, mapping and frozen step to the policy's (the other fields are kept). reference_step_s (s,
+/** Sets stepping's cut, mapping, frozen step and step_seed use to the policy's (the other fields are kept): naive
+ *  sets step_seed to -1 (ODE's generator left alone, as the program's own loop leaves it); every other policy sets a
+ *  negative step_seed to 0 and keeps a seed the caller chose. reference_step_s (s,
  *  in the step range) is the length naive and substeps-frozen freeze their softness at, e.g. the step a program was tuned for.
  *  Errors, with stepping unchanged: SS_ERROR_PARSE for an unknown name (named, with the known ones);
  *  SS_ERROR_OUT_OF_RANGE for NULL or a reference_step_s out of range; SS_ERROR_NOT_FINITE. */
 SS_API ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssStepping* stepping);
 
-/** The name of the policy stepping is (cut, mapping and whether the softness is frozen), or NULL when it is no
- *  preset (e.g. whole frame with matched). */
+/** The name of the policy stepping is (cut, mapping and whether the softness is frozen; step_seed is not looked at),
+ *  or NULL when it is no preset (e.g. whole frame with matched). */
 SS_API const char* ssSteppingPolicyName(const ssStepping* stepping);
 
 #ifdef __cplusplus

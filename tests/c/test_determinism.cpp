@@ -70,9 +70,9 @@ const Pinned kPinned[] = {
 };
 #else
 const Pinned kPinned[] = {
-    {"chain", SS_SOLVER_QUICK, 0xeb18d208a81468aeULL},
+    {"chain", SS_SOLVER_QUICK, 0xc14ceb0ed803b7dfULL},
     {"chain", SS_SOLVER_STEP, 0x77d62c6d806702e9ULL},
-    {"buggy", SS_SOLVER_QUICK, 0x86d0c0ee60376a2fULL},
+    {"buggy", SS_SOLVER_QUICK, 0xb1c508f0a16d3bf6ULL},
     {"buggy", SS_SOLVER_STEP, 0x60dbe3f6626be7ebULL},
 };
 #endif

@@ -1,6 +1,10 @@
 // What a real ODE program does around the stepper: forces added once a frame, its own solver settings, contacts
 // softened in its own near callback. The truths: momentum F·dt, settings read back, the tuned softness.
+#include <algorithm>
 #include <cmath>
+#include <random>
+#include <functional>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
@@ -17,10 +21,27 @@ class ProgramTest : public OdeTest {};
 const char* const kPolicies[] = {"naive", "implicit-euler", "matched", "exact",
                               "fixed"};
 
-TEST_F(ProgramTest, AForceAddedOncePerFrameDeliversFdtPerFrameUnderEveryPolicy) {
-  const double force = 1.0, torque = 0.25, mass = 2.0;
-  // Frames of 50 ms with 1/60 s substeps, and frames shorter than the fixed step, which FIXED carries.
-  const std::vector<double> frames = {0.05, 0.05, 0.004, 0.05, 0.003, 0.002, 0.05, 1e-12, 0.05};
+// The impulse of forces held from frame to frame up to time t: frame i's force acts over its own time
+// [start_i, start_i + frame_i), integrated by hand over the piecewise-constant input.
+double HeldImpulse(const std::vector<double>& frames, const std::vector<double>& forces, double t) {
+  double impulse = 0, start = 0;
+  for (size_t i = 0; i < frames.size() && start < t; ++i) {
+    impulse += forces[i] * (std::min(start + frames[i], t) - start);
+    start += frames[i];
+  }
+  return impulse;
+}
+
+TEST_F(ProgramTest, AForceAddedOncePerFrameIsHeldAndDeliversFdtUnderEveryPolicy) {
+  const double mass = 2.0;
+  // 50 ms frames (1/60 s substeps), frames shorter than the fixed step, which FIXED carries, and frames of 0 s and
+  // 1e-12 s, which every cut carries; each frame its own force and torque.
+  const std::vector<double> frames = {0.05, 0.05, 0.004, 0.05, 0.003, 0.002, 0.05, 1e-12, 0.05, 0, 0.013, 0.021};
+  std::vector<double> forces, torques;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    forces.push_back(1.0 + 0.37 * std::sin(1.0 + 2.1 * i));
+    torques.push_back(0.25 - 0.11 * std::cos(0.3 + 1.7 * i));
+  }
   for (const char* policy : kPolicies) {
     dWorldSetGravity(world, 0, 0, 0);
     dBodyID body = MakeBody(mass);
@@ -35,25 +56,74 @@ TEST_F(ProgramTest, AForceAddedOncePerFrameDeliversFdtPerFrameUnderEveryPolicy) 
     ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
     ASSERT_EQ(ssStepper_WatchBody(stepper, body), SS_OK);
     double elapsed_s = 0;
-    for (double frame_s : frames) {
-      dBodyAddForce(body, force, 0, 0);  // once a frame, as a game loop does
-      dBodyAddTorque(body, 0, 0, torque);
+    std::vector<double> so_far;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      dBodyAddForce(body, forces[i], 0, 0);  // once a frame, as a game loop does
+      dBodyAddTorque(body, 0, 0, torques[i]);
       ssFrameReport report;
-      ASSERT_EQ(ssStepper_Step(stepper, frame_s, &report), SS_OK) << ssLastError();
-      elapsed_s += frame_s;
-      if (report.steps == 0) continue;  // its momentum is carried to the next frame that steps
-      // p = F·Σdt, L = τ·Σdt: every frame's whole impulse, whatever the substeps
+      ASSERT_EQ(ssStepper_Step(stepper, frames[i], &report), SS_OK) << ssLastError();
+      elapsed_s += frames[i];
+      so_far.push_back(frames[i]);
+      // what was stepped: every frame's time but what waits for the next step, which carries its own force
+      const double stepped_s = elapsed_s - report.carried_s;
+      EXPECT_NEAR(report.time_s, stepped_s, 1e-15) << policy << " frame " << i;
+      const double p = HeldImpulse(so_far, forces, stepped_s), l = HeldImpulse(so_far, torques, stepped_s);
       // in float measured up to 3e-7 relative (2.5 ε): the velocity is a float sum of the frames' impulses
-      EXPECT_NEAR(mass * dBodyGetLinearVel(body)[0], force * elapsed_s,
-                  IntegratedTolerance(1e-9, 1e-6 * force * elapsed_s))
-          << policy;
-      EXPECT_NEAR(inertia_zz * dBodyGetAngularVel(body)[2], torque * elapsed_s,
-                  IntegratedTolerance(1e-9, 1e-6 * torque * elapsed_s))
-          << policy;
+      EXPECT_NEAR(mass * dBodyGetLinearVel(body)[0], p, IntegratedTolerance(1e-9 * std::fabs(p), 1e-6 * p))
+          << policy << " frame " << i;
+      EXPECT_NEAR(inertia_zz * dBodyGetAngularVel(body)[2], l, IntegratedTolerance(1e-9 * std::fabs(l), 1e-6 * l))
+          << policy << " frame " << i;
     }
     ssStepper_Destroy(stepper);
     dBodyDestroy(body);
   }
+}
+
+// A force that does not change, added every frame, acts as itself at every step: under the fixed cut the body's
+// state after the n-th step is the same bits at every frame rate (the program's forces are never rescaled).
+TEST_F(ProgramTest, AConstantForceAddedEveryFrameGivesTheSameBitsAtEveryFrameRateUnderFixed) {
+  const double h = 1.0 / 60;
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> uniform_15_45(1.0 / 45, 1.0 / 15);
+  std::normal_distribution<double> jitter_60_2(1.0 / 60, 0.002);
+  const std::function<double()> frame_rates[] = {
+      [] { return 1.0 / 60; }, [] { return 1.0 / 144; }, [] { return 1.0 / 30; },
+      [&] { return uniform_15_45(random); }, [&] { return std::clamp(jitter_60_2(random), 0.0107, 0.0227); }};
+  std::vector<std::vector<double>> runs;
+  for (const auto& next_frame : frame_rates) {
+    dBodyID body = MakeBody(1.5);
+    dBodySetPosition(body, 0, 0, 10);
+    ssStepperDef def = TestStepperDef();
+    def.world = world;
+    ssSteppingForPolicy("fixed", h, &def.stepping);
+    def.stepping.fixed_step_s = h;
+    ssStepper* stepper = nullptr;
+    ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
+    ASSERT_EQ(ssStepper_WatchBody(stepper, body), SS_OK);
+    std::vector<double> states(121 * 3, std::nan(""));  // z, vx and spin after each frame's last step, up to 2 s
+    for (int steps = 0; steps < 120;) {
+      dBodyAddForce(body, 3.0, 0, 0);  // a constant wind, once a frame
+      dBodyAddTorque(body, 0, 0.7, 0);
+      ssFrameReport report;
+      ASSERT_EQ(ssStepper_Step(stepper, next_frame(), &report), SS_OK) << ssLastError();
+      steps += report.steps;
+      if (steps > 120) break;
+      states[3 * steps] = dBodyGetPosition(body)[2];
+      states[3 * steps + 1] = dBodyGetLinearVel(body)[0];
+      states[3 * steps + 2] = dBodyGetAngularVel(body)[1];
+    }
+    ssStepper_Destroy(stepper);
+    dBodyDestroy(body);
+    runs.push_back(states);
+  }
+  int shared = 0;
+  for (size_t r = 1; r < runs.size(); ++r)
+    for (size_t k = 0; k < runs[0].size(); ++k)
+      if (!std::isnan(runs[0][k]) && !std::isnan(runs[r][k])) {
+        ASSERT_EQ(std::memcmp(&runs[0][k], &runs[r][k], sizeof(double)), 0) << "frame rate " << r << " value " << k;
+        shared += 1;
+      }
+  EXPECT_GT(shared, 300) << "values compared at the steps the runs share";
 }
 
 TEST_F(ProgramTest, StateDependentForcesGoInBeforeStepWithTheStepsLength) {
