@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
         code = 1;
         break;
       }
-      time_s += report.simulated_s;
+      time_s = report.time_s; /* the stepper's clock: the same bits at the same step whatever the frame rate */
       frame = counts(&report);
     } else {
       dWorldQuickStep(world, frame_s);

@@ -1,9 +1,9 @@
-/* A stack of boxes as ODE programs write one: towers of up to eight 1 kg boxes on the ground, contacts softened by
- * a soft CFM alone (their ERP is the world's, ODE's default), contact feedback on every ground contact to read the
- * load the ground carries, body damping and auto-disable counted in steps, and the top box of the first tower nudged
- * back and forth by a force added every frame for the first three seconds. The world's ERP/CFM are ODE's defaults.
- * This is stack_ode.c adopted with steadystep: the lines marked "steadystep" take over what it tuned, and the stepper
- * steps each frame.
+/* A stack of boxes as ODE programs write one: towers of up to eight 1 kg boxes on the ground, contacts softened by a
+ * soft CFM alone (their ERP is the world's, ODE's default), contact feedback on every ground contact to read the load
+ * the ground carries, body damping and auto-disable counted in steps, and the top box of the first tower nudged back
+ * and forth by a force added every frame for the first three seconds. The world's ERP/CFM are ODE's defaults. This is
+ * stack_ode.c adopted with steadystep: the lines marked "steadystep" take over what it tuned, run its per-frame logic
+ * before every physics step at that step's time, and the stepper steps each frame.
  *
  *   stack_steadystep --policy implicit-euler --profile uniform:15:45 [--boxes 8] > run.csv      (t_s,top_z_m,ground_force_N)
  *
@@ -89,10 +89,17 @@ static void build(void) {
   }
 }
 
-/* The frame's nudge on the first tower's top box (N), from the clock. */
+/* The nudge on the first tower's top box (N), from the clock. */
 static void nudge(double time_s) {
   dBodyID top = boxes[(box_count < TOWER_HEIGHT ? box_count : TOWER_HEIGHT) - 1];
   if (time_s < 3.0) dBodyAddForce(top, 1.5 * sin(2 * M_PI * time_s / 1.5), 0, 0);
+}
+
+/* steadystep: the program's per-step logic (the nudge on the top box) runs before every physics step, at that step's simulated
+ * time: run once a frame, it would make the motion depend on the frame rate under every policy. */
+static void beforeStep(void* context, ssStepper* stepper) {
+  (void)context;
+  nudge(ssStepper_CurrentStep(stepper).time_s);
 }
 
 /* The ground's load is the z force on the boxes at the ground contacts of the last step. A sleeping stack makes no
@@ -136,6 +143,7 @@ int main(int argc, char** argv) {
   def.space = space;
   def.tuned_step_s = 1.0 / 60;
   def.stepping = stepping;
+  def.before_step = beforeStep;
   def.collide = collide;
   def.contact_group = contacts;
   ssStepper* stepper = NULL;
@@ -150,14 +158,13 @@ int main(int argc, char** argv) {
   ExampleClock started = exampleClock();
   for (double time_s = 0; time_s < flags.duration_s - 1e-12;) {
     double frame_s = fmin(ssProfile_Next(flags.frames), flags.duration_s - time_s);
-    nudge(time_s);
     ssFrameReport report;
     if (ssStepper_Step(stepper, frame_s, &report) != SS_OK) { /* steadystep: a failed stepper refuses later frames */
       fprintf(stderr, PROGRAM ": t = %.6g s: %s\n", time_s, ssLastError());
       code = 1;
       break;
     }
-    time_s += report.simulated_s; /* under the fixed policy, part of a frame may wait for the next one */
+    time_s = report.time_s; /* the stepper's clock: under fixed, part of a frame may wait for the next one */
     if (!record(&flags, time_s)) {
       fprintf(stderr, PROGRAM ": t = %.6g s: the boxes' state is not finite\n", time_s);
       code = 1;

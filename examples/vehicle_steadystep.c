@@ -1,8 +1,9 @@
 /* A car as ODE programs write one: a box chassis on four sphere wheels, each on a hinge-2 joint whose axis 1 is the
  * steering and suspension axis and axis 2 the wheel's spin. The rear wheels are driven by their axis-2 motors, the
  * front wheels steered by their axis-1 motors, and air drag is added to the chassis every frame. It drives over a
- * ground plane and a row of speed bumps. Its ERP/CFM numbers were tuned at 60 fps. This is vehicle_ode.c adopted
- * with steadystep: the lines marked "steadystep" take over what it tuned, and the stepper steps each frame.
+ * ground plane and a row of speed bumps. Its ERP/CFM numbers were tuned at 60 fps. This is vehicle_ode.c adopted with
+ * steadystep: the lines marked "steadystep" take over what it tuned, run its per-frame logic before every physics step
+ * at that step's time, and the stepper steps each frame.
  *
  *   vehicle_steadystep --policy implicit-euler --profile uniform:15:45 --duration 10 > run.csv      (t_s,height_m,pitch_rad)
  *
@@ -96,7 +97,7 @@ static void build(void) {
   }
 }
 
-/* The frame's input: throttle (a speed target for the rear motors), steering and air drag, from the clock. */
+/* The input: throttle (a speed target for the rear motors), steering and air drag, from the clock. */
 static void drive(double time_s) {
   double speed = fmin(1.5 * time_s, 9.0); /* m/s */
   double steer = 0.12 * sin(2 * M_PI * time_s / 4.0);
@@ -116,6 +117,13 @@ static void drive(double time_s) {
 }
 
 /* Height (m) and pitch (rad, nose up > 0): the chassis' forward axis is the first column of its rotation. */
+/* steadystep: the program's per-step logic (throttle, steering and drag) runs before every physics step, at that step's simulated
+ * time: run once a frame, it would make the motion depend on the frame rate under every policy. */
+static void beforeStep(void* context, ssStepper* stepper) {
+  (void)context;
+  drive(ssStepper_CurrentStep(stepper).time_s);
+}
+
 static int record(const ExampleFlags* flags, double time_s) {
   const dReal* r = dBodyGetRotation(chassis);
   double values[2] = {dBodyGetPosition(chassis)[2], atan2(r[8], hypot(r[0], r[4]))};
@@ -140,6 +148,7 @@ int main(int argc, char** argv) {
   def.space = space;
   def.tuned_step_s = 1.0 / 60;
   def.stepping = stepping;
+  def.before_step = beforeStep;
   def.collide = collide;
   def.contact_group = contacts;
   ssStepper* stepper = NULL;
@@ -154,14 +163,13 @@ int main(int argc, char** argv) {
   ExampleClock started = exampleClock();
   for (double time_s = 0; time_s < flags.duration_s - 1e-12;) {
     double frame_s = fmin(ssProfile_Next(flags.frames), flags.duration_s - time_s);
-    drive(time_s);
     ssFrameReport report;
     if (ssStepper_Step(stepper, frame_s, &report) != SS_OK) { /* steadystep: a failed stepper refuses later frames */
       fprintf(stderr, PROGRAM ": t = %.6g s: %s\n", time_s, ssLastError());
       code = 1;
       break;
     }
-    time_s += report.simulated_s; /* under the fixed policy, part of a frame may wait for the next one */
+    time_s = report.time_s; /* the stepper's clock: under fixed, part of a frame may wait for the next one */
     if (!record(&flags, time_s)) {
       fprintf(stderr, PROGRAM ": t = %.6g s: the chassis' state is not finite\n", time_s);
       code = 1;

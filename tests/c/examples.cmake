@@ -53,6 +53,15 @@ endforeach()
 # on its own) are the same bytes under naive. Chaotic: a difference of one rounding would show within seconds.
 foreach(profile fixed:60 fixed:30 uniform:15:45 fixed:120)
   string(REPLACE ":" "_" profile_name ${profile})
+  # The game-like program (examples/wrecking_arm.c) likewise: its logic once a frame on its own, before every step
+  # adopted, and its wind added once a frame either way.
+  add_test(NAME example_wrecking_arm_naive_is_own_stepping_${profile_name}
+           COMMAND sh -c "\"$1\" --profile $3 --duration 10 --seed 3 | cut -d, -f1-4 > \"$2.ode.csv\" && \
+\"$1\" --policy naive --profile $3 --duration 10 --seed 3 | cut -d, -f1-4 > \"$2.naive.csv\" && \
+rows=$(wc -l < \"$2.ode.csv\") && test \"$rows\" -gt 100 && cmp \"$2.ode.csv\" \"$2.naive.csv\" && \
+echo \"$rows rows, byte-identical\""
+                   sh $<TARGET_FILE:steadystep_example_wrecking_arm>
+                   ${CMAKE_CURRENT_BINARY_DIR}/example_wrecking_arm_naive_${profile_name} ${profile})
   add_test(NAME example_audit_pendulum_naive_is_own_stepping_${profile_name}
            COMMAND sh -c "\"$1\" --profile $3 --duration 10 --seed 3 | cut -d, -f1-3 > \"$2.ode.csv\" && \
 \"$1\" --policy naive --profile $3 --duration 10 --seed 3 | cut -d, -f1-3 > \"$2.naive.csv\" && \
@@ -60,6 +69,28 @@ rows=$(wc -l < \"$2.ode.csv\") && test \"$rows\" -gt 100 && cmp \"$2.ode.csv\" \
 echo \"$rows rows, byte-identical\""
                    sh $<TARGET_FILE:steadystep_example_audit_pendulum>
                    ${CMAKE_CURRENT_BINARY_DIR}/example_audit_pendulum_naive_${profile_name} ${profile})
+endforeach()
+
+# The game-like program steps 10 s of 15-45 fps frames under every policy, and on its own.
+foreach(policy ${STEADYSTEP_EXAMPLE_POLICIES})
+  add_test(NAME example_wrecking_arm_${policy}_uniform
+           COMMAND sh -c "\"$1\" --policy $2 --profile uniform:15:45 --duration 10 --seed 1 > /dev/null"
+                   sh $<TARGET_FILE:steadystep_example_wrecking_arm> ${policy})
+endforeach()
+
+# Identical motion at every frame rate, the README's way: each program adopted under fixed, its per-step logic in
+# before_step at the step's time, forces added once a frame held, rows labelled with the stepper's clock, prints the
+# same bytes at every simulated time its runs at 144, 60, 30, 15-45 (three seeds) and jittered 60 fps share.
+foreach(program vehicle_steadystep:3 chain_steadystep:3 stack_steadystep:3 audit_pendulum:3 wrecking_arm:4
+                oscillator:5)
+  string(REPLACE ":" ";" parts ${program})
+  list(GET parts 0 name)
+  list(GET parts 1 columns)
+  add_test(NAME example_${name}_fixed_is_the_same_at_every_frame_rate
+           COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/tests/c/same_at_every_rate.sh $<TARGET_FILE:steadystep_example_${name}>
+                   ${columns} ${CMAKE_CURRENT_BINARY_DIR}/example_${name}_fixed --duration 10)
+  set_tests_properties(example_${name}_fixed_is_the_same_at_every_frame_rate PROPERTIES PASS_REGULAR_EXPRESSION
+                       "rows at shared times, byte-identical")
 endforeach()
 
 set_tests_properties(example_vehicle_csv_header PROPERTIES PASS_REGULAR_EXPRESSION
