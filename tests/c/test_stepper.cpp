@@ -2,6 +2,7 @@
 // world as it was, blow-up and speed checks, and the Nyquist report.
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -386,6 +387,119 @@ TEST_F(StepperTest, ALongSubstepFrameIsCappedAndTheDroppedTimeReported) {
   EXPECT_NEAR(report.simulated_s, 5.0 / 60, 1e-15);
   EXPECT_NEAR(report.dropped_s, 10.0 - 5.0 / 60, 1e-12);
   EXPECT_EQ(ssDefaultStepping().max_steps_per_frame, 32);
+}
+
+// The slack: a frame a little longer than the largest step (jitter, a 59 Hz display, a frame time kept in a float)
+// is one step, not two; beyond the slack the frame is cut as before, and no step is ever longer than the slack
+// allows: the guard against instability stays.
+TEST_F(StepperTest, AFrameWithinTheSlackIsOneStepAndNoStepIsLongerThanTheSlackAllows) {
+  const double max_step_s = 1.0 / 60;
+  for (double slack : {0.25, 0.0, 1.0}) {
+    OscillatorRig rig;
+    rig.def.stepping.max_step_slack = slack;
+    ASSERT_EQ(rig.Build(), SS_OK);
+    std::vector<double> frames = {max_step_s * (1 + 1e-9), 1.0 / 59, static_cast<float>(1.0 / 60),
+                                  max_step_s * (1 + slack), max_step_s * (1 + slack) * (1 + 1e-6), 0.05, 0.1};
+    for (int i = 0; i < 400; ++i) frames.push_back(1e-3 + 0.16 * std::fabs(std::sin(1.3 * i + 0.2)));
+    for (double frame_s : frames) {
+      ssFrameReport report;
+      ASSERT_EQ(ssStepper_Step(rig.stepper, frame_s, &report), SS_OK) << ssLastError();
+      // the rule, stated on its own: one step within the slack, else ceil(frame / max) equal steps
+      int expected = frame_s <= max_step_s * (1 + slack) ? 1 : static_cast<int>(std::ceil(frame_s / max_step_s - 1e-9));
+      EXPECT_EQ(report.steps, expected) << "slack " << slack << ", frame " << frame_s;
+      // frame times are sums of floating-point parts: 1e-9 of a step is the rounding the cut forgives (stepper.c)
+      EXPECT_LE(report.step_s, max_step_s * (1 + slack) * (1 + 2e-9)) << "slack " << slack << ", frame " << frame_s;
+      EXPECT_NEAR(report.simulated_s, frame_s, 1e-15);
+    }
+  }
+  ssStepping stepping = TestStepping();
+  for (double bad : {-0.1, 1.5, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    stepping.max_step_slack = bad;
+    EXPECT_NE(ssValidateStepping(&stepping), SS_OK) << bad;
+    EXPECT_NE(std::string(ssLastError()).find("stepping.max_step_slack"), std::string::npos) << ssLastError();
+  }
+  stepping = TestStepping();
+  stepping.step_seed = -2;
+  EXPECT_EQ(ssValidateStepping(&stepping), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("stepping.step_seed = -2"), std::string::npos) << ssLastError();
+  EXPECT_EQ(ssDefaultStepping().max_step_slack, 0.25);
+}
+
+// A chain of capsules on ball joints from the static world, its end pushed: QuickStep's row order matters to it.
+struct BallChain {
+  std::vector<dBodyID> links;
+  BallChain(dWorldID world, int count) {
+    dMass mass;
+    dMassSetCapsuleTotal(&mass, 1, 3, 0.05, 0.3);
+    for (int i = 0; i < count; ++i) {
+      dBodyID link = dBodyCreate(world);
+      dBodySetMass(link, &mass);
+      dBodySetPosition(link, 0.4 * (i + 0.5), 0, 2);
+      dJointID ball = dJointCreateBall(world, 0);
+      dJointAttach(ball, link, i == 0 ? nullptr : links.back());
+      dJointSetBallAnchor(ball, 0.4 * i, 0, 2);
+      links.push_back(link);
+    }
+  }
+  std::vector<double> State() const {
+    std::vector<double> state;
+    for (dBodyID link : links)
+      for (const dReal* v : {dBodyGetPosition(link), dBodyGetLinearVel(link), dBodyGetAngularVel(link)})
+        state.insert(state.end(), v, v + 3);
+    return state;
+  }
+};
+
+// Runs a chain under implicit Euler for 120 frames of varying length; between frames, `elsewhere` QuickSteps of
+// another world (other code in the process using ODE's generator). Returns every frame's state, and whether ODE's
+// generator was left as the program had it across each frame.
+std::vector<double> ChainRun(int step_seed, int elsewhere, bool* generator_untouched) {
+  dWorldID world = dWorldCreate(), other = dWorldCreate();
+  dWorldSetGravity(world, 0, 0, -9.81);
+  BallChain chain(world, 6), other_chain(other, 4);
+  dRandSetSeed(1234);
+  ssStepperDef def = TestStepperDef();
+  def.world = world;
+  def.stepping.step_seed = step_seed;
+  ssStepper* stepper = nullptr;
+  EXPECT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
+  EXPECT_EQ(ssStepper_WatchBody(stepper, chain.links[0]), SS_OK);
+  std::vector<double> states;
+  *generator_untouched = true;
+  for (int frame = 0; frame < 120; ++frame) {
+    for (int i = 0; i < elsewhere * (frame % 3); ++i) dWorldQuickStep(other, 0.01);
+    dBodyAddForce(chain.links.back(), 5 * std::sin(0.1 * frame), 2, 0);
+    unsigned long before = dRandGetSeed();
+    EXPECT_EQ(ssStepper_Step(stepper, 0.01 + 0.03 * std::fabs(std::sin(0.7 * frame)), nullptr), SS_OK);
+    *generator_untouched = *generator_untouched && dRandGetSeed() == before;
+    std::vector<double> state = chain.State();
+    states.insert(states.end(), state.begin(), state.end());
+  }
+  ssStepper_Destroy(stepper);
+  dWorldDestroy(other);
+  dWorldDestroy(world);
+  return states;
+}
+
+TEST_F(StepperTest, AStepDependsOnTheWorldNotOnQuickStepsTakenElsewhere) {
+  bool untouched_alone, untouched_interleaved;
+  std::vector<double> alone = ChainRun(0, 0, &untouched_alone);
+  std::vector<double> interleaved = ChainRun(0, 2, &untouched_interleaved);
+  ASSERT_EQ(alone.size(), interleaved.size());
+  EXPECT_EQ(std::memcmp(alone.data(), interleaved.data(), alone.size() * sizeof(double)), 0)
+      << "another world's QuickSteps changed this world's steps";
+  EXPECT_TRUE(untouched_alone && untouched_interleaved) << "the program's dRand sequence was read or advanced";
+  EXPECT_GT(std::fabs(alone[alone.size() - 9] - alone[0]), 1e-3) << "the chain moved";
+  // The control: with ODE's generator left alone (-1, naive's way), the same two runs part, and the steps advance
+  // the program's generator, as its own loop's do.
+  bool untouched;
+  std::vector<double> own_alone = ChainRun(-1, 0, &untouched);
+  EXPECT_FALSE(untouched);
+  std::vector<double> own_interleaved = ChainRun(-1, 2, &untouched);
+  EXPECT_NE(std::memcmp(own_alone.data(), own_interleaved.data(), own_alone.size() * sizeof(double)), 0);
+  // A different seed is a different (equally reproducible) row order.
+  std::vector<double> other_seed = ChainRun(7, 0, &untouched);
+  EXPECT_NE(std::memcmp(alone.data(), other_seed.data(), alone.size() * sizeof(double)), 0);
 }
 
 TEST_F(StepperTest, WithASpaceTheStepperAdoptsIntoARegistryOfItsOwnAtTheTunedStep) {
