@@ -93,6 +93,24 @@ foreach(program vehicle_steadystep:3 chain_steadystep:3 stack_steadystep:3 audit
                        "rows at shared times, byte-identical")
 endforeach()
 
+# A 60 fps game with ordinary jitter, or on a 59 Hz display, takes about one physics step a frame under implicit
+# Euler (the slack, stepping.h), not 1.5: the steps column of the audit programs' rows, averaged over 20 s.
+foreach(program audit_pendulum:4 wrecking_arm:5)
+  string(REPLACE ":" ";" parts ${program})
+  list(GET parts 0 name)
+  list(GET parts 1 steps_column)
+  foreach(profile jitter:60:2 vsync:60:59)
+    string(REPLACE ":" "_" profile_name ${profile})
+    add_test(NAME example_${name}_about_one_step_a_frame_at_${profile_name}
+             COMMAND sh -c "\"$1\" --policy implicit-euler --profile $2 --duration 20 | awk -F, -v c=$3 \
+'NR > 2 { steps += $c; frames += 1 } END { ok = frames > 1000 && steps / frames <= 1.05; \
+printf \"%.4f steps a frame over %d frames: %s\\n\", steps / frames, frames, ok ? \"at most 1.05\" : \"too many\" }'"
+                     sh $<TARGET_FILE:steadystep_example_${name}> ${profile} ${steps_column})
+    set_tests_properties(example_${name}_about_one_step_a_frame_at_${profile_name} PROPERTIES
+                         PASS_REGULAR_EXPRESSION "steps a frame over [0-9]+ frames: at most 1.05")
+  endforeach()
+endforeach()
+
 set_tests_properties(example_vehicle_csv_header PROPERTIES PASS_REGULAR_EXPRESSION
                      "^t_s,height_m,pitch_rad\n0,[^\n]+\n0\\.0333")
 set_tests_properties(example_chain_csv_header PROPERTIES PASS_REGULAR_EXPRESSION
