@@ -121,20 +121,20 @@ add_test(NAME example_stack_bad_boxes
          COMMAND sh -c "\"$1\" --boxes 0 2>&1; echo exit $?" sh $<TARGET_FILE:steadystep_example_stack_steadystep>)
 set_tests_properties(example_stack_bad_boxes PROPERTIES PASS_REGULAR_EXPRESSION "--boxes 0: [^\n]*\nexit 2\n")
 
-# The README's code: its C block compiled as C and as C++ against the library (stubs for the program around it in
-# tests/c/readme_snippet.sh, not in the README), and its diff the output of the command it names (scripts/readme-diff
-# rewrites it).
+# The README's code: its C blocks compiled as C and as C++ against the library (stubs for the program around it in
+# tests/c/readme_snippet.sh, not in the README), and docs/adopting.md's diff the output of the command it names
+# (scripts/adopting-diff rewrites it).
 if(NOT STEADYSTEP_SANITIZE)  # a sanitized library needs its runtime linked first, as for the install test
   set(readme_ode_runpath "")  # an ODE outside the system's directories (STEADYSTEP_ODE_PREFIX) is found at run time
   foreach(dir ${ODE_LIBRARY_DIRS})
     list(APPEND readme_ode_runpath "-Wl,-rpath,${dir}")
   endforeach()
-  add_test(NAME readme_c_block_compiles_as_c_and_cpp
+  add_test(NAME readme_c_blocks_compile_as_c_and_cpp
            COMMAND sh ${PROJECT_SOURCE_DIR}/tests/c/readme_snippet.sh ${PROJECT_SOURCE_DIR}/README.md
                    ${CMAKE_C_COMPILER} ${CMAKE_CXX_COMPILER} ${CMAKE_CURRENT_BINARY_DIR}/readme_snippet
                    $<TARGET_FILE:steadystep> ${PROJECT_SOURCE_DIR}/include ${ODE_CFLAGS} ${ODE_LDFLAGS}
                    ${readme_ode_runpath})
 endif()
 find_package(Python3 COMPONENTS Interpreter REQUIRED)
-add_test(NAME readme_diff_is_current
-         COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/scripts/readme-diff --check)
+add_test(NAME adopting_diff_is_current
+         COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/scripts/adopting-diff --check)
