@@ -38,14 +38,23 @@ class Stepping:
     quick_iterations: int = _DEFAULT.quick_iterations  # QuickStep iterations set before each frame; 0: the world's
     max_step_s: float = _DEFAULT.max_step_s            # SUBSTEPS: the longest substep (s); 0 (default): the tuned
     fixed_step_s: float = _DEFAULT.fixed_step_s        # FIXED: the constant step (s); 0 (default): the tuned step
+    # SUBSTEPS: a frame up to (1 + max_step_slack)·max_step_s long is one step (a longer one: equal substeps of at
+    # most max_step_s), in [0, 1], a fraction (no unit); default 0.25; 0: every frame longer than max_step_s is split
+    max_step_slack: float = _DEFAULT.max_step_slack
+    # QuickStep's row order: >= 0 (default 0) sets ODE's random generator before every step from this seed and the
+    # step's simulated start time (s), and puts it back after, so a step depends only on the world and its time;
+    # -1: ODE's generator left alone, as the program's own loop leaves it (the naive policy)
+    step_seed: int = _DEFAULT.step_seed
     max_steps_per_frame: int = _DEFAULT.max_steps_per_frame  # steps a frame at most (the rest dropped, reported)
     max_speed: float = _DEFAULT.max_speed              # m/s above which a known body is a runaway; 0: ODE's guard
     max_angular_speed: float = _DEFAULT.max_angular_speed  # rad/s, likewise
 
     @classmethod
     def for_policy(cls, policy: str, reference_step_s: float = 1.0 / 60.0, **fields) -> "Stepping":
-        """The named preset's cut, mapping and frozen step (policy_names()) over Stepping(**fields).
-        reference_step_s (s) is the step naive freezes its softness at, e.g. the step the program was tuned for.
+        """The named preset's cut, mapping, frozen step and step_seed use (policy_names()) over Stepping(**fields):
+        naive sets step_seed to -1 (ODE's generator left alone), every other preset a negative step_seed to 0 and
+        keeps one chosen. reference_step_s (s) is the step naive freezes its softness at, e.g. the step the program
+        was tuned for.
         Raises SteadystepError ("parse error") naming an unknown policy."""
         out = ffi.new("ssStepping*", cls(**fields).as_c_fields())
         check(lib.ssSteppingForPolicy(c_string("policy", policy), number("reference_step_s", reference_step_s, "s"),
@@ -57,7 +66,8 @@ class Stepping:
         """The Stepping of a C ssStepping."""
         return cls(cut=FrameCut(cdata.cut), mapping=Mapping(cdata.mapping), frozen_step_s=cdata.frozen_step_s,
                    solver=Solver(cdata.solver), quick_iterations=cdata.quick_iterations, max_step_s=cdata.max_step_s,
-                   fixed_step_s=cdata.fixed_step_s, max_steps_per_frame=cdata.max_steps_per_frame,
+                   fixed_step_s=cdata.fixed_step_s, max_step_slack=cdata.max_step_slack,
+                   step_seed=cdata.step_seed, max_steps_per_frame=cdata.max_steps_per_frame,
                    max_speed=cdata.max_speed, max_angular_speed=cdata.max_angular_speed)
 
     def as_c_fields(self) -> dict:
@@ -77,7 +87,8 @@ class Stepping:
 
     @property
     def policy(self) -> str | None:
-        """The name of the preset this stepping is, or None (e.g. the whole frame with matched)."""
+        """The name of the preset this stepping is (step_seed not looked at), or None (e.g. the whole frame with
+        matched)."""
         return text(lib.ssSteppingPolicyName(ffi.new("ssStepping*", self.as_c_fields())))
 
 

@@ -73,6 +73,32 @@ def test_the_stepping_defaults_and_presets_are_the_librarys():
         ss.Stepping(cut="x").validate()
 
 
+def test_every_stepping_field_round_trips_through_c():
+    """Each field set to a value unlike its default comes back from the C struct as it went in, with its type."""
+    chosen = ss.Stepping(cut=ss.FrameCut.FIXED, mapping=ss.Mapping.MATCHED, frozen_step_s=1 / 50,
+                         solver=ss.Solver.STEP, quick_iterations=7, max_step_s=1 / 90, fixed_step_s=1 / 120,
+                         max_step_slack=0.5, step_seed=12345, max_steps_per_frame=9, max_speed=50.0,
+                         max_angular_speed=60.0)
+    default = ss.Stepping()
+    assert all(getattr(chosen, f.name) != getattr(default, f.name) for f in dataclasses.fields(ss.Stepping))
+    back = ss.Stepping.from_c(ffi.new("ssStepping*", chosen.as_c_fields())[0])
+    assert back == chosen
+    assert type(back.max_step_slack) is float and type(back.step_seed) is int
+    # The library's defaults: a quarter of slack, seed 0; naive leaves ODE's generator alone, the others seed it.
+    assert (default.max_step_slack, default.step_seed) == (0.25, 0)
+    assert ss.Stepping.for_policy("naive").step_seed == -1
+    for name in ("implicit-euler", "fixed"):
+        assert ss.Stepping.for_policy(name, step_seed=-1).step_seed == 0
+        assert ss.Stepping.for_policy(name, step_seed=7).step_seed == 7
+    quick = ss.Stepping(solver=ss.Solver.QUICK, max_step_s=1 / 60)
+    with pytest.raises(ss.SteadystepError, match="stepping.max_step_slack = 1.5"):
+        dataclasses.replace(quick, max_step_slack=1.5).validate()
+    with pytest.raises(ss.SteadystepError, match="stepping.step_seed = -2"):
+        dataclasses.replace(quick, step_seed=-2).validate()
+    with pytest.raises(ss.SteadystepError, match="stepping.step_seed"):
+        dataclasses.replace(quick, step_seed=2**31).as_c_fields()  # beyond C's int, named before C sees it
+
+
 def test_the_run_bound_is_the_c_librarys():
     from steadystep.limits import MAX_RUN_FRAMES, MAX_RUN_STEPS
     header = (Path(ss.__file__).parent / "_native" / "include" / "steadystep" / "lab" / "scene.h").read_text()
