@@ -20,12 +20,16 @@
  *   ssAuditHeader(&flags, "t_s,height_m,pitch_rad", 1);              // 1: with the optional count columns
  *   for (double t = 0; ssAuditRunning(&flags, t);) {
  *     double frame_s = ssAuditNextFrame(&flags, t);
- *     ... the frame: forces, ssStepper_Step(stepper, frame_s, &report) ...
- *     t += report.simulated_s;
+ *     ... the frame: input added once a frame, ssStepper_Step(stepper, frame_s, &report) ...
+ *     t = report.time_s;                                               // the stepper's clock
  *     ssAuditFrame frame = {report.steps, {...}};                     // the report's counts (ssAuditServed)
  *     if (!ssAuditRow(&flags, t, 2, values, &frame)) { fprintf(stderr, "..."); code = 1; break; }
  *   }
  *   ssAuditFinish(&flags);
+ *
+ * Logic that depends on time or state runs in the stepper's before_step at ssStepper_CurrentStep's time_s (as
+ * examples/wrecking_arm.c does), so that `fixed` can be the same at every frame rate; the program's own stepping runs
+ * it once a frame, as it always did.
  *
  * Header-only (static inline): include it in one file of the program and link the lab (steadystep_lab) for the
  * profiles. Not part of the core library: a shipped program keeps its own frame clock. */
