@@ -3,12 +3,22 @@
     stepper = Stepper(world, space=space, tuned_step_s=1 / 60, solver=Solver.QUICK, policy="exact",
                       collide=collide, contact_group=contacts)   # adopts all the space reaches, as tuned at 1/60 s
     for frame_s in frames:                    # the frame's real length (s)
-        odepy.dBodyAddForce(car, throttle, 0, 0)   # forces added once a frame act for the whole frame
+        odepy.dBodyAddForce(car, throttle, 0, 0)   # added once a frame: held at every step until the next frame's
         report = stepper.step(frame_s)        # FrameReport; SteadystepError on a blow-up: repair, then reset()
 
-Callbacks are plain Python callables, called from C during step(): before_step(stepper) and collide(stepper) before
-each physics step (stepper.current_step() tells the step), step_done(step_s) after each step that passed the
-checks. collide typically calls odepy.dSpaceCollide(space, None, near) and the near callback calls
+Callbacks are plain Python callables, called from C during step(): before_step(stepper) (or before_step(stepper,
+step)) and collide(stepper) before each physics step, step_done(step_s) after each step that passed the checks.
+stepper.current_step() tells the step about to be taken: its length step_s (s) and the simulated time at its start
+time_s (s). The program's per-step logic goes in before_step, computed from those two: anything that depends on the
+state or on the time (a controller, drag, a motor's target, a scripted input):
+
+    def before_step(stepper, step):           # step: stepper.current_step(), a StepInfo
+        odepy.dJointSetHingeParam(motor, odepy.dParamVel, target_speed(step.time_s))
+
+Under the fixed policy the n-th step starts at the same time_s, to the bit, at every frame rate: logic computed there
+makes the motion identical at every frame rate; the same logic run once a frame does not.
+
+collide typically calls odepy.dSpaceCollide(space, None, near) and the near callback calls
 stepper.soften_contact(contact, body1, body2) before dJointCreateContact. An exception raised by a callback does
 not cross C: it is kept, the callbacks are not called again for the rest of that frame (whose remaining steps
 ODE still takes), and step() raises it once the frame is over. The near callback is called by ODE through ctypes,
@@ -39,15 +49,20 @@ class StepInfo(StructView, c_type="ssStepInfo", convert={"mapping": Mapping}):
     (the Mapping this step's softness is written with), step_s (the length of the step about to be taken, s),
     softness_step_s (the step length the softness is for, s: step_s, or stepping.frozen_step_s), previous_step_s
     (the step before, for Mapping.EXACT, s; 0 when there is no usable history), index (0-based, within the frame),
-    count (steps this frame takes). Fields as stepper.h declares them, read-only."""
+    count (steps this frame takes), time_s (the simulated time at the step's start, s: every step the stepper took
+    since it was made, added in order; under the fixed cut the same bits for the n-th step at every frame rate).
+    Fields as stepper.h declares them, read-only; a StepInfo is a copy, which keeps its values after the step."""
 
     __slots__ = ()
 
 
 class FrameReport(StructView, c_type="ssFrameReport", convert={"failed_body": address_of}):
     """What one frame did (ssFrameReport), with the fields and meanings stepper.h gives them, read-only and read
-    from the C report when asked for (FIELDS lists them; as_dict() copies them). failed_body is the address of
-    the body that failed, else 0 (compare with ctypes.cast(body, c_void_p).value)."""
+    from the C report when asked for (FIELDS lists them; as_dict() copies them): steps, step_s (s), simulated_s (s),
+    time_s (the stepper's simulated time after the frame, s: the time to label the frame's state with, the same
+    bits after the same number of steps under the fixed cut at every frame rate), carried_s, dropped_s (s),
+    interpolation (the fixed cut's blend factor, in [0, 1)), ... failed_body is the address of the body that failed,
+    else 0 (compare with ctypes.cast(body, c_void_p).value)."""
 
     __slots__ = ()
 
@@ -77,12 +92,17 @@ class Stepper:
     reference_step_s (s; default the tuned step, else 1/60 s); neither: the defaults. max_step_s and fixed_step_s
     of 0 (the defaults) are the tuned step. before_step(stepper), collide(stepper): called before each physics
     step; step_done(step_s): after each step that passed the checks. contact_group: an odepy dJointGroupID emptied
-    after every step, or None. Raises SteadystepError naming a bad value."""
+    after every step, or None. Raises SteadystepError naming a bad value.
+
+    before_step is the program's per-step logic: it reads the step from stepper.current_step() (a StepInfo: time_s,
+    the simulated time at the step's start, and step_s, its length, both in s). A before_step that requires two
+    positional parameters, before_step(stepper, step), is given that StepInfo as its second argument; one that
+    requires one (or cannot be inspected) is called before_step(stepper), as always."""
 
     def __init__(self, world, registry: Registry | None = None, *, space=None, tuned_step_s: float = 0.0,
                  solver: Solver | None = None, stepping: Stepping | None = None,
                  policy: str | None = None, reference_step_s: float | None = None,
-                 before_step: Callable[["Stepper"], object] | None = None,
+                 before_step: Callable[["Stepper"], object] | Callable[["Stepper", StepInfo], object] | None = None,
                  collide: Callable[["Stepper"], object] | None = None,
                  step_done: Callable[[float], object] | None = None, contact_group=None):
         if registry is not None and not isinstance(registry, Registry):
@@ -97,7 +117,11 @@ class Stepper:
         if solver is not None:
             self._stepping = dataclasses.replace(self._stepping, solver=solver)
         self._registry = registry  # kept alive: the C stepper borrows it
-        self._user = {"before_step": _checked_callable("before_step", before_step),
+        before_step = _checked_callable("before_step", before_step)
+        if before_step is not None and _takes_the_step(before_step):
+            given = before_step
+            before_step = lambda stepper: given(stepper, stepper.current_step())  # noqa: E731
+        self._user = {"before_step": before_step,
                       "collide": _checked_callable("collide", collide),
                       "step_done": _checked_callable("step_done", step_done)}
         self._pending: BaseException | None = None  # the first exception a callback raised in this frame
@@ -180,9 +204,11 @@ class Stepper:
 
     def step(self, frame_s: float) -> FrameReport:
         """Advances the world by one frame of frame_s seconds (0 <= frame_s <= 3600; 0 takes no step). Forces the
-        program added to known bodies before this call act for the whole frame (a frame of 0 s reads and clears
-        them: F·0 = 0). Returns the frame's FrameReport. Raises SteadystepError with the library's message (the
-        world left as it was for a refused frame); for a body refused at the boundary before the frame or a step (a state or force ODE cannot step, Status.POSITION_LIMIT, ...) or one that blew
+        program added to known bodies before this call are held (a zero-order hold): they act, unchanged, at every
+        physics step until the next frame's forces replace them, and time left unstepped carries them with it, so
+        F·dt is exact over the run; an input that varies within a frame belongs in before_step. Returns the
+        frame's FrameReport. Raises SteadystepError with the library's message (the world left as it was for a
+        refused frame); for a body refused at the boundary before the frame or a step (a state or force ODE cannot step, Status.POSITION_LIMIT, ...) or one that blew
         up or ran away in a step (Status.BLOWUP, Status.SPEED_LIMIT) the error's `report` is the FrameReport, whose
         failed_body names the body, and every later frame is refused (Status.FAILED) until reset(). An exception
         raised by a callback, or by a call the near callback made (soften_contact ...), is raised here, after the
@@ -234,8 +260,9 @@ class Stepper:
         return count
 
     def current_step(self) -> StepInfo:
-        """The step about to be taken: meaningful inside before_step and collide; between frames, the next step of
-        the default length."""
+        """The step about to be taken (a copy): meaningful inside before_step and collide, where time_s is the
+        simulated time at its start and step_s its length (s). Between frames it describes no step to come: the
+        stepper's simulated time is then the last FrameReport's time_s."""
         return StepInfo.of(lib.ssStepper_CurrentStep(self._handle()))
 
     def near_callback(self, near: Callable) -> Callable:
@@ -330,6 +357,20 @@ class Stepper:
             self._between_frames("close")
             ffi.release(self._stepper)
             self._stepper = None
+
+
+def _takes_the_step(function) -> bool:
+    """Whether before_step wants the StepInfo as a second argument: it requires two positional parameters. A
+    callable that requires one, takes *args or defaults its second, or whose signature cannot be read, is called
+    with the stepper alone, as before_step always was."""
+    import inspect
+
+    try:
+        parameters = inspect.signature(function).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    positional = (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
+    return sum(1 for p in parameters if p.kind in positional and p.default is inspect.Parameter.empty) >= 2
 
 
 def _call(stepper_ref, which: str, *args) -> None:
