@@ -2,8 +2,10 @@
 world and one that reads its quantities; the audit steps the world itself under every profile and policy.
 
 A 1 kg body on a slider whose stop (lo = hi = 0) is a spring of k = 40 N/m, c = 1 N·s/m (the article's kind),
-released at rest from x0 = 0.5 m with no gravity, and pushed every frame by the program's own per-frame logic
-(a force of 2 N·sin(2π t / 1.7 s)).
+released at rest from x0 = 0.5 m with no gravity, and pushed by the program's per-step logic (a force of
+2 N·sin(2π t / 1.7 s), t the simulated time at each physics step's start): an input that changes with time is
+computed before every step, not once a frame, so that under the fixed policies the motion is the same at every
+frame rate.
 
     .venv/bin/steadystep audit --python examples/audit_slider.py --out audit-slider
 """
@@ -40,14 +42,14 @@ def build_world() -> PythonWorld:
     registry = ss.Registry(world)
     registry.bind_joint(slider, ss.JointParam.STOP, 1, SPRING)  # effective mass from the body: 1 kg
 
-    def push(time_s: float) -> None:
+    def push(time_s: float, step_s: float) -> None:  # before every physics step: its start time and length (s)
         odepy.dBodyAddForce(body, 2.0 * math.sin(2 * math.pi * time_s / 1.7), 0.0, 0.0)
 
     def close() -> None:
         registry.close()
         odepy.dWorldDestroy(world)
 
-    return PythonWorld(world=world, registry=registry, before_frame=push, close=close, extra={"body": body})
+    return PythonWorld(world=world, registry=registry, before_step=push, close=close, extra={"body": body})
 
 
 def read_quantities(world: PythonWorld) -> dict[str, float]:

@@ -11,7 +11,10 @@ A program takes part in one of two ways:
   parses the flags and prints the rows for a C program.
 - a Python file defining ``build_world()``, which builds its odepy world and returns a PythonWorld, and
   ``read_quantities(world)``, which returns {column name with its unit: value} of that PythonWorld; the audit steps
-  the world itself with a steadystep Stepper, a frame at a time, and counts what each frame's report says.
+  the world itself with a steadystep Stepper, a frame at a time, and counts what each frame's report says. The
+  PythonWorld's hooks carry the program's logic: before_frame(time_s) once a frame, before_step(time_s, step_s)
+  before every physics step, under every policy. A Python program has no own stepping (no "own" variant): naive
+  is the nearest, one step of the whole frame with the softness as tuned.
 
 A program that cannot take part raises BadProgram, one line naming the program, the run and what is wrong: it does
 not exist or is not executable, it refused the flags (exit 2), printed no CSV or malformed CSV, did not finish
@@ -150,9 +153,14 @@ class PythonWorld:
     into registry or into one of its own. tuned_step_s: the step the program tuned its numbers for, which the
     stepper also takes as its longest (and fixed) step. collide(stepper): called before
     each physics step (its near callback calls stepper.soften_contact). contact_group: emptied after each step.
-    before_frame(time_s): the program's per-frame logic (forces, controls), called before each frame with the
-    simulated time (s). close(): destroys what build_world made (the world last); the audit closes its stepper (and
-    a registry it made) first. solver: "quick" (dWorldQuickStep) or "step" (dWorldStep)."""
+    before_frame(time_s): the program's per-frame logic, called before each frame with the simulated time (s) the
+    frame starts at; a force it adds is held for every step of the frame. before_step(time_s, step_s): the
+    program's per-step logic, called before every physics step under every policy, after the frame's held forces
+    are put back and before collide, with the simulated time (s) at the step's start and the step's length (s):
+    whatever depends on the time or the state (a motor's target, a controller, a scripted push) belongs here, and
+    under the fixed policies it then gives the same motion at every frame rate. close(): destroys what build_world
+    made (the world last); the audit closes its stepper (and a registry it made) first. solver: "quick"
+    (dWorldQuickStep) or "step" (dWorldStep)."""
 
     world: object
     space: object = None
@@ -161,6 +169,7 @@ class PythonWorld:
     collide: Callable | None = None
     contact_group: object = None
     before_frame: Callable[[float], object] | None = None
+    before_step: Callable[[float, float], object] | None = None
     close: Callable[[], object] | None = None
     solver: str = "quick"
     extra: dict = dataclasses.field(default_factory=dict)  # the program's own handles, for read_quantities
@@ -364,7 +373,8 @@ def _run_python(program: PythonProgram, variant: str, profile: str, seed: int, d
         stepper = _call_user(shown, "the Stepper of build_world()'s PythonWorld", Stepper, built.world,
                              built.registry, space=built.space,
                              tuned_step_s=built.tuned_step_s, solver=solver,
-                             policy=variant, collide=built.collide, contact_group=built.contact_group)
+                             policy=variant, collide=built.collide, contact_group=built.contact_group,
+                             before_step=_per_step(shown, built.before_step))
         names, rows = None, []
         status = "ok"
         time_s, started_cpu, started = 0.0, time.process_time(), time.perf_counter()
@@ -383,10 +393,12 @@ def _run_python(program: PythonProgram, variant: str, profile: str, seed: int, d
                 _call_user(shown, "before_frame", built.before_frame, time_s)
             try:
                 report = stepper.step(frame_s)
+            except BadProgram:  # its before_step raised: a fault of the program, not of a frame
+                raise
             except SteadystepError as error:
                 status = f"failed: {error}"
                 break
-            time_s += report.simulated_s
+            time_s = report.time_s  # every step taken, added: under fixed, the same bits at every frame rate
             record({STEP_COLUMN: report.steps, **served_counts(report)})
         cpu_s, wall_s = time.process_time() - started_cpu, time.perf_counter() - started
     finally:
@@ -399,6 +411,24 @@ def _run_python(program: PythonProgram, variant: str, profile: str, seed: int, d
     if status == "ok" and not all(np.all(np.isfinite(v)) for v in columns.values()):
         status = "failed: a value that is not finite"
     return Run(variant, profile, seed, columns, status, cpu_s, wall_s)
+
+
+def _per_step(shown: str, before_step):
+    """The Stepper's before_step for a PythonWorld's before_step(time_s, step_s), or None; what it raises becomes a
+    BadProgram naming it, which step() raises after the frame."""
+    if before_step is None:
+        return None
+    if not callable(before_step):
+        raise _bad(f"{shown}: PythonWorld.before_step = {before_step!r}: must be callable as "
+                   "before_step(time_s, step_s), or None")
+
+    def per_step(stepper, step) -> None:
+        try:
+            before_step(step.time_s, step.step_s)
+        except Exception as error:  # the user's code: its failure named in one line
+            raise _bad(f"{shown}: before_step() raised {type(error).__name__}: {error}") from None
+
+    return per_step
 
 
 def served_counts(report) -> dict:
