@@ -90,6 +90,7 @@ class Audit:
     claims: list[dict] = field(default_factory=list)
     trajectories: dict = field(default_factory=dict)  # for the figures: reference, check, each variant's first run
     elapsed_s: float = 0.0
+    language: str = "C"  # the program's: "C" (an executable) or "Python"; its snippet comes first (code_to_write)
 
 
 def validate(program, profiles, seeds, policies, duration_s: float) -> None:
@@ -243,7 +244,8 @@ def measure(program, variants: list[str], runs_per_variant, duration_s: float, d
     check_fps = int(round(1 / np.median(np.diff(check.columns[TIME_COLUMN]))))
     checked = check_reference(reference, check, quantities, amplitudes, duration_s, reference_fps, check_fps)
     result = Audit(program.name, None if program.own is None else Path(program.own[0]).name, variants,
-                   list(runs_per_variant), duration_s, quantities, amplitudes, checked)
+                   list(runs_per_variant), duration_s, quantities, amplitudes, checked,
+                   language="Python" if isinstance(program, PythonProgram) else "C")
     for window, holds in (("whole", None), ("window", holds_at(checked))):
         result.spread[window], result.deviation[window] = {}, {}
         for variant in variants:
@@ -281,6 +283,20 @@ def measure(program, variants: list[str], runs_per_variant, duration_s: float, d
 
     result.claims = claims(result)
     return result
+
+
+def recommended(result: Audit) -> str | None:
+    """The policy the recommendation names (its "recommend" claim), or None when it names none."""
+    return next((c["variant"] for c in result.claims if c["kind"] == "recommend"), None)
+
+
+def code_to_write(result: Audit) -> str:
+    """The end of the recommendation as text: the lines of code to write for the recommended policy, the program's
+    language first (snippets.as_text); "" when no policy is recommended."""
+    from steadystep import snippets
+
+    policy = recommended(result)
+    return snippets.as_text(policy, result.language) if policy else ""
 
 
 # ---- writing ------------------------------------------------------------------------------------------------------

@@ -94,4 +94,8 @@ def command(args, argv) -> int:
     print(path)
     for claim in result.claims:
         print(f"- {claim['text']}")
+    code = audit.code_to_write(result)
+    if code:
+        print()
+        print(code)
     return 0

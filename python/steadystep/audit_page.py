@@ -99,6 +99,20 @@ def _reference_table(result) -> str:
                    "RMS difference in the window / A"], rows, "reference")
 
 
+def _code(result) -> str:
+    """The recommendation's end: the lines of code to write for the policy it recommends, the program's language
+    first; "" when it recommends none."""
+    from steadystep import audit, snippets
+
+    policy = audit.recommended(result)
+    if policy is None:
+        return ""
+    blocks = "".join(f"<p class=small>{html.escape(s.language)}:</p><pre class=code><code>{html.escape(s.text)}"
+                     "</code></pre>" for s in snippets.for_policy(policy, result.language))
+    return (f"<h3 id='code'>The code to write for {html.escape(policy)}</h3>"
+            f"<p>{html.escape(snippets.summary(policy)[0].upper() + snippets.summary(policy)[1:])}.</p>{blocks}")
+
+
 def _embed(path: Path) -> str:
     data = base64.b64encode(Path(path).read_bytes()).decode()
     return f'<img src="data:image/png;base64,{data}" alt="{html.escape(Path(path).name)}">'
@@ -175,7 +189,7 @@ def page(result, out_dir: Path, command: str) -> str:
         "<section id='recommendation'><h2>Recommendation for this program</h2>"
         "<p class=small>Every line is computed from the tables below (metrics.json holds them and these claims) "
         "and links to its table.</p>"
-        f"<ul class='answers'>{claims}</ul></section>",
+        f"<ul class='answers'>{claims}</ul>{_code(result)}</section>",
         "<h2>Spread across frame rates</h2>", _by_quantity(result, result.spread, "spread"),
         f"<p class=small>Spread: each run after the first ({html.escape(first[0])} seed {first[1]}) against the "
         "first of the same variant on the first's times, RMS over runs and time, divided by the reference's range A "
@@ -217,6 +231,7 @@ img {{ max-width: 100%; display: block; margin: 0.5em 0 1.5em; }}
 #recommendation {{ background: #f4f8ff; border: 1px solid #c9d8f0; padding: 0.3em 1em 1em; }}
 .answers li {{ margin: 0.35em 0; }}
 pre {{ background: #f6f6f6; padding: 0.6em; white-space: pre-wrap; }}
+pre.code {{ white-space: pre; overflow-x: auto; }}
 .small {{ color: #666; font-size: 0.85em; margin-bottom: 1.5em; }}
 </style></head><body>
 {body}

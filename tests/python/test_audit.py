@@ -5,6 +5,7 @@ Each page's recommendation is checked claim by claim against its own metrics.jso
 (audit_claims_check.py), and the audit's numbers for an example equal those recomputed here from the programs' own
 CSV with the definitions of bench/bench_examples.py (docs/examples.md)."""
 
+import html
 import json
 import subprocess
 import sys
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 
 import audit_claims_check
+from steadystep import snippets
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILD = ROOT / "build"
@@ -60,6 +62,14 @@ def test_example_page_agrees_with_its_tables(examples, program):
     page = (directory / "audit.html").read_text()
     for claim in metrics["claims"]:  # each claim on the page, linked to a table that is there
         assert f"href='#{claim['table']}'" in page and f"id='{claim['table']}'" in page
+    # The recommendation ends with the lines of code for the policy it names, C (the program's language) first.
+    policy, = (c["variant"] for c in metrics["claims"] if c["kind"] == "recommend")
+    c, python = snippets.for_policy(policy)
+    section = page[page.index("<section id='recommendation'>"):]
+    section = section[:section.index("</section>")]
+    assert section.index(f"<h3 id='code'>The code to write for {policy}</h3>") > section.index("</ul>")
+    assert section.index(html.escape(c.text)) < section.index(html.escape(python.text))
+    assert section.endswith(f"<code>{html.escape(python.text)}</code></pre>")
     # The adopted programs move alike at every frame rate; their own stepping does not (docs/examples.md).
     spread = metrics["spread"]["window"]
     assert max(spread["implicit-euler"].values()) < max(spread["own"].values())
@@ -127,6 +137,8 @@ def test_python_program(tmp_path):
     assert done.returncode == 0, done.stderr
     metrics = json.loads((tmp_path / "metrics.json").read_text())
     assert metrics["quantities"] == ["x_m", "v_m_per_s"] and metrics["own"] is None
+    policy, = (c["variant"] for c in metrics["claims"] if c["kind"] == "recommend")
+    assert done.stdout.endswith(snippets.as_text(policy, "Python") + "\n")  # the code to write, Python first
     audit_claims_check.check(metrics)
     # The spring is linear with a known mass: exact follows it far closer than implicit Euler's damping does.
     deviation = metrics["deviation"]["window"]

@@ -106,3 +106,39 @@ def test_a_hook_that_raises_refuses_the_program_by_name(tmp_path):
     path.write_text(PROGRAM.replace("before_step=before_step,", "before_step=3,"))
     with pytest.raises(BadProgram, match=r"PythonWorld.before_step = 3: must be callable"):
         run(audit.PythonProgram(str(path)), "implicit-euler", "fixed:60", 1, 1.0)
+
+
+def test_the_recommendation_ends_with_the_code_to_write(tmp_path):
+    """The audit's page and its command line end their recommendation with the lines of code for the policy it
+    recommends, the program's language (Python here) first."""
+    import html
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from steadystep import snippets
+
+    script = Path(sys.executable).parent / "steadystep"
+    command = [str(script)] if script.exists() else [sys.executable, "-m", "steadystep.cli"]
+    program = tmp_path / "slider.py"  # following the body alone: the hook's counts differ with the step
+    program.write_text(PROGRAM.replace('"seen_s": seen["sum_s"],\n            "calls_count": float(seen["calls"])',
+                                       '"v_m_per_s": odepy.dBodyGetLinearVel(world.extra["body"])[0]'))
+    out = tmp_path / "audit"
+    done = subprocess.run([*command, "audit", "--python", program, "--out", out, "--duration", "1",
+                           "--profiles", "fixed:60", "uniform:15:45", "--seeds", "1", "--policies", "implicit-euler",
+                           "fixed", "--executor", "serial"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["quantities"] == ["x_m", "v_m_per_s"]
+    policy, = (c["variant"] for c in metrics["claims"] if c["kind"] == "recommend")
+    code = snippets.as_text(policy, "Python")
+    assert done.stdout.endswith(code + "\n")
+    assert done.stdout.index("- For this program: ") < done.stdout.index(code)  # after the claims
+    page = (out / "audit.html").read_text()
+    section = page[page.index("<section id='recommendation'>"):]
+    section = section[:section.index("</section>")]
+    python, c = snippets.for_policy(policy, "Python")
+    assert section.index(f"<h3 id='code'>The code to write for {policy}</h3>") > section.index("</ul>")
+    assert section.index(html.escape(python.text)) < section.index(html.escape(c.text))
+    assert section.endswith(f"<code>{html.escape(c.text)}</code></pre>")
