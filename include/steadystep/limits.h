@@ -58,7 +58,13 @@
 #define STEADYSTEP_LIMITS_H
 
 #include <float.h>
-#include <ode/precision.h> /* dSINGLE or dDOUBLE: the precision of the ODE the library is built with */
+#include <ode/precision.h> /* dSINGLE or dDOUBLE: the precision of the ODE the program is compiled against */
+
+#include "steadystep/ode_build.h" /* SS_ODE_DOUBLE_PRECISION: the precision the library was built against */
+
+#if (SS_ODE_DOUBLE_PRECISION && !defined(dDOUBLE)) || (!SS_ODE_DOUBLE_PRECISION && !defined(dSINGLE))
+#error "steadystep was built against ODE in the other precision than these ODE headers (dSINGLE/dDOUBLE): build the program and the library against one ODE"
+#endif
 
 /** The shortest step (s) the library hands to dWorldStep or dWorldQuickStep: a nanosecond, in both precisions.
  *  ODE aborts below about 1e-155 s in double (where (1/h)² overflows) and goes non-finite below about 1e-20 s in

@@ -166,10 +166,17 @@ typedef struct ssFrameReport {
 /** The defaults listed at each field. */
 SS_API ssStepperDef ssDefaultStepperDef(void);
 
+/** Whether the ODE loaded at run time has the precision the library was built against (SS_ODE_DOUBLE_PRECISION,
+ *  ode_build.h): a program and the library compiled against one ODE, then run with a libode of the other precision
+ *  under the same name, would read and write every dReal wrongly. ssStepper_Create calls it; so does the Python
+ *  package when it loads. Errors: SS_ERROR_UNSUPPORTED, naming both precisions. */
+SS_API ssStatus ssCheckOdePrecision(void);
+
 /** Makes a stepper. The world and a given registry are borrowed: they must outlive it. With def->space, the
  *  world and everything the space reaches are adopted as tuned at def->tuned_step_s (into def->registry when
  *  given, else into a registry the stepper makes and destroys with itself); nothing is made or adopted on an error.
- *  Errors: SS_ERROR_OUT_OF_RANGE (def or out NULL, no world, a registry of another world, space without
+ *  Errors: SS_ERROR_UNSUPPORTED (an ODE of the other precision loaded: ssCheckOdePrecision);
+ *  SS_ERROR_OUT_OF_RANGE (def or out NULL, no world, a registry of another world, space without
  *  tuned_step_s, a field outside its range, stepping.max_step_s or fixed_step_s 0 with no tuned step, named),
  *  SS_ERROR_NOT_FINITE, SS_ERROR_UNSUPPORTED (those of ssValidateStepping, e.g. stepping.solver unset); those of
  *  ssRegistry_Adopt; SS_ERROR_OUT_OF_MEMORY. */

@@ -132,7 +132,8 @@ if(NOT STEADYSTEP_SANITIZE)  # a sanitized library needs its runtime linked firs
   add_test(NAME readme_c_blocks_compile_as_c_and_cpp
            COMMAND sh ${PROJECT_SOURCE_DIR}/tests/c/readme_snippet.sh ${PROJECT_SOURCE_DIR}/README.md
                    ${CMAKE_C_COMPILER} ${CMAKE_CXX_COMPILER} ${CMAKE_CURRENT_BINARY_DIR}/readme_snippet
-                   $<TARGET_FILE:steadystep> ${PROJECT_SOURCE_DIR}/include ${ODE_CFLAGS} ${ODE_LDFLAGS}
+                   $<TARGET_FILE:steadystep> ${PROJECT_SOURCE_DIR}/include -I${STEADYSTEP_GENERATED_INCLUDE} ${ODE_CFLAGS}
+                   ${ODE_LDFLAGS}
                    ${readme_ode_runpath})
 endif()
 find_package(Python3 COMPONENTS Interpreter REQUIRED)
