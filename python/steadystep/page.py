@@ -13,7 +13,9 @@ and links to the table or figure that shows it. The needs it answers:
 - where the accurate mappings serve: the share of rows and contacts they served, and what fell back;
 - cost: wall time against plain ODE in one interleaved benchmark (cost.py);
 - the largest stable step (probe.py);
-and which policies failed (blew up or broke) on some run.
+and which policies failed (blew up or broke) on some run. The section ends with the lines of code to write for the
+policy its first line recommends (code_policy, steadystep.snippets): the one with the same motion under every
+profile, else the one most alike across profiles on the most scenes.
 
 A winner is named only where its lead is larger than the measured spread of repeats: for the deviation and the
 consistency, how much each moved when the random profiles were run again with the next seed
@@ -369,6 +371,28 @@ def recommendation(report) -> list[tuple[str, Markup]]:
              ("Largest stable step", _stable(report)),
              ("Avoid", _failures(report))]
     return [(need, text) for need, text in lines if text]
+
+
+def code_policy(report) -> tuple[str, Markup] | None:
+    """The policy whose code the opening section ends with, and why, from the first line's numbers: the first (in
+    the library's order of presets) whose motion is the same under every profile on every scene; else the preset
+    that is most alike across profiles (or tied for it) on the most scenes; None when neither is measured. Only the
+    library's presets (stepping.h) have code: the lab's control substeps-frozen does not."""
+    from steadystep.stepping import policy_names
+
+    presets = policy_names()
+    same = [p for p in presets if p in same_everywhere(report)]
+    if same:
+        return same[0], Markup("the same motion at every frame rate, as the first line says (") + link(
+            "consistency", "consistency table") + Markup(")")
+    per_scene = {s: values for s, values in _per_scene(report, report.consistency,
+                                                        getattr(report, "repeat_consistency", {}), IDENTICAL).items()}
+    counts = {p: sum(p in leaders for leaders in per_scene.values()) for p in presets}
+    if not any(counts.values()):
+        return None
+    best = max(presets, key=lambda p: (counts[p], -presets.index(p)))
+    return best, Markup("the most alike across frame rates on {} of the {} scenes, as the first line says (").format(
+        counts[best], len(per_scene)) + link("consistency", "consistency table") + Markup(")")
 
 
 def per_scene(report) -> list[dict]:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from markupsafe import Markup
 
-from steadystep import animation, cost, figures, page, runs
+from steadystep import animation, cost, figures, page, runs, snippets
 from steadystep.report_export import swept_axes
 from steadystep.report_model import Report
 from steadystep.report_tasks import NOT_PROBED
@@ -188,12 +188,22 @@ def scene_section(report: Report, scene: str) -> dict:
             "images": [embed(p) for p in report.figures.get(scene, []) if p.suffix == ".png"]}
 
 
+def code_to_write(report: Report) -> dict | None:
+    """The end of the opening section: the policy its first line recommends, why, and the C and Python snippets."""
+    chosen = page.code_policy(report)
+    if chosen is None:
+        return None
+    policy, why = chosen
+    return {"policy": policy, "why": why, "summary": snippets.summary(policy),
+            "snippets": snippets.for_policy(policy)}
+
+
 def as_html(report: Report, command: str, article_paths: list[Path]) -> str:
     """The whole page."""
     pngs = [p for p in article_paths if p.suffix == ".png"]
     return ENVIRONMENT.get_template("report.html").render(
         report=report, command=command,
-        recommendation=page.recommendation(report),
+        recommendation=page.recommendation(report), code=code_to_write(report),
         per_scene=[{**entry, "consistency": page.verdict(entry["consistency"]),
                     "deviation": page.verdict(entry["deviation"]), "cost": page.verdict(entry["cost"])}
                    for entry in page.per_scene(report)],

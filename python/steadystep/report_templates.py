@@ -28,7 +28,7 @@ img { max-width: 100%; display: block; margin: 0.5em 0 1.5em; }
 .bad { color: #b00; font-weight: bold; }
 #recommendation { background: #f4f8ff; border: 1px solid #c9d8f0; padding: 0.3em 1em 1em; }
 .answers li { margin: 0.35em 0; }
-pre { background: #f6f6f6; padding: 0.6em; } .small { color: #666; font-size: 0.85em; margin-bottom: 1.5em; }
+pre { background: #f6f6f6; padding: 0.6em; } pre.code { overflow-x: auto; } .small { color: #666; font-size: 0.85em; margin-bottom: 1.5em; }
 figure { margin: 0.5em 0 1.5em; }
 </style></head><body>
 <h1>steadystep: which constraint-softness policy, under variable frame times</h1>
@@ -56,6 +56,13 @@ whose steps follow the frames)</th><th>closest to the reference</th><th>cheapest
 <table id='policies'><thead><tr><th>policy</th><th>how a frame is cut</th><th>softness of each step</th></tr></thead>
 <tbody>{% for name, cut, mapping in policies %}<tr><td><b>{{ name }}</b></td><td>{{ cut }}</td><td>{{ mapping }}</td></tr>
 {% endfor %}</tbody></table>
+{% if code %}
+<h3 id='code'>The code to write for {{ code.policy }}</h3>
+<p>For {{ code.why }}: {{ code.summary }}.</p>
+{% for snippet in code.snippets %}<p class=small>{{ snippet.language }}:</p>
+<pre class=code><code>{{ snippet.text }}</code></pre>
+{% endfor %}
+{% endif %}
 </section>
 {% if animation %}
 <h2 id='animation'>Watch: the chain at 15-45 fps</h2>

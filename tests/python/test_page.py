@@ -151,6 +151,67 @@ def test_the_recommendation_names_the_best_by_the_numbers_on_the_page(written):
         assert (f"<b>{policy}</b>" in stable_text) == (score[policy] == best)
 
 
+def _first_screen(page: str) -> str:
+    section = page[page.index("<section id='recommendation'>"):]
+    return section[:section.index("</section>")]
+
+
+def test_the_first_screen_ends_with_the_code_for_the_policy_it_recommends(written):
+    """Read from metrics.json by the page's stated rule: no preset is the same under every profile here (no fixed
+    policy ran), so the code is for the preset most alike across profiles on the most scenes (ties within the spread
+    of repeats count for each), the library's order breaking a tie. The lab's control substeps-frozen has no code."""
+    import steadystep as ss
+    from steadystep import snippets
+
+    page, metrics = written[0].read_text(), written[1]
+    presets = ss.policy_names()
+    counts = dict.fromkeys(presets, 0)
+    for scene, quantity in (("chain", "end x"), ("stack", "top x")):
+        values = {p: v[quantity] for p, v in metrics["consistency"][scene].items()}
+        assert not any(v is not None and v <= 1e-9 for v in values.values())  # none the same everywhere
+        spread = {p: v[quantity] for p, v in metrics["repeat"]["consistency"][scene].items()}
+        for policy in _leaders(values, spread):
+            if policy in counts:
+                counts[policy] += 1
+    policy = max(presets, key=lambda p: (counts[p], -presets.index(p)))
+    assert counts[policy] > 0 and policy != "substeps-frozen"
+    screen = _first_screen(page)
+    assert f"<h3 id='code'>The code to write for {policy}</h3>" in screen
+    assert f"the most alike across frame rates on {counts[policy]} of the 2 scenes" in screen
+    assert screen.index("id='policies'") < screen.index("<h3 id='code'>")
+    blocks = re.findall(r"<pre class=code><code>(.*?)</code></pre>", screen, re.S)
+    assert [html.unescape(b) for b in blocks] == [s.text for s in snippets.for_policy(policy)]  # C, then Python
+    assert screen.rstrip().endswith(f"<code>{blocks[-1]}</code></pre>")  # the code ends the first screen
+
+
+def test_code_for_fixed_when_it_is_the_same_motion_everywhere():
+    from steadystep import page as page_module, report_html, snippets
+    from steadystep.report_model import Report
+
+    made = Report(scenes=["chain", "stack"], profiles=["fixed:30", "uniform:15:45"],
+                  policies={"chain": ["implicit-euler", "fixed-exact", "fixed"], "stack": ["implicit-euler", "fixed",
+                                                                                            "fixed-exact"]},
+                  duration_s=1.0, seed=1,
+                  consistency={"chain": {"implicit-euler": {"end x": 0.01}, "fixed": {"end x": 0.0},
+                                         "fixed-exact": {"end x": 1e-12}},
+                               "stack": {"implicit-euler": {"top x": 0.02}, "fixed": {"top x": 0.0},
+                                         "fixed-exact": {"top x": 0.0}}})
+    policy, why = page_module.code_policy(made)
+    assert policy == "fixed" and "the same motion at every frame rate" in why  # the library's order: fixed first
+    code = report_html.code_to_write(made)
+    assert code["snippets"] == snippets.for_policy("fixed")
+    assert "before_step" in code["summary"] and "interpolated poses" in code["summary"]
+    # No preset the same everywhere: the most alike on the most scenes, a tie (one scene each) to the library's
+    # order, in which implicit-euler comes before the fixed ones.
+    made.consistency["stack"]["fixed"]["top x"] = made.consistency["stack"]["fixed-exact"]["top x"] = 0.03
+    policy, why = page_module.code_policy(made)
+    assert policy == "implicit-euler" and "on 1 of the 2 scenes" in why
+    made.consistency["chain"]["fixed-exact"]["end x"] = 0.5  # on the chain, fixed alone leads now
+    made.consistency["stack"]["fixed"]["top x"] = 0.02  # and ties implicit-euler on the stack
+    policy, why = page_module.code_policy(made)
+    assert policy == "fixed" and "on 2 of the 2 scenes" in why
+
+
 def test_the_csv_columns_have_no_spaces(written):
     header = (written[0].parent / "metrics.csv").read_text().splitlines()[0].split(",")
     assert header == list(report.CSV_COLUMNS) and not any(" " in name for name in header)
