@@ -1,16 +1,17 @@
 """steadystep: frame-rate independent constraint softness for the Open Dynamics Engine, from Python.
 
 On a program's own ODE world (built with odepy, PyPI ode-python): ``Registry`` (bind springs, adopt what the program
-tuned), ``Stepper`` (one call per frame: substeps, mappings, forces kept over the frame, failures refused until
-reset), ``Stepper.soften_contact`` in the near callback, and ``Stepping`` for how frames become steps. The
-conversions (``implicit_euler_softness`` ..., scalars or numpy arrays), the lab's profiles and runs on built-in scenes
-(``steadystep.runs``, ``steadystep.profiles``), the article's model (``steadystep.article``), metrics, ``sweep`` of
-independent runs over any ``concurrent.futures.Executor`` (``make_executor``: a process pool, Dask); figures and
-the HTML report need the ``report`` extra (``pip install steadystep[report]``). Every failure raises
-``SteadystepError`` naming the value at fault, with ``code`` the C status (``Status``) and ``status`` its name:
-``InvalidValue`` (also a ValueError) for a refused value, ``SimulationFailure`` for a simulation that failed (a
-blow-up, a speed or position limit, a frame after a failure). Importing the package changes no global state and
-parses nothing (the cffi declarations were prepared from the headers when the package was built).
+tuned), ``Stepper`` (one call per frame: substeps or fixed steps, mappings, forces held until the next frame, per-step
+logic in ``before_step``, failures refused until reset), ``Stepper.soften_contact`` in the near callback, and
+``Stepping`` for how frames become steps. The conversions (``implicit_euler_softness`` ..., scalars or numpy arrays),
+the lab's profiles and runs on built-in scenes (``steadystep.runs``, ``steadystep.profiles``), the article's model
+(``steadystep.article``), metrics, ``sweep`` of independent runs over any ``concurrent.futures.Executor``
+(``make_executor``: a process pool, Dask); figures and the HTML report need the ``report`` extra (``pip install
+steadystep[report]``). Every failure raises ``SteadystepError`` naming the value at fault, with ``code`` the C status
+(``Status``) and ``status`` its name: ``InvalidValue`` (also a ValueError) for a refused value, ``SimulationFailure``
+for a simulation that failed (a blow-up, a speed or position limit, a frame after a failure). Importing the package
+changes no global state and parses nothing (the cffi declarations were prepared from the headers when the package was
+built).
 """
 
 from steadystep._native import InvalidValue, SimulationFailure, SteadystepError

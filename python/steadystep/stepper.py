@@ -251,7 +251,7 @@ class Stepper:
 
     @property
     def known_body_count(self) -> int:
-        """How many bodies the stepper knows now (ssStepper_KnownBodyCount): forces kept over a frame, checked at
+        """How many bodies the stepper knows now (ssStepper_KnownBodyCount): forces held over a frame, checked at
         every step. A body nothing reaches (no geom in the space, no joint to a known body) is not among them:
         watch_body() it."""
         count = lib.ssStepper_KnownBodyCount(self._handle())
@@ -326,7 +326,8 @@ class Stepper:
         lib.ssStepper_ResetHistory(self._between_frames("reset_history"))
 
     def watch_body(self, body) -> None:
-        """Makes a body known: its forces kept for the whole frame, its state checked after each step."""
+        """Makes a body known: its forces held for every step until the next frame, its state checked after each
+        step."""
         try:
             check(lib.ssStepper_WatchBody(self._handle(), _handles.handle("body", "body", body)))
         except SteadystepError as error:
