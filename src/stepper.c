@@ -80,10 +80,22 @@ static ssStatus validateDef(const ssStepperDef* def) {
   return ssValidateStepping(&def->stepping);
 }
 
-/* stepping's max_step_s and fixed_step_s of 0 stand for the tuned step; the one the cut uses must have one. */
+/* stepping's max_step_s and fixed_step_s of 0, and a frozen step of SS_FROZEN_AT_TUNED_STEP, stand for the tuned
+ * step; the one the cut uses must have one. A frozen step other than the tuned step is refused: the tuned numbers
+ * mean their softness at that step alone. */
 static ssStatus resolveSteps(ssStepping* stepping, double tuned_step_s) {
   if (stepping->max_step_s == 0) stepping->max_step_s = tuned_step_s;
   if (stepping->fixed_step_s == 0) stepping->fixed_step_s = tuned_step_s;
+  if (stepping->frozen_step_s == SS_FROZEN_AT_TUNED_STEP) {
+    if (tuned_step_s == 0)
+      return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.frozen_step_s = the tuned step, but there is no tuned step: set "
+                                           "def.tuned_step_s, adopt into the registry, or give the step to freeze at");
+    stepping->frozen_step_s = tuned_step_s;
+  }
+  if (stepping->frozen_step_s > 0 && tuned_step_s > 0 && stepping->frozen_step_s != tuned_step_s)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping.frozen_step_s = %.17g s: not the tuned step %.17g s, which the "
+                  "adopted numbers were tuned for (pass 0 or the tuned step to ssSteppingForPolicy)",
+                  stepping->frozen_step_s, tuned_step_s);
   const char* missing = stepping->cut == SS_CUT_SUBSTEPS && stepping->max_step_s == 0  ? "max_step_s"
                         : stepping->cut == SS_CUT_FIXED && stepping->fixed_step_s == 0 ? "fixed_step_s"
                                                                                         : NULL;
@@ -122,7 +134,8 @@ static void resolveSpeeds(ssStepping* stepping) {
 }
 
 ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
-  ssStatus status = validateDef(def);
+  ssStatus status = ssCheckOdePrecision();
+  if (status == SS_OK) status = validateDef(def);
   if (status != SS_OK) return status;
   if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the stepper");
   double tuned_step_s = def->tuned_step_s != 0 ? def->tuned_step_s : ssRegistry_TunedStep(def->registry);

@@ -72,7 +72,7 @@ ssStatus ssValidateStepping(const ssStepping* stepping) {
   if (stepping->max_step_s != 0) status = ssCheckStepLength("stepping.max_step_s", stepping->max_step_s);
   if (status == SS_OK && stepping->fixed_step_s != 0)
     status = ssCheckStepLength("stepping.fixed_step_s", stepping->fixed_step_s);
-  if (status == SS_OK && stepping->frozen_step_s != 0)
+  if (status == SS_OK && stepping->frozen_step_s != 0 && stepping->frozen_step_s != SS_FROZEN_AT_TUNED_STEP)
     status = ssCheckStepLength("stepping.frozen_step_s", stepping->frozen_step_s);
   if (status == SS_OK) status = checkSpeed("stepping.max_speed", "m/s", stepping->max_speed);
   if (status == SS_OK) status = checkSpeed("stepping.max_angular_speed", "rad/s", stepping->max_angular_speed);
@@ -110,13 +110,14 @@ ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssSteppi
   if (stepping == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "stepping = NULL: needs somewhere to write the policy");
   for (int i = 0; i < POLICY_COUNT; ++i) {
     if (name == NULL || strcmp(name, policies[i].name) != 0) continue;
-    if (policies[i].frozen) {
+    if (policies[i].frozen && reference_step_s != 0) {
       ssStatus status = ssCheckStepLength("reference_step_s", reference_step_s);
       if (status != SS_OK) return status;
     }
     stepping->cut = policies[i].cut;
     stepping->mapping = policies[i].mapping;
-    stepping->frozen_step_s = policies[i].frozen ? reference_step_s : 0;
+    stepping->frozen_step_s = !policies[i].frozen ? 0 : reference_step_s != 0 ? reference_step_s
+                                                                               : SS_FROZEN_AT_TUNED_STEP;
     /* naive is the program's own loop, which leaves ODE's generator alone; the others make each step replayable */
     if (policies[i].cut == SS_CUT_WHOLE_FRAME) stepping->step_seed = -1;
     else if (stepping->step_seed < 0) stepping->step_seed = 0;
@@ -134,7 +135,7 @@ const char* ssSteppingPolicyName(const ssStepping* stepping) {
   if (stepping == NULL) return NULL;
   for (int i = 0; i < POLICY_COUNT; ++i)
     if (policies[i].cut == stepping->cut && policies[i].mapping == stepping->mapping &&
-        policies[i].frozen == (stepping->frozen_step_s > 0))
+        policies[i].frozen == (stepping->frozen_step_s != 0))
       return policies[i].name;
   return NULL;
 }

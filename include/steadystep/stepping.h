@@ -21,6 +21,9 @@
 extern "C" {
 #endif
 
+/** stepping.frozen_step_s: the softness frozen at the stepper's tuned step (the naive policy of an adopted program). */
+#define SS_FROZEN_AT_TUNED_STEP (-1.0)
+
 /** How a frame's time becomes physics steps. */
 typedef enum ssFrameCut {
   SS_CUT_WHOLE_FRAME = 0, /* one step of the whole frame (what ODE programs usually do) */
@@ -42,7 +45,10 @@ typedef struct ssStepping {
   ssFrameCut cut;          /* default SS_CUT_SUBSTEPS */
   ssMapping mapping;       /* default SS_MAPPING_IMPLICIT_EULER */
   /* > 0: every step's softness is computed for this step length (s), whatever the step's own: fixed ERP/CFM, the
-   * way ODE programs are usually tuned (the naive policy). 0 (default): each step's own length. */
+   * way ODE programs are usually tuned (the naive policy). SS_FROZEN_AT_TUNED_STEP (-1): at the stepper's tuned step
+   * (ssStepperDef.tuned_step_s or the registry's), which is what adopted numbers mean. 0 (default): each step's own
+   * length. A stepper with a tuned step refuses any other frozen step: the numbers a program tuned mean that
+   * softness at one step only, so a second value could only disagree with it. */
   double frozen_step_s;
   ssSolver solver;         /* required: default SS_SOLVER_UNSET, which is refused */
   /* dWorldQuickStep iterations written into the world before each frame, >= 0; default 0: the world's own setting
@@ -109,10 +115,12 @@ SS_API const char* ssSteppingPolicyNameAt(int index);
 
 /** Sets stepping's cut, mapping, frozen step and step_seed use to the policy's (the other fields are kept): naive
  *  sets step_seed to -1 (ODE's generator left alone, as the program's own loop leaves it); every other policy sets a
- *  negative step_seed to 0 and keeps a seed the caller chose. reference_step_s (s,
- *  in the step range) is the length naive and substeps-frozen freeze their softness at, e.g. the step a program was tuned for.
+ *  negative step_seed to 0 and keeps a seed the caller chose. reference_step_s is the length naive and
+ *  substeps-frozen freeze their softness at: 0 for the stepper's tuned step (SS_FROZEN_AT_TUNED_STEP, what an
+ *  adopted program means; a stepper refuses any other), or a step (s, in the step range) for springs bound by
+ *  hand.
  *  Errors, with stepping unchanged: SS_ERROR_PARSE for an unknown name (named, with the known ones);
- *  SS_ERROR_OUT_OF_RANGE for NULL or a reference_step_s out of range; SS_ERROR_NOT_FINITE. */
+ *  SS_ERROR_OUT_OF_RANGE for NULL or a reference_step_s neither 0 nor in range; SS_ERROR_NOT_FINITE. */
 SS_API ssStatus ssSteppingForPolicy(const char* name, double reference_step_s, ssStepping* stepping);
 
 /** The name of the policy stepping is (cut, mapping and whether the softness is frozen; step_seed is not looked at),

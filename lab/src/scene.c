@@ -174,6 +174,10 @@ static ssStatus makeStepper(ssScene* scene, const ssStepping* stepping) {
   def.world = scene->parts.world;
   def.registry = scene->parts.registry;
   def.stepping = *stepping;
+  /* a frozen softness means the scene's numbers as they were tuned: an adopted scene's at its tuned step (naive is
+   * then the program's own stepping), springs bound by hand at the lab's reference step (ssLabStepping) */
+  if (def.stepping.frozen_step_s != 0 && ssRegistry_TunedStep(def.registry) > 0)
+    def.stepping.frozen_step_s = SS_FROZEN_AT_TUNED_STEP;
   def.stepping.max_speed = fmin(stepping->max_speed > 0 ? stepping->max_speed : SS_MAX_SAFE_SPEED,
                                 SS_SCENE_MAX_SPEED_M_PER_S);
   def.before_step = scene->desc->before_step;

@@ -432,12 +432,18 @@ TEST_F(AdoptTest, ContactsSoftenedAtTheFrozenTunedStepGetTheProgramsOwnNumbers) 
     }
   }
 
-  // Frozen at another step, the rate-independent form: what the tuned numbers stand for at that step.
+  // Frozen at another step than the tuned one is refused by name: the tuned numbers mean their softness at the tuned
+  // step alone, so a second step could only disagree with it (naive would no longer be the program's stepping).
   ssStepping other = ssStepper_Stepping(stepper);
   other.frozen_step_s = tuned_step / 2;
-  ASSERT_EQ(ssStepper_SetStepping(stepper, &other), SS_OK);
+  EXPECT_EQ(ssStepper_SetStepping(stepper, &other), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(std::string(ssLastError()).find("not the tuned step"), std::string::npos) << ssLastError();
+  EXPECT_EQ(ssStepper_Stepping(stepper).frozen_step_s, tuned_step);
+  // At another step, unfrozen, the rate-independent form: what the tuned numbers stand for at that step.
+  ASSERT_EQ(ssSteppingForPolicy("implicit-euler", 0, &other), SS_OK);
+  ASSERT_EQ(ssStepper_SetStepping(stepper, &other), SS_OK) << ssLastError();
   probe.softened.clear();
-  ASSERT_EQ(ssStepper_Step(stepper, tuned_step, nullptr), SS_OK) << ssLastError();
+  ASSERT_EQ(ssStepper_Step(stepper, tuned_step / 2, nullptr), SS_OK) << ssLastError();
   ASSERT_FALSE(probe.softened.empty());
   const double h = tuned_step / 2, k = 0.41 / (tuned_step * 2.9e-3), c = (1 - 0.41) / 2.9e-3;
   EXPECT_READ_BACK(probe.softened[0].soft_erp, h * k / (h * k + c), 1e-15);

@@ -170,7 +170,7 @@ TEST_F(ProgramTest, TheWorldsSolverSettingsAreTheProgramsOwn) {
     ssStepperDef def = TestStepperDef();
     def.world = world;
     def.registry = registry;
-    ssSteppingForPolicy(policy, 1.0 / 30, &def.stepping);
+    ssSteppingForPolicy(policy, 0, &def.stepping);  // naive frozen at the tuned step
     ssStepper* stepper = nullptr;
     ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK);
     for (int frame = 0; frame < 10; ++frame) ASSERT_EQ(ssStepper_Step(stepper, 0.04, nullptr), SS_OK);

@@ -107,7 +107,11 @@ TEST_F(StepperTest, CreateRefusesBadDefinitionsNamingTheField) {
       {[](ssStepperDef* d) { d->world = nullptr; }, SS_ERROR_OUT_OF_RANGE, "world"},
       {[](ssStepperDef* d) { d->stepping.max_step_s = 0; }, SS_ERROR_OUT_OF_RANGE, "max_step_s = 0"},
       {[](ssStepperDef* d) { d->stepping.max_step_s = NAN; }, SS_ERROR_NOT_FINITE, "max_step_s"},
-      {[](ssStepperDef* d) { d->stepping.frozen_step_s = -1; }, SS_ERROR_OUT_OF_RANGE, "frozen_step_s = -1"},
+      {[](ssStepperDef* d) { d->stepping.frozen_step_s = -2; }, SS_ERROR_OUT_OF_RANGE, "frozen_step_s = -2"},
+      {[](ssStepperDef* d) { d->stepping.frozen_step_s = SS_FROZEN_AT_TUNED_STEP; }, SS_ERROR_OUT_OF_RANGE,
+       "frozen_step_s = the tuned step, but there is no tuned step"},
+      {[](ssStepperDef* d) { d->tuned_step_s = 1.0 / 60; d->stepping.frozen_step_s = 1.0 / 30; },
+       SS_ERROR_OUT_OF_RANGE, "frozen_step_s = 0.033333333333333333 s: not the tuned step 0.016666666666666666 s"},
       {[](ssStepperDef* d) { d->stepping.fixed_step_s = INFINITY; }, SS_ERROR_NOT_FINITE, "fixed_step_s"},
       {[](ssStepperDef* d) { d->stepping.quick_iterations = -1; }, SS_ERROR_OUT_OF_RANGE, "quick_iterations = -1"},
       {[](ssStepperDef* d) { d->stepping.max_step_s = 1e-12; }, SS_ERROR_OUT_OF_RANGE, "max_step_s = 1e-12"},
@@ -148,9 +152,21 @@ TEST_F(StepperTest, PoliciesArePresetsOfCutAndMappingNamedByTheLibrary) {
   EXPECT_EQ(ssSteppingForPolicy("smooth", 1.0 / 60, &stepping), SS_ERROR_PARSE);
   EXPECT_NE(std::string(ssLastError()).find("smooth"), std::string::npos);
   EXPECT_NE(std::string(ssLastError()).find("fixed-exact"), std::string::npos);  // the known names, listed
-  EXPECT_EQ(ssSteppingForPolicy("naive", 0, &stepping), SS_ERROR_OUT_OF_RANGE);
-  EXPECT_EQ(ssSteppingForPolicy("substeps-frozen", 0, &stepping), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssSteppingForPolicy("naive", -1, &stepping), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_EQ(ssSteppingForPolicy("substeps-frozen", 1e-12, &stepping), SS_ERROR_OUT_OF_RANGE);
   EXPECT_EQ(std::memcmp(&before, &stepping, sizeof stepping), 0);
+  // 0: frozen at the stepper's tuned step, whatever it is; one stepper with a tuned step takes no other
+  ASSERT_EQ(ssSteppingForPolicy("naive", 0, &stepping), SS_OK);
+  EXPECT_EQ(stepping.frozen_step_s, SS_FROZEN_AT_TUNED_STEP);
+  EXPECT_STREQ(ssSteppingPolicyName(&stepping), "naive");
+  ssStepperDef def = TestStepperDef();
+  def.world = world;
+  def.stepping = stepping;
+  def.tuned_step_s = 1.0 / 47;
+  ssStepper* stepper = nullptr;
+  ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK) << ssLastError();
+  EXPECT_EQ(ssStepper_Stepping(stepper).frozen_step_s, 1.0 / 47);
+  ssStepper_Destroy(stepper);
   // The control: implicit-euler's cut with naive's frozen softness.
   ssStepping control = TestStepping();
   ASSERT_EQ(ssSteppingForPolicy("substeps-frozen", 1.0 / 30, &control), SS_OK);

@@ -131,7 +131,9 @@ SS_LAB_API int ssColumnName(const char* name, const char* unit, char* out, size_
  *  SS_ERROR_OUT_OF_RANGE for name = NULL or out = NULL. */
 SS_LAB_API ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out);
 
-/** The naive policy's reference step in the lab (s): the scenes' softness frozen as if tuned at 30 fps. */
+/** The naive policy's reference step in the lab (s): the softness of the scenes that bind their springs by hand
+ *  frozen as if tuned at 30 fps. The scenes written as ODE programs (stack, wall, piston) are adopted at their own
+ *  tuned step, and a frozen policy freezes them there: naive is their own stepping. */
 #define SS_LAB_NAIVE_REFERENCE_STEP_S (1.0 / 30.0)
 
 /** The lab's longest substep and fixed step (s): 1/60. The lab's scenes bind their springs by hand and have no
