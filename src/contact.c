@@ -48,6 +48,21 @@ static void writeSoftness(dContact* contact, ssSoftness softness) {
   contact->surface.soft_cfm = softness.cfm;
 }
 
+/* A contact ODE's own colliders made, checked before it becomes a joint: a contact whose position, normal or depth is
+ * not finite (ODE 0.16's sphere-cylinder collider makes one) would carry the NaN into the step. */
+static ssStatus checkContactGeometry(const dContact* contact) {
+  const dContactGeom* geom = &contact->geom;
+  const char* bad = NULL;
+  for (int i = 0; i < 3 && bad == NULL; ++i)
+    bad = !isfinite(geom->pos[i]) ? "position" : !isfinite(geom->normal[i]) ? "normal" : NULL;
+  if (bad == NULL && !isfinite(geom->depth)) bad = "depth";
+  if (bad == NULL) return SS_OK;
+  return ssFail(SS_ERROR_NOT_FINITE, "contact between geoms %p and %p: %s not finite (position (%g, %g, %g) m, "
+                "normal (%g, %g, %g), depth %g m): drop it instead of creating its joint",
+                (void*)geom->g1, (void*)geom->g2, bad, geom->pos[0], geom->pos[1], geom->pos[2], geom->normal[0],
+                geom->normal[1], geom->normal[2], geom->depth);
+}
+
 /* ssContactSoften for a law, its arguments checked. */
 static ssStatus softenByLaw(dContact* contact, const ssRowLaw* law, ssMapping mapping, double step_s) {
   ssSoftness softness;
@@ -68,6 +83,8 @@ ssContactCache ssContactCacheEmpty(void) {
 ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID body1, dBodyID body2,
                                double tuned_erp, double tuned_cfm, double tuned_step_s, ssMapping mapping,
                                double step_s, double previous_step_s, ssRowFallback* handed_on) {
+  ssStatus checked = checkContactGeometry(contact);
+  if (checked != SS_OK) return checked;
   if (tuned_erp != cache->tuned_erp || tuned_cfm != cache->tuned_cfm || tuned_step_s != cache->tuned_step_s) {
     ssRowLaw law;
     ssStatus status = ssRowLawFromTuned("contact", tuned_erp, tuned_cfm, tuned_step_s, &law);
@@ -105,6 +122,7 @@ ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpri
   ssStatus status = ssValidateSpring(spring);
   if (status == SS_OK) status = ssCheckStepLength("step_s", step_s);
   if (status == SS_OK && previous_step_s != 0) status = ssCheckStepLength("previous_step_s", previous_step_s);
+  if (status == SS_OK) status = checkContactGeometry(contact);
   if (status != SS_OK) return status;
   ssRowLaw law = ssRowLawOfSpring(spring);
   (void)body1, (void)body2;

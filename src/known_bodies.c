@@ -93,6 +93,29 @@ static void listPushed(ssKnownBodies* known) {
     if (known->bodies[i].pushed) known->pushed[known->pushed_count++] = i;
 }
 
+/* How far (m, in any coordinate) the body's geoms lie from it: the largest offset a program gave one. */
+static double geomReach(dBodyID body) {
+  double reach = 0;
+  for (dGeomID geom = dBodyGetFirstGeom(body); geom != 0; geom = dBodyGetNextGeom(geom)) {
+    if (!dGeomIsOffset(geom)) continue;
+    const dReal* offset = dGeomGetOffsetPosition(geom);
+    for (int i = 0; i < 3; ++i) {
+      double distance = fabs(offset[i]);
+      if (!(distance <= reach)) reach = isnan(distance) ? INFINITY : distance; /* a NaN offset reaches anywhere */
+    }
+  }
+  return reach;
+}
+
+static uint64_t magnitudeBits(dReal value);
+
+/* The body's position bound (ssBodyValues): 0 bits when its geoms reach beyond the bound themselves (no position
+ * but the origin passes, and the check names the offset). */
+static uint64_t positionBound(dBodyID body) {
+  double bound = SS_MAX_POSITION_M - geomReach(body);
+  return bound > 0 ? magnitudeBits(bound) : 0;
+}
+
 ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const dBodyID* watched, int watched_count) {
   BodyWalk walk = {.slots = calloc(64, sizeof(dBodyID)), .mask = 63};
   if (walk.slots == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
@@ -130,8 +153,9 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
     const ssKnownBody* old = findOld(known, body);
     bodies[i] = old != NULL ? *old : (ssKnownBody){.body = body};
     ids[i] = body;
-    values[i] = (ssBodyValues){dBodyGetPosition(body), dBodyGetLinearVel(body), dBodyGetAngularVel(body),
-                               dBodyGetForce(body), dBodyGetTorque(body)};
+    values[i] = (ssBodyValues){dBodyGetPosition(body),  dBodyGetLinearVel(body), dBodyGetAngularVel(body),
+                               dBodyGetForce(body),     dBodyGetTorque(body),
+                               positionBound(body)};
     first_joints[i] = dBodyGetJoint(body, 0);
   }
   free(walk.list);
@@ -266,6 +290,11 @@ static ssStatus describe(dBodyID body, const ssBodyBounds* bounds, const char* w
                   (void*)body, quantities[q].name, v[0], v[1], v[2], quantities[q].unit, when);
   }
   const dReal* p = quantities[0].value;
+  double reach = geomReach(body);
+  if (reach > 0 && !within(p, SS_MAX_POSITION_M - reach))
+    return ssFail(SS_ERROR_POSITION_LIMIT, "body %p: position (%g, %g, %g) m %s, with a geom offset %g m from it: "
+                  "beyond SS_MAX_POSITION_M = %g m, where ODE's collision spaces overflow", (void*)body, p[0], p[1],
+                  p[2], when, reach, SS_MAX_POSITION_M);
   if (!within(p, SS_MAX_POSITION_M))
     return ssFail(SS_ERROR_POSITION_LIMIT, "body %p: position (%g, %g, %g) m %s: beyond SS_MAX_POSITION_M = %g m, "
                   "where ODE's collision spaces overflow", (void*)body, p[0], p[1], p[2], when, SS_MAX_POSITION_M);
@@ -303,7 +332,7 @@ static uint64_t largestOf(const dReal* v) {
 /* Whether a body's state is one ODE can step: position within SS_MAX_POSITION_M, speeds within the bounds (every
  * comparison is false for a NaN). Combined with & (no branch a number): the slow naming path runs only on failure. */
 static int stateWithin(const ssBodyValues* v, double max_speed2, double max_spin2) {
-  int position_within = largestOf(v->position) <= magnitudeBits(SS_MAX_POSITION_M);
+  int position_within = largestOf(v->position) <= v->position_bound;
   int speed_within = squared(v->linear_vel) <= max_speed2, spin_within = squared(v->angular_vel) <= max_spin2;
   return position_within & speed_within & spin_within;
 }

@@ -8,6 +8,8 @@
 #ifndef STEADYSTEP_KNOWN_BODIES_H
 #define STEADYSTEP_KNOWN_BODIES_H
 
+#include <stdint.h>
+
 #include <ode/ode.h>
 
 #include "steadystep/registry.h"
@@ -30,6 +32,10 @@ typedef struct ssBodyValues {
   const dReal* angular_vel;
   const dReal* force;  /* the force accumulator (N) */
   const dReal* torque; /* the torque accumulator (N·m) */
+  /* the bound on the position's coordinates, as ssKnownCheck compares it (a magnitude's bits): SS_MAX_POSITION_M less
+   * the farthest offset of the body's geoms (dGeomSetOffsetPosition) when it was listed, so that no geom of it lies
+   * beyond SS_MAX_POSITION_M either */
+  uint64_t position_bound;
 } ssBodyValues;
 
 typedef struct ssKnownBodies {

@@ -566,6 +566,14 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
     }
     stepper->current = (ssStepInfo){mapping, step_s, softness_step_s, previous_step_s, i, steps, stepper->time_s};
     if (def->before_step) def->before_step(def->before_step_context, stepper);
+    /* the boundary before collision: a state before_step (or the last step's step_done) set reaches the program's
+     * dSpaceCollide next, and a position far out of range aborts ODE's spaces there (forces wait for the check
+     * before the step: collision reads none) */
+    int acted = def->before_step || (i > 0 && def->step_done);
+    if (acted && def->collide && !stepper->destroy_requested &&
+        ((status = refreshKnown(stepper)) != SS_OK ||
+         (status = checkKnown(stepper, 0, "before the collision of", i, steps, step_s, report)) != SS_OK))
+      return refuseStep(stepper, status, i);
     if (!stepper->destroy_requested && def->collide) def->collide(def->collide_context, stepper);
     if (stepper->destroy_requested) { /* the frame stops here: this step is not taken */
       if (def->contact_group) dJointGroupEmpty(def->contact_group);
@@ -575,9 +583,9 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
      * callbacks only the stepper wrote since the last check (after the last step, or before the frame): the
      * frame's checked forces spread over its steps, and load corrections within SS_MAX_FORCE_N. step_done ran
      * after the last step's check */
-    int called_back = def->before_step || def->collide || (i > 0 && def->step_done);
-    if (called_back && ((status = refreshKnown(stepper)) != SS_OK || /* what the callbacks bound or watched */
-                        (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
+    if ((acted || def->collide) &&
+        ((status = refreshKnown(stepper)) != SS_OK || /* what the callbacks bound or watched */
+         (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistoryBeforeLastStep(stepper->poses);
     int stepped = odeStep(stepper, step_s);

@@ -160,7 +160,8 @@ SS_API ssStatus ssJointEffectiveMass(dJointID joint, ssJointParam param, int axi
  *  world) and previous_step_s are therefore not read. Call it in the near callback that ssStepper hands the step
  *  length to.
  *  Errors: those of ssImplicitEulerSoftness; SS_ERROR_OUT_OF_RANGE (contact NULL, step_s or previous_step_s),
- *  SS_ERROR_UNSUPPORTED (unknown mapping). On error contact is unchanged. */
+ *  SS_ERROR_UNSUPPORTED (unknown mapping), SS_ERROR_NOT_FINITE (the contact's position, normal or depth, as a
+ *  collider made it: drop such a contact). On error contact is unchanged. */
 SS_API ssStatus ssContactSoften(dContact* contact, dBodyID body1, dBodyID body2, ssSpring spring, ssMapping mapping,
                                 double step_s, double previous_step_s);
 

@@ -55,8 +55,11 @@
  * before_step or collide). After every step it checks the state again. A failure refuses the frame by name (the
  * body, the quantity, its value) with nothing of that step taken: the world as the previous step left it (the
  * step's contacts removed, the accumulators as the program left them for the frame, or empty after an earlier
- * step), report->failed_body set, and every later frame refused until ssStepper_Reset. A state set inside
- * before_step reaches the program's own dSpaceCollide before this check; one set between frames does not.
+ * step), report->failed_body set, and every later frame refused until ssStepper_Reset. A state set in before_step or
+ * in the last step's step_done is checked again before collide runs (position and speeds: dSpaceCollide aborts on a
+ * position far out of range), so no state the program set reaches its own collision unchecked. A body's bound on
+ * its position is SS_MAX_POSITION_M less the farthest offset of its geoms from it (dGeomSetOffsetPosition), as
+ * they were when the body became known.
  *
  * Callbacks (before_step, collide, step_done) may call, on their own stepper:
  *  - ssStepper_CurrentStep, ssStepper_SoftenContact, ssStepper_Stepping, ssStepper_ResetHistory, WatchBody,
@@ -238,7 +241,9 @@ SS_API ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
  *  and count it in the frame report's contacts.handed_to_implicit_euler. body1 and body2 are not read. A contact
  *  tuned with cfm = 0 stays hard (erp follows h as for adopted hard rows).
  *  Errors, with the contact unchanged: SS_ERROR_OUT_OF_RANGE (stepper or contact NULL, no tuned step: adopt
- *  first, or a tuned erp outside [0, 1] or cfm < 0); SS_ERROR_NOT_FINITE. */
+ *  first, or a tuned erp outside [0, 1] or cfm < 0); SS_ERROR_NOT_FINITE (a tuned value, or the contact's position,
+ *  normal or depth as the collider made it: ODE 0.16's sphere-cylinder collider makes such contacts; drop it instead
+ *  of creating its joint). */
 SS_API ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2);
 
 /** Adds a body to the known bodies: forces kept for the whole frame and checks at each step.

@@ -234,6 +234,84 @@ TEST_F(PromiseTest, AStateSetInStepDoneIsRefusedBeforeTheNextStepWithNoOtherCall
   }
 }
 
+// A teleport far out of range in step_done or before_step is refused before the next collision: in a hash space
+// ODE's dSpaceCollide aborts on such a position (the body's geom would reach it before the check before the step).
+TEST_F(PromiseTest, ATeleportInACallbackIsRefusedBeforeTheCollisionNotAnAbort) {
+  dBodyID body = Box(0, 0, 1);
+  Box(0.5, 0, 1);  // another body in the space, so that the collision has pairs to look at
+  for (int in_step_done = 0; in_step_done < 2; ++in_step_done) {
+    ssStepper_Destroy(stepper);
+    stepper = nullptr;
+    dBodySetPosition(body, 0, 0, 1);
+    ssStepperDef def = Def();
+    struct Teleport {
+      dBodyID body;
+      int calls = 0;
+    } teleport{body};
+    if (in_step_done) {
+      def.step_done = [](void* context, double) {
+        auto* t = static_cast<Teleport*>(context);
+        if (++t->calls == 1) dBodySetPosition(t->body, 1e300, 0, 0);
+      };
+      def.step_done_context = &teleport;
+    } else {
+      def.before_step = [](void* context, ssStepper*) {
+        auto* t = static_cast<Teleport*>(context);
+        if (++t->calls == 2) dBodySetPosition(t->body, 1e300, 0, 0);
+      };
+      def.before_step_context = &teleport;
+    }
+    ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+    ssFrameReport report;
+    EXPECT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_ERROR_POSITION_LIMIT);
+    EXPECT_TRUE(Names("position (1e+300, 0, 0) m before the collision of step 2 of 3")) << ssLastError();
+    EXPECT_EQ(report.steps, 1);
+    EXPECT_EQ(report.failed_body, body);
+  }
+}
+
+// ODE's own sphere-cylinder collider makes a contact with a NaN normal for a sphere at the cylinder's centre: the
+// stepper refuses to soften it, by name, and leaves it as it was (the program drops it, as Near above does).
+TEST_F(PromiseTest, AContactWithANonFiniteNormalIsRefusedByNameNotSoftened) {
+  dGeomID cylinder = dCreateCylinder(space, 0.5, 1.0);
+  dGeomID sphere = dCreateSphere(space, 0.2);
+  ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
+  dContact contact;
+  std::memset(&contact, 0, sizeof contact);
+  ASSERT_EQ(dCollide(sphere, cylinder, 1, &contact.geom, sizeof contact), 1);
+  ASSERT_TRUE(std::isnan(contact.geom.normal[0]));  // ODE's own collider made it
+  contact.surface.mode = dContactSoftCFM;
+  contact.surface.soft_cfm = 1e-4;
+  dContact before = contact;
+  EXPECT_EQ(ssStepper_SoftenContact(stepper, &contact, 0, 0), SS_ERROR_NOT_FINITE);
+  EXPECT_TRUE(Names("normal not finite")) << ssLastError();
+  EXPECT_EQ(std::memcmp(&before, &contact, sizeof contact), 0);
+  EXPECT_EQ(ssContactSoften(&contact, 0, 0, ssSpring{100, 1}, SS_MAPPING_IMPLICIT_EULER, 1.0 / 60, 0),
+            SS_ERROR_NOT_FINITE);
+  EXPECT_EQ(std::memcmp(&before, &contact, sizeof contact), 0);
+  contact.geom.normal[0] = 1, contact.geom.normal[1] = 0, contact.geom.normal[2] = 0;
+  contact.geom.depth = INFINITY;
+  EXPECT_EQ(ssStepper_SoftenContact(stepper, &contact, 0, 0), SS_ERROR_NOT_FINITE);
+  EXPECT_TRUE(Names("depth not finite")) << ssLastError();
+  // stepped with them, the world is safe: Near drops what is refused
+  ssFrameReport report;
+  EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 60, &report), SS_OK) << ssLastError();
+}
+
+// A geom set far from its body (dGeomSetOffsetPosition) lies beyond the bound before its body does: the body's bound
+// is what is left of SS_MAX_POSITION_M.
+TEST_F(PromiseTest, AGeomsOffsetFromItsBodyCountsTowardThePositionBound) {
+  dBodyID body = MakeBody(1.0, 0, 0, 1);
+  dGeomID geom = dCreateBox(space, 0.1, 0.1, 0.1);
+  dGeomSetBody(geom, body);
+  dGeomSetOffsetPosition(geom, 0.75 * SS_MAX_POSITION_M, 0, 0);
+  ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 60, nullptr), SS_OK) << ssLastError();
+  dBodySetPosition(body, 0.5 * SS_MAX_POSITION_M, 0, 1);  // within the bound, but its geom at 1.25 times it
+  EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 60, nullptr), SS_ERROR_POSITION_LIMIT);
+  EXPECT_TRUE(Names("with a geom offset 750000 m from it")) << ssLastError();
+}
+
 TEST_F(PromiseTest, TheRunawayLeftByAResetWithoutRepairIsRefusedAgainNotStepped) {
   dBodyID body = Box(0, 0, 1);
   ssStepperDef def = Def();
