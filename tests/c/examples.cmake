@@ -71,6 +71,21 @@ echo \"$rows rows, byte-identical\""
                    ${CMAKE_CURRENT_BINARY_DIR}/example_audit_pendulum_naive_${profile_name} ${profile})
 endforeach()
 
+# A program that substeps itself (three dWorldStep substeps a frame, tests/c/substepping_program.c), adopted with one
+# ssStepper_Step per substep: under naive its own stepping bit for bit.
+add_executable(steadystep_test_substepping_program tests/c/substepping_program.c)
+target_link_libraries(steadystep_test_substepping_program PRIVATE steadystep_lab m)
+foreach(profile fixed:60 fixed:30 fixed:144 uniform:15:45)
+  string(REPLACE ":" "_" profile_name ${profile})
+  add_test(NAME substepping_program_naive_is_own_stepping_${profile_name}
+           COMMAND sh -c "\"$1\" --profile $3 --duration 10 --seed 3 | cut -d, -f1-3 > \"$2.ode.csv\" && \
+\"$1\" --policy naive --profile $3 --duration 10 --seed 3 | cut -d, -f1-3 > \"$2.naive.csv\" && \
+rows=$(wc -l < \"$2.ode.csv\") && test \"$rows\" -gt 100 && cmp \"$2.ode.csv\" \"$2.naive.csv\" && \
+echo \"$rows rows, byte-identical\""
+           sh $<TARGET_FILE:steadystep_test_substepping_program>
+           ${CMAKE_CURRENT_BINARY_DIR}/substepping_program_naive_${profile_name} ${profile})
+endforeach()
+
 # The game-like program steps 10 s of 15-45 fps frames under every policy, and on its own.
 foreach(policy ${STEADYSTEP_EXAMPLE_POLICIES})
   add_test(NAME example_wrecking_arm_${policy}_uniform
