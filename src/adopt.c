@@ -328,13 +328,15 @@ static ssStatus walk(Plan* plan) {
   return SS_OK;
 }
 
-static ssStatus planSpace(Plan* plan, dSpaceID space) {
+static ssStatus planSpace(Plan* plan, dSpaceID space, const char* what) {
+  ssStatus listable = ssCheckSpaceListable(what, space);
+  if (listable != SS_OK) return listable;
   int count = dSpaceGetNumGeoms(space);
   for (int i = 0; i < count; ++i) {
     dGeomID geom = dSpaceGetGeom(space, i);
     ssStatus status = SS_OK;
     if (dGeomIsSpace(geom)) {
-      status = planSpace(plan, (dSpaceID)geom);
+      status = planSpace(plan, (dSpaceID)geom, "nested space");
     } else if (dGeomGetBody(geom) != 0) {
       status = planBody(plan, dGeomGetBody(geom));
       if (status == SS_OK) status = walk(plan);
@@ -444,7 +446,7 @@ ssStatus ssRegistry_AdoptSpace(ssRegistry* registry, dSpaceID space, ssAdoptRepo
   if (status != SS_OK) return status;
   if (space == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "space = NULL: a space is required");
   Plan plan = startPlan(registry);
-  status = planSpace(&plan, space);
+  status = planSpace(&plan, space, "space");
   if (status == SS_OK) status = commit(&plan, report);
   freePlan(&plan);
   return status;
@@ -455,7 +457,7 @@ ssStatus ssRegistry_Adopt(ssRegistry* registry, double tuned_step_s, dSpaceID sp
   if (space == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "space = NULL: a space is required");
   Plan plan = startPlan(registry);
   ssStatus status = planWorld(&plan, tuned_step_s);
-  if (status == SS_OK) status = planSpace(&plan, space);
+  if (status == SS_OK) status = planSpace(&plan, space, "space");
   if (status == SS_OK) status = commit(&plan, report);
   freePlan(&plan);
   return status;

@@ -156,7 +156,8 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
     values[i] = (ssBodyValues){dBodyGetPosition(body),  dBodyGetLinearVel(body), dBodyGetAngularVel(body),
                                dBodyGetForce(body),     dBodyGetTorque(body),
                                positionBound(body)};
-    first_joints[i] = dBodyGetJoint(body, 0);
+    /* a body that stays keeps the first joint it was listed with: a joint attached since is still seen as new */
+    first_joints[i] = old != NULL ? known->first_joints[old - known->bodies] : dBodyGetJoint(body, 0);
   }
   free(walk.list);
   int geared_count = 0;

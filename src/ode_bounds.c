@@ -40,3 +40,10 @@ ssStatus ssCheckComputedSoftness(const char* name, ssSoftness softness) {
 ssStatus ssCheckMass(const char* name, double mass_kg) {
   return checkRange(name, " kg", mass_kg, SS_MIN_MASS_KG, SS_MAX_MASS_KG);
 }
+
+ssStatus ssCheckSpaceListable(const char* what, dSpaceID space) {
+  if (dSpaceGetClass(space) != dQuadTreeSpaceClass) return SS_OK;
+  return ssFail(SS_ERROR_UNSUPPORTED, "%s %p: a quadtree space, whose geoms ODE 0.16 cannot list (dSpaceGetGeom is not "
+                "implemented there and aborts): use a hash, simple or sweep-and-prune space, or make its bodies "
+                "known with ssStepper_WatchBody", what, (void*)space);
+}

@@ -7,6 +7,7 @@
 #define STEADYSTEP_ODE_BOUNDS_H
 
 #include <ode/common.h>
+#include <ode/collision.h>
 
 #include "steadystep/limits.h"
 #include "steadystep/spring.h"
@@ -28,6 +29,11 @@ ssStatus ssCheckComputedSoftness(const char* name, ssSoftness softness);
  * so that every path decides alike whether a value needs writing, whether it remembers b in double or reads it back
  * from ODE. NAN (nothing written yet) is never the same. */
 static inline int ssSameInOde(double a, double b) { return (dReal)a == (dReal)b; }
+
+/* A space whose geoms the library may list with dSpaceGetGeom: ODE 0.16 implements it for simple, hash and
+ * sweep-and-prune spaces, and asserts (aborts the process) in a quadtree space. what names the space's role in the
+ * message ("def.space", "a space nested in the adopted one"). Errors: SS_ERROR_UNSUPPORTED. */
+ssStatus ssCheckSpaceListable(const char* what, dSpaceID space);
 
 /* A body mass (kg) for dBodySetMass: finite and in [SS_MIN_MASS_KG, SS_MAX_MASS_KG]. */
 ssStatus ssCheckMass(const char* name, double mass_kg);

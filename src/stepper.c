@@ -20,13 +20,12 @@
 /* Frame times are sums of floating-point parts: a frame of exactly 2·max_step_s must not become 3 substeps. */
 static const double kStepCountSlack = 1e-9;
 
-/* A space the stepper adopted from, as it was when last walked: ODE adds a geom at the head of a space's list, so a
- * new geom changes the count or the first geom, or gives the first a body not known (sweep-and-prune appends: there
- * only the count tells, and ssStepper_DestroyBody, which has every space walked again). */
+/* A space the stepper adopted from, as it was when last walked (spacesChanged says what tells a change). */
 typedef struct SeenSpace {
   dSpaceID space;
   int geoms;
   dGeomID first;
+  int sweep_and_prune; /* walked at every look (spacesChanged) */
 } SeenSpace;
 
 struct ssStepper {
@@ -46,6 +45,7 @@ struct ssStepper {
   SeenSpace* spaces;    /* def.space and the spaces nested in it */
   int space_count, space_capacity;
   int apply_due;         /* bindings were added within the frame: the next step applies whatever the mapping */
+  int adopt_known_due;   /* the known list was rebuilt: bodies on it the registry has not are adopted (adoptKnown) */
   int in_step;           /* inside ssStepper_Step: its callbacks are running */
   int destroy_requested; /* ssStepper_Destroy was called from a callback: done when ssStepper_Step returns */
   int rebase_gears;      /* ssStepper_Reset was called: the next frame has ODE measure its gears afresh (gears.h) */
@@ -155,7 +155,7 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
       free(stepper);
       return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating a stepper");
     }
-    stepper->spaces[stepper->space_count++] = (SeenSpace){def->space, -1, 0};
+    stepper->spaces[stepper->space_count++] = (SeenSpace){def->space, -1, 0, 0};
     if ((status = ssRegistry_Adopt(registry, tuned_step_s, def->space, &stepper->adopted)) != SS_OK) {
       ssRegistry_Destroy(stepper->owned_registry);
       free(stepper->spaces);
@@ -355,8 +355,11 @@ static ssStatus refreshKnown(ssStepper* stepper) {
   if (status != SS_OK) return status;
   known->registry_generation = generation;
   known->watched_generation = stepper->watched_generation;
+  /* the list may now reach, through a joint, a body made since: one the stepper adopts before it steps (findNew) */
+  stepper->adopt_known_due = stepper->def.space != 0;
   return SS_OK;
 }
+
 
 /* Adopts body and what it reaches, when the stepper adopts (def.space); otherwise the known list reaches it through
  * its joints when rebuilt. */
@@ -367,51 +370,88 @@ static ssStatus adoptBody(ssStepper* stepper, dBodyID body) {
   return status;
 }
 
-/* Whether a space may hold a geom of a body the stepper does not know: its count changed, its first geom is another,
- * or the first geom's body is not known (a geom destroyed and another added may reuse its address: the body tells). */
+/* With def.space: adopts every known body that the registry has not (reached through a joint made since, or a body
+ * watched), with its joints, so that no known body steps with the softness the program tuned for one step. */
+static ssStatus adoptKnown(ssStepper* stepper) {
+  stepper->adopt_known_due = 0;
+  ssStatus status = SS_OK;
+  int adopted = 0;
+  for (int k = 0; k < stepper->known.count && status == SS_OK; ++k) {
+    dBodyID body = stepper->known.ids[k];
+    if (ssRegistryHasBody(stepper->def.registry, body)) continue;
+    status = adoptBody(stepper, body);
+    adopted = 1;
+  }
+  if (status != SS_OK) stepper->adopt_known_due = 1; /* refused: again at the next look, until repaired */
+  return status == SS_OK && adopted ? refreshKnown(stepper) : status;
+}
+
+/* Whether a space may hold a geom of a body the stepper has not adopted: its count changed, its first geom is another,
+ * or the first geom's body is not known (a geom destroyed and another added may reuse its address: the body tells).
+ * ODE adds a geom at the head of a simple or hash space's list; a sweep-and-prune space reorders its geoms as they
+ * move (dSpaceGetGeom lists the moved ones first) and puts a new one among them, so it is walked at every look. */
 static int spacesChanged(const ssStepper* stepper) {
   for (int i = 0; i < stepper->space_count; ++i) {
     const SeenSpace* seen = &stepper->spaces[i];
+    if (seen->sweep_and_prune) return 1;
     int geoms = dSpaceGetNumGeoms(seen->space);
     if (geoms != seen->geoms) return 1;
     if (geoms == 0) continue;
     dGeomID first = dSpaceGetGeom(seen->space, 0);
     if (first != seen->first) return 1;
     dBodyID body = dGeomIsSpace(first) ? 0 : dGeomGetBody(first);
-    if (body != 0 && !ssKnownContains(&stepper->known, body)) return 1;
+    if (body != 0 && !ssRegistryHasBody(stepper->def.registry, body)) return 1;
   }
   return 0;
 }
 
-/* Walks def.space and the spaces in it: each geom's body that is not known is adopted (a box spawned after the
- * stepper was made), and the spaces are remembered as they are now. */
+/* Whether space is listed among the adopted spaces already. */
+static int spaceListed(const ssStepper* stepper, dSpaceID space) {
+  for (int k = 0; k < stepper->space_count; ++k)
+    if (stepper->spaces[k].space == space) return 1;
+  return 0;
+}
+
+/* Walks def.space and every space nested in it, at any depth (breadth first: the list is the queue): each geom's
+ * body that the registry has not adopted is adopted (a box spawned after the stepper was made, or a body the known
+ * list reached through a joint), and the spaces are remembered as they are now. A walk that fails (a body refused,
+ * a quadtree space) remembers nothing, so the next look walks again and refuses again until the program repairs it. */
 static ssStatus walkSpaces(ssStepper* stepper) {
   stepper->space_count = 0;
-  dSpaceID next = stepper->def.space;
-  for (int walked = 0; next != 0; ++walked) {
-    if (!ssReserveOne((void**)&stepper->spaces, stepper->space_count, &stepper->space_capacity, sizeof(SeenSpace)))
-      return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
-    dSpaceID space = next;
+  ssStatus status = ssReserveOne((void**)&stepper->spaces, 0, &stepper->space_capacity, sizeof(SeenSpace))
+                        ? SS_OK
+                        : ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
+  if (status == SS_OK) stepper->spaces[stepper->space_count++] = (SeenSpace){stepper->def.space, -1, 0, 0};
+  for (int walked = 0; status == SS_OK && walked < stepper->space_count; ++walked) {
+    dSpaceID space = stepper->spaces[walked].space;
+    if ((status = ssCheckSpaceListable(walked == 0 ? "def.space" : "nested space", space)) != SS_OK) break;
     int geoms = dSpaceGetNumGeoms(space);
-    stepper->spaces[stepper->space_count++] = (SeenSpace){space, geoms, geoms > 0 ? dSpaceGetGeom(space, 0) : 0};
-    for (int i = 0; i < geoms; ++i) {
+    for (int i = 0; i < geoms && status == SS_OK; ++i) {
       dGeomID geom = dSpaceGetGeom(space, i);
-      if (dGeomIsSpace(geom)) continue; /* listed above, walked below */
-      dBodyID body = dGeomGetBody(geom);
-      if (body == 0 || ssKnownContains(&stepper->known, body)) continue;
-      ssStatus status = adoptBody(stepper, body); /* idempotent: a body of two geoms, or reached twice, once */
-      if (status != SS_OK) return status;
-    }
-    /* the nested spaces, breadth first: those of spaces walked so far that are not listed yet */
-    next = 0;
-    for (int s = walked; s < stepper->space_count && next == 0; ++s)
-      for (int i = 0, n = stepper->spaces[s].geoms; i < n && next == 0; ++i) {
-        dGeomID geom = dSpaceGetGeom(stepper->spaces[s].space, i);
-        if (!dGeomIsSpace(geom)) continue;
-        int listed = 0;
-        for (int k = 0; k < stepper->space_count; ++k) listed |= stepper->spaces[k].space == (dSpaceID)geom;
-        if (!listed) next = (dSpaceID)geom;
+      if (dGeomIsSpace(geom)) {
+        if (spaceListed(stepper, (dSpaceID)geom)) continue;
+        if (!ssReserveOne((void**)&stepper->spaces, stepper->space_count, &stepper->space_capacity,
+                          sizeof(SeenSpace)))
+          status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
+        else
+          stepper->spaces[stepper->space_count++] = (SeenSpace){(dSpaceID)geom, -1, 0, 0};
+        continue;
       }
+      dBodyID body = dGeomGetBody(geom);
+      /* idempotent: a body of two geoms, or reached twice, once */
+      if (body != 0 && !ssRegistryHasBody(stepper->def.registry, body)) status = adoptBody(stepper, body);
+    }
+  }
+  if (status != SS_OK) { /* nothing remembered: the next look walks again */
+    stepper->space_count = 1;
+    stepper->spaces[0] = (SeenSpace){stepper->def.space, -1, 0, 0};
+    return status;
+  }
+  for (int i = 0; i < stepper->space_count; ++i) {
+    SeenSpace* seen = &stepper->spaces[i];
+    seen->geoms = dSpaceGetNumGeoms(seen->space);
+    seen->first = seen->geoms > 0 ? dSpaceGetGeom(seen->space, 0) : 0;
+    seen->sweep_and_prune = dSpaceGetClass(seen->space) == dSweepAndPruneSpaceClass;
   }
   return refreshKnown(stepper);
 }
@@ -421,6 +461,7 @@ static ssStatus walkSpaces(ssStepper* stepper) {
 static ssStatus findNew(ssStepper* stepper, int look_at_joints) {
   ssStatus status = refreshKnown(stepper);
   if (status == SS_OK && stepper->def.space != 0 && spacesChanged(stepper)) status = walkSpaces(stepper);
+  if (status == SS_OK && stepper->adopt_known_due) status = adoptKnown(stepper);
   dBodyID changed;
   while (status == SS_OK && look_at_joints && ssKnownJointsChanged(&stepper->known, &changed)) {
     status = adoptBody(stepper, changed);
