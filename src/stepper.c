@@ -217,6 +217,9 @@ ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body) {
     if (stepper->watched[i] != body) continue;
     stepper->watched[i] = stepper->watched[--stepper->watched_count];
     stepper->watched_generation += 1;
+    /* the program may destroy it next, in a callback too: the pose history forgets it now (a body still known
+     * otherwise starts its history again at the next frame) */
+    ssPoseHistoryForgetBody(stepper->poses, body);
     return SS_OK;
   }
   return ssFail(SS_ERROR_NOT_FOUND, "body %p: not watched", (void*)body);
@@ -370,15 +373,22 @@ static ssStatus adoptBody(ssStepper* stepper, dBodyID body) {
   return status;
 }
 
-/* With def.space: adopts every known body that the registry has not (reached through a joint made since, or a body
- * watched), with its joints, so that no known body steps with the softness the program tuned for one step. */
+static int watched(const ssStepper* stepper, dBodyID body) {
+  for (int i = 0; i < stepper->watched_count; ++i)
+    if (stepper->watched[i] == body) return 1;
+  return 0;
+}
+
+/* With def.space: adopts every known body that the registry has not (one reached through a joint made since), with
+ * its joints, so that no body joined to the adopted ones steps with the softness the program tuned for one step.
+ * Watched bodies are the program's to adopt or not (ssRegistry_AdoptBody): unwatched, they are known no more. */
 static ssStatus adoptKnown(ssStepper* stepper) {
   stepper->adopt_known_due = 0;
   ssStatus status = SS_OK;
   int adopted = 0;
   for (int k = 0; k < stepper->known.count && status == SS_OK; ++k) {
     dBodyID body = stepper->known.ids[k];
-    if (ssRegistryHasBody(stepper->def.registry, body)) continue;
+    if (ssRegistryHasBody(stepper->def.registry, body) || watched(stepper, body)) continue;
     status = adoptBody(stepper, body);
     adopted = 1;
   }

@@ -470,6 +470,33 @@ TEST_F(PromiseTest, DestroyingAKnownBodyFromEachCallbackIsSafe) {
   }
 }
 
+// Under fixed steps the stepper keeps every known body's last two poses: a watched body the program unwatches and
+// destroys in a callback is never read again (under AddressSanitizer a read would be a heap-use-after-free report).
+TEST_F(PromiseTest, ABodyUnwatchedAndDestroyedInACallbackIsForgottenByThePoseHistory) {
+  dBodyID bob = MakeBody(1.0, 0, 0, 1);  // no geom: known only because it is watched
+  ssStepperDef def = Def();
+  ssSteppingForPolicy("fixed", 0, &def.stepping);
+  struct Program {
+    ssStepper** stepper;
+    dBodyID bob;
+    int calls = 0;
+  } program{&stepper, bob};
+  def.before_step = [](void* context, ssStepper* s) {
+    auto* p = static_cast<Program*>(context);
+    if (++p->calls != 3 || p->bob == nullptr) return;
+    EXPECT_EQ(ssStepper_UnwatchBody(s, p->bob), SS_OK);
+    dBodyDestroy(p->bob);  // with ODE's own call, after unwatching it
+    p->bob = nullptr;
+  };
+  def.before_step_context = &program;
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  ASSERT_EQ(ssStepper_WatchBody(stepper, bob), SS_OK);
+  for (int frame = 0; frame < 4; ++frame) ASSERT_EQ(ssStepper_Step(stepper, 0.04, nullptr), SS_OK) << ssLastError();
+  EXPECT_EQ(program.bob, nullptr);
+  double position[3], quaternion[4];
+  EXPECT_EQ(ssStepper_InterpolatedPose(stepper, bob, position, quaternion), SS_ERROR_NOT_FOUND);
+}
+
 TEST_F(PromiseTest, SteppingAgainFromItsOwnCallbackIsRefusedByName) {
   Box(0, 0, 1);
   struct Reentry {
