@@ -150,6 +150,28 @@ static ssStatus dampingRates(const char* what, double linear, double angular, do
   return SS_OK;
 }
 
+ssStatus ssBodyValuesAsTuned(const char* what, dWorldID world, dBodyID body, double tuned_step_s, ssBodyBinding* out) {
+  memset(out, 0, sizeof *out);
+  out->body = body;
+  double linear = body ? dBodyGetLinearDamping(body) : dWorldGetLinearDamping(world);
+  double angular = body ? dBodyGetAngularDamping(body) : dWorldGetAngularDamping(world);
+  int steps = body ? dBodyGetAutoDisableSteps(body) : dWorldGetAutoDisableSteps(world);
+  double seconds = body ? dBodyGetAutoDisableTime(body) : dWorldGetAutoDisableTime(world);
+  int samples = body ? dBodyGetAutoDisableAverageSamplesCount(body) : dWorldGetAutoDisableAverageSamplesCount(world);
+  ssStatus status = dampingRates(what, linear, angular, tuned_step_s, out);
+  if (status == SS_OK) status = autoDisableTimes(what, steps, seconds, samples, tuned_step_s, out);
+  if (status != SS_OK) return status;
+  /* as the registry's own binding calls would leave it (see bindBody) */
+  out->written_step_s = NAN;
+  out->average_samples_written = samples;
+  if (!out->has_auto_disable) {
+    out->idle_time_s = out->average_window_s = 0;
+    out->tuned.auto_disable_step_s = out->tuned.idle_time_s = 0;
+    out->tuned.idle_steps = out->tuned.average_samples = 0;
+  }
+  return SS_OK;
+}
+
 /* The world's defaults as this adoption binds them, or as bound before; NULL when neither. */
 static const ssBodyBinding* worldDefaults(Plan* plan) {
   if (plan->world_planned) return &plan->world_defaults.binding;

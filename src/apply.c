@@ -628,6 +628,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     dWorldSetCFM(registry->world, registry->world_pending.cfm);
     counts.row_writes += 1;
   }
+  if (registry->world_bound) registry->world_written = registry->world_pending;
   if (by_law) {
     counts.rows.by_mapping += registry->joint_count; /* implicit Euler serves every row */
     counts.row_writes += writeRowsByLaw(registry, law_softness);

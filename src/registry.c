@@ -33,6 +33,7 @@ ssRegistry* ssRegistry_Create(dWorldID world) {
     return NULL;
   }
   registry->world = world;
+  registry->world_written = (ssSoftness){NAN, NAN};
   registry->applied_step_s = NAN;
   registry->body_cache_stale = 1;
   return registry;
@@ -337,51 +338,58 @@ ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body) {
  * (10·(1/60)/(1/60) = 10.000000000000002) must not become one more. */
 static double stepsIn(double seconds, double step_s) { return ceil(seconds / step_s - 1e-9); }
 
+void ssBodyWrittenFor(const ssBodyBinding* binding, double step_s, ssBodyWritten* out) {
+  const ssBodyTuned* tuned = &binding->tuned;
+  *out = (ssBodyWritten){0, 0, 0, 0, 0};
+  if (binding->has_damping) {
+    /* ODE scales velocity by (1 - scale) once per step: this scale removes the same fraction per second */
+    int as_tuned = step_s == tuned->damping_step_s;
+    out->linear_scale = as_tuned ? tuned->linear_scale : -expm1(-binding->linear_rate_per_s * step_s);
+    out->angular_scale = as_tuned ? tuned->angular_scale : -expm1(-binding->angular_rate_per_s * step_s);
+  }
+  if (!binding->has_auto_disable) return;
+  if (step_s == tuned->auto_disable_step_s) {
+    out->idle_steps = tuned->idle_steps;
+    out->idle_time_s = tuned->idle_time_s;
+    out->average_samples = tuned->average_samples;
+    return;
+  }
+  double steps = stepsIn(binding->idle_time_s, step_s);
+  out->idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
+  out->idle_time_s = binding->idle_time_s;
+  /* ODE allocates two vectors a sample for every body: bounded, see SS_MAX_AVERAGE_SAMPLES */
+  double samples = fmax(1.0, stepsIn(binding->average_window_s, step_s));
+  out->average_samples = samples < SS_MAX_AVERAGE_SAMPLES ? (int)samples : SS_MAX_AVERAGE_SAMPLES;
+}
+
 /* The body's numbers for a step of step_s: at the step adoption read them for, the program's own; otherwise what the
  * rates and seconds stand for at this step. */
 static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
   dBodyID body = binding->body;
-  const ssBodyTuned* tuned = &binding->tuned;
+  ssBodyWritten values;
+  ssBodyWrittenFor(binding, step_s, &values);
   if (binding->has_damping) {
-    /* ODE scales velocity by (1 - scale) once per step: this scale removes the same fraction per second */
-    int as_tuned = step_s == tuned->damping_step_s;
-    double linear = as_tuned ? tuned->linear_scale : -expm1(-binding->linear_rate_per_s * step_s);
-    double angular = as_tuned ? tuned->angular_scale : -expm1(-binding->angular_rate_per_s * step_s);
     if (body) {
-      dBodySetLinearDamping(body, linear);
-      dBodySetAngularDamping(body, angular);
+      dBodySetLinearDamping(body, values.linear_scale);
+      dBodySetAngularDamping(body, values.angular_scale);
     } else {
-      dWorldSetLinearDamping(world, linear);
-      dWorldSetAngularDamping(world, angular);
+      dWorldSetLinearDamping(world, values.linear_scale);
+      dWorldSetAngularDamping(world, values.angular_scale);
     }
   }
   if (binding->has_auto_disable) {
-    int idle_steps, average_samples;
-    double idle_time_s;
-    if (step_s == tuned->auto_disable_step_s) {
-      idle_steps = tuned->idle_steps;
-      idle_time_s = tuned->idle_time_s;
-      average_samples = tuned->average_samples;
-    } else {
-      double steps = stepsIn(binding->idle_time_s, step_s);
-      idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
-      idle_time_s = binding->idle_time_s;
-      /* ODE allocates two vectors a sample for every body: bounded, see SS_MAX_AVERAGE_SAMPLES */
-      double samples = fmax(1.0, stepsIn(binding->average_window_s, step_s));
-      average_samples = samples < SS_MAX_AVERAGE_SAMPLES ? (int)samples : SS_MAX_AVERAGE_SAMPLES;
-    }
     if (body) {
-      dBodySetAutoDisableSteps(body, idle_steps);
-      dBodySetAutoDisableTime(body, idle_time_s);
-      if (average_samples != binding->average_samples_written)
-        dBodySetAutoDisableAverageSamplesCount(body, (unsigned)average_samples);
+      dBodySetAutoDisableSteps(body, values.idle_steps);
+      dBodySetAutoDisableTime(body, values.idle_time_s);
+      if (values.average_samples != binding->average_samples_written)
+        dBodySetAutoDisableAverageSamplesCount(body, (unsigned)values.average_samples);
     } else {
-      dWorldSetAutoDisableSteps(world, idle_steps);
-      dWorldSetAutoDisableTime(world, idle_time_s);
-      if (average_samples != binding->average_samples_written)
-        dWorldSetAutoDisableAverageSamplesCount(world, (unsigned)average_samples);
+      dWorldSetAutoDisableSteps(world, values.idle_steps);
+      dWorldSetAutoDisableTime(world, values.idle_time_s);
+      if (values.average_samples != binding->average_samples_written)
+        dWorldSetAutoDisableAverageSamplesCount(world, (unsigned)values.average_samples);
     }
-    binding->average_samples_written = average_samples;
+    binding->average_samples_written = values.average_samples;
   }
   binding->written_step_s = step_s;
 }

@@ -29,6 +29,29 @@ typedef struct ssBodyBinding {
   unsigned char has_damping, has_auto_disable;
 } ssBodyBinding;
 
+/* What body's damping and auto-disable numbers in ODE (body 0: world's defaults) stand for when tuned at
+ * tuned_step_s, as adoption binds them (adopt.c). what names the body in messages. Errors: those of adoption
+ * (SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE: a damping scale outside [0, 1), a negative idle time). */
+ssStatus ssBodyValuesAsTuned(const char* what, dWorldID world, dBodyID body, double tuned_step_s, ssBodyBinding* out);
+
+/* The numbers the registry writes into a body binding's body (or the world's defaults) for a step of step_s. */
+typedef struct ssBodyWritten {
+  double linear_scale, angular_scale; /* has_damping */
+  int idle_steps;                     /* has_auto_disable, with the two below */
+  double idle_time_s;
+  int average_samples;
+} ssBodyWritten;
+void ssBodyWrittenFor(const ssBodyBinding* binding, double step_s, ssBodyWritten* out);
+
+/* The program stays in charge (follow.c): every value the registry writes for each step (the world's ERP/CFM, each
+ * bound joint row, each body's damping and auto-disable) that ODE holds otherwise than the registry last wrote it
+ * was written by the program since, and is taken as newly tuned at the registry's tuned step (or, without adoption,
+ * at the step it was last written for): bound again as what it stands for, so that every step length writes what
+ * the program's value means. *followed (may be NULL) counts the values taken. Nothing is changed on an error.
+ * Errors, naming the value: those of adoption for a value no spring stands for (erp outside [0, 1], cfm < 0, a
+ * damping scale outside [0, 1), ...), SS_ERROR_NO_FINITE_MAPPING. */
+ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed);
+
 /* A number that changes whenever a joint or body is bound or unbound: the stepper rebuilds its list on a change. */
 unsigned ssRegistryGeneration(const ssRegistry* registry);
 

@@ -69,6 +69,7 @@ struct ssRegistry {
   ssRowLaw world_law;
   double world_mass;
   ssSoftness world_pending;
+  ssSoftness world_written; /* what ODE holds since the last Apply (NAN before): follow.c compares it */
   double tuned_step_s;      /* adoption's tuned step; 0 before any */
   ssSoftness tuned_world;   /* the world's ERP/CFM as adopted (contacts without soft modes stand for these) */
   JointBinding* joints;

@@ -530,6 +530,19 @@ static void holdForces(ssStepper* stepper, double remaining_s) {
   stepper->known.carrying = remaining_s > 0 && stepper->known.pushed_count > 0;
 }
 
+/* ---- the program's own writes ---- */
+
+/* Values the program wrote into what the registry rewrites (registry_internal.h, ssRegistryFollowProgram), taken as
+ * newly tuned; the next step applies whatever the mapping. */
+static ssStatus followProgram(ssStepper* stepper, ssFrameReport* report) {
+  if (stepper->def.registry == NULL) return SS_OK;
+  int followed = 0;
+  ssStatus status = ssRegistryFollowProgram(stepper->def.registry, &followed);
+  report->program_writes += followed;
+  if (followed > 0) stepper->apply_due = 1;
+  return status;
+}
+
 /* ---- the checks at the boundary ---- */
 
 static ssStatus latch(ssStepper* stepper, ssStatus status) {
@@ -608,6 +621,9 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
     double previous_step_s = use_history ? stepper->previous_step_s : 0;
     /* bodies made in the last step's callbacks (joints made there are found before the next frame) */
     ssStatus status = i == 0 ? SS_OK : findNew(stepper, 0);
+    /* values the program set in the last step's callbacks */
+    if (status == SS_OK && i > 0 && (def->before_step || def->collide || def->step_done))
+      status = followProgram(stepper, report);
     if (status != SS_OK) return status;
     putForces(stepper, i, step_s, carried_s);
     if (i == 0 || apply_every_step || stepper->apply_due) {
@@ -735,6 +751,7 @@ static ssStatus startFrame(ssStepper* stepper, ssFrameReport* report) {
     }
     if (joints_changed) status = findNew(stepper, 1);
   }
+  if (status == SS_OK) status = followProgram(stepper, report);
   /* after the check, on the list it passed: the bodies are those the program repaired, within every bound */
   if (status == SS_OK && stepper->rebase_gears) {
     ssGearsRebase(stepper->known.geared, stepper->known.geared_count);

@@ -61,6 +61,14 @@
  * its position is SS_MAX_POSITION_M less the farthest offset of its geoms from it (dGeomSetOffsetPosition), as
  * they were when the body became known.
  *
+ * The program's own writes. A program may go on setting what it tuned (world ERP/CFM, a joint's parameters, a body's
+ * damping or auto-disable) after adoption, from its settings or its entities. Before each frame, and before each
+ * step that follows a callback, the stepper compares every value it rewrites for each step with what it last wrote:
+ * one that differs was the program's, and is taken as newly tuned at the tuned step (as adoption took the first),
+ * so that every step length gets what the program's value means. report->program_writes counts them. A value no
+ * spring stands for (an erp outside [0, 1], a cfm below 0, a damping scale of 1) refuses the frame by name, with
+ * nothing stepped, until the program sets another.
+ *
  * Callbacks (before_step, collide, step_done) may call, on their own stepper:
  *  - ssStepper_CurrentStep, ssStepper_SoftenContact, ssStepper_Stepping, ssStepper_ResetHistory, WatchBody,
  *    UnwatchBody: as between frames; the known list follows before the next check.
@@ -159,6 +167,9 @@ typedef struct ssFrameReport {
   ssServedCounts contacts;    /* contacts softened with ssStepper_SoftenContact, by who served them */
   int row_writes;             /* parameter sets written into ODE, summed over the frame's Applies (implicit Euler
                                * applies once a frame of equal substeps, and writes only what changed) */
+  int program_writes;         /* values the program wrote into ODE since the stepper last looked (the world's
+                               * ERP/CFM, a bound joint row, a body's damping or auto-disable), each taken as newly
+                               * tuned at the tuned step (see "The program's own writes" at the top) */
   dBodyID failed_body;        /* the body that blew up or ran too fast, else 0 */
 } ssFrameReport;
 

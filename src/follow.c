@@ -1,0 +1,168 @@
+/* The program stays in charge (registry_internal.h, ssRegistryFollowProgram): values a program writes into ODE after
+ * adoption (a settings menu, an entity's fields, a script) are noticed where they differ from what Apply last wrote,
+ * and bound again as what they stand for, the way adoption read them. Without this, a program that sets world ERP
+ * 0.8 between frames keeps it while the frames keep their length and loses it to the adopted value as soon as one
+ * frame is longer: the library itself would make the program's setting depend on the frame rate.
+ *
+ * Two passes, as Apply's: every changed value is read and turned into its law first, and the bindings change only
+ * when all of them passed, so that an error leaves the registry as it was. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "error.h"
+#include "joint_rows.h"
+#include "ode_bounds.h"
+#include "registry_layout.h"
+
+/* A row the program wrote: its binding, what ODE holds now and the law that stands for it. */
+typedef struct FollowedRow {
+  int binding;
+  ssSoftness held;
+  ssRowLaw law;
+} FollowedRow;
+
+/* The step the program's values are taken as tuned for: adoption's, or (springs bound by hand, no adoption) the
+ * step the registry last wrote them for. 0: none yet, nothing to compare with. */
+static double meantFor(const ssRegistry* registry) {
+  if (registry->tuned_step_s > 0) return registry->tuned_step_s;
+  return isfinite(registry->applied_step_s) ? registry->applied_step_s : 0;
+}
+
+/* What the binding holds in ODE as the registry wrote it (NAN: nothing written since it was bound). */
+static ssSoftness writtenOf(const ssRegistry* registry, const JointBinding* binding) {
+  if (registry->written_by_law && binding->law_slot >= 0) return registry->law_written[binding->law_slot];
+  return binding->written;
+}
+
+/* The law a value the program wrote stands for, checked as adoption checks it; the message names the row. */
+static ssStatus lawOfWritten(const char* what, ssSoftness held, double step_s, ssRowLaw* law) {
+  ssStatus status = ssRowLawFromTuned(what, held.erp, held.cfm, step_s, law);
+  return status == SS_OK ? ssCheckLawForEveryStep(what, law) : status;
+}
+
+static ssStatus followRows(ssRegistry* registry, double step_s, FollowedRow** out, int* count) {
+  *out = NULL;
+  *count = 0;
+  int capacity = 0;
+  for (int i = 0; i < registry->joint_count; ++i) {
+    const JointBinding* binding = &registry->joints[i];
+    if (binding->writer.set == NULL) continue; /* plane-2D: ODE cannot read it back */
+    ssSoftness written = writtenOf(registry, binding);
+    if (isnan(written.cfm)) continue;
+    double erp, cfm;
+    ssJointReadSoftness(binding->joint, binding->param, binding->axis, &erp, &cfm);
+    int has_erp = binding->writer.erp_number >= 0;
+    if (ssSameInOde(cfm, written.cfm) && (!has_erp || ssSameInOde(erp, written.erp))) continue;
+    /* a motor row (no erp) stands for a damper: its law is read with erp 0, as adoption reads it */
+    ssSoftness held = {has_erp ? erp : 0, cfm};
+    FollowedRow row = {i, held, {{0, 0}, 0, 0, 0, {0, 0}}};
+    char what[96];
+    snprintf(what, sizeof what, "%s joint %p, %s axis %d, as the program wrote it", ssJointTypeName(binding->joint),
+             (void*)binding->joint, ssJointParamName(binding->param), binding->axis);
+    ssStatus status = lawOfWritten(what, held, step_s, &row.law);
+    if (status == SS_OK && *count == capacity) {
+      capacity = capacity ? 2 * capacity : 8;
+      FollowedRow* larger = realloc(*out, (size_t)capacity * sizeof *larger);
+      if (larger == NULL) status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory following the program's writes");
+      else *out = larger;
+    }
+    if (status != SS_OK) {
+      free(*out);
+      *out = NULL;
+      return status;
+    }
+    (*out)[(*count)++] = row;
+  }
+  return SS_OK;
+}
+
+/* Whether the body binding's numbers in ODE are those the registry last wrote. */
+static int bodyAsWritten(const ssRegistry* registry, const ssBodyBinding* binding) {
+  ssBodyWritten written;
+  ssBodyWrittenFor(binding, binding->written_step_s, &written);
+  dBodyID body = binding->body;
+  dWorldID world = registry->world;
+  if (binding->has_damping &&
+      (!ssSameInOde(written.linear_scale, body ? dBodyGetLinearDamping(body) : dWorldGetLinearDamping(world)) ||
+       !ssSameInOde(written.angular_scale, body ? dBodyGetAngularDamping(body) : dWorldGetAngularDamping(world))))
+    return 0;
+  if (!binding->has_auto_disable) return 1;
+  int steps = body ? dBodyGetAutoDisableSteps(body) : dWorldGetAutoDisableSteps(world);
+  double seconds = body ? dBodyGetAutoDisableTime(body) : dWorldGetAutoDisableTime(world);
+  int samples = body ? dBodyGetAutoDisableAverageSamplesCount(body) : dWorldGetAutoDisableAverageSamplesCount(world);
+  return steps == written.idle_steps && ssSameInOde(seconds, written.idle_time_s) &&
+         samples == binding->average_samples_written;
+}
+
+ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
+  if (followed != NULL) *followed = 0;
+  double step_s = meantFor(registry);
+  if (step_s == 0) return SS_OK;
+  dWorldID world = registry->world;
+  /* the world's rows */
+  int world_followed = 0;
+  ssRowLaw world_law;
+  ssSoftness world_held = {dWorldGetERP(world), dWorldGetCFM(world)};
+  if (registry->world_bound && !isnan(registry->world_written.cfm) &&
+      (!ssSameInOde(world_held.erp, registry->world_written.erp) ||
+       !ssSameInOde(world_held.cfm, registry->world_written.cfm))) {
+    ssStatus status = lawOfWritten("world ERP/CFM, as the program wrote them,", world_held, step_s, &world_law);
+    if (status != SS_OK) return status;
+    world_followed = 1;
+  }
+  FollowedRow* rows;
+  int row_count;
+  ssStatus status = followRows(registry, step_s, &rows, &row_count);
+  if (status != SS_OK) return status;
+  /* the bodies (and the world's defaults, body 0), each planned whole */
+  ssBodyBinding* bodies = NULL;
+  int* body_at = NULL;
+  int body_count = 0;
+  for (int i = 0; i < registry->body_count && status == SS_OK; ++i) {
+    const ssBodyBinding* binding = &registry->bodies[i];
+    if (isnan(binding->written_step_s) || bodyAsWritten(registry, binding)) continue;
+    ssBodyBinding* larger_bodies = realloc(bodies, (size_t)(body_count + 1) * sizeof *bodies);
+    int* larger_at = realloc(body_at, (size_t)(body_count + 1) * sizeof *body_at);
+    if (larger_bodies != NULL) bodies = larger_bodies;
+    if (larger_at != NULL) body_at = larger_at;
+    if (larger_bodies == NULL || larger_at == NULL) {
+      status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory following the program's writes");
+      break;
+    }
+    char what[64] = "world's defaults, as the program set them,";
+    if (binding->body) snprintf(what, sizeof what, "body %p, as the program set it,", (void*)binding->body);
+    status = ssBodyValuesAsTuned(what, world, binding->body, step_s, &bodies[body_count]);
+    body_at[body_count++] = i;
+  }
+  if (status != SS_OK) {
+    free(rows);
+    free(bodies);
+    free(body_at);
+    return status;
+  }
+
+  /* Nothing below can fail: every followed value is bound as what it stands for. */
+  if (row_count > 0) ssApplyMaterializeWritten(registry); /* the rows' own written, before they change */
+  for (int r = 0; r < row_count; ++r) {
+    JointBinding* binding = &registry->joints[rows[r].binding];
+    binding->law = rows[r].law;
+    binding->written = rows[r].held; /* what ODE holds: Apply writes the law's softness over it */
+    binding->computed_step_s = NAN;
+  }
+  if (world_followed) {
+    registry->world_law = world_law;
+    registry->world_written = world_held;
+    if (registry->tuned_step_s > 0) registry->tuned_world = world_law.tuned; /* contacts without soft modes */
+  }
+  for (int b = 0; b < body_count; ++b) {
+    registry->bodies[body_at[b]] = bodies[b]; /* its samples written: what ODE holds now */
+  }
+  int total = world_followed + row_count + body_count;
+  if (total > 0) registry->revision += 1; /* Apply computes and writes again, even at the same step */
+  if (followed != NULL) *followed = total;
+  free(rows);
+  free(bodies);
+  free(body_at);
+  return SS_OK;
+}
