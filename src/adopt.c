@@ -15,6 +15,7 @@
 #include "error.h"
 #include "joint_rows.h"
 #include "ode_bounds.h"
+#include "pointer_set.h"
 #include "registry_internal.h"
 #include "row_law.h"
 
@@ -34,12 +35,6 @@ typedef struct PlannedBody {
   int samples_held;
 } PlannedBody;
 
-/* Pointers seen by the walk: open addressing, grown at half full. */
-typedef struct PointerSet {
-  const void** slots;
-  size_t capacity, count;
-} PointerSet;
-
 typedef struct Plan {
   ssRegistry* registry;
   dWorldID world;
@@ -54,48 +49,16 @@ typedef struct Plan {
   int body_count, body_capacity;
   dBodyID* pending; /* bodies still to walk from */
   int pending_count, pending_capacity;
-  PointerSet seen;
+  ssPointerSet seen; /* bodies and joints the walk has met */
   ssAdoptReport counts;
   int out_of_memory;
 } Plan;
-
-/* As the registry's index (binding_index.c): objects made together stay near each other in the set. */
-static size_t slotOf(const void* pointer, size_t capacity) {
-  uint64_t address = (uint64_t)(uintptr_t)pointer;
-  return (size_t)((address >> 4) + ((address >> 20) * 0x9E3779B97F4A7C15ull >> 32)) & (capacity - 1);
-}
-
-/* Adds pointer; returns 1 if it was new, 0 if seen before, -1 when out of memory. */
-static int addSeen(PointerSet* set, const void* pointer) {
-  if (2 * (set->count + 1) > set->capacity) {
-    size_t capacity = set->capacity ? 2 * set->capacity : 64;
-    const void** slots = calloc(capacity, sizeof *slots);
-    if (slots == NULL) return -1;
-    for (size_t i = 0; i < set->capacity; ++i) {
-      if (set->slots[i] == NULL) continue;
-      size_t j = slotOf(set->slots[i], capacity);
-      while (slots[j] != NULL) j = (j + 1) & (capacity - 1);
-      slots[j] = set->slots[i];
-    }
-    free(set->slots);
-    set->slots = slots;
-    set->capacity = capacity;
-  }
-  size_t j = slotOf(pointer, set->capacity);
-  while (set->slots[j] != NULL) {
-    if (set->slots[j] == pointer) return 0;
-    j = (j + 1) & (set->capacity - 1);
-  }
-  set->slots[j] = pointer;
-  set->count += 1;
-  return 1;
-}
 
 static void freePlan(Plan* plan) {
   free(plan->rows);
   free(plan->bodies);
   free(plan->pending);
-  free(plan->seen.slots);
+  ssPointerSetFree(&plan->seen);
 }
 
 static ssStatus outOfMemory(void) { return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory adopting"); }
@@ -205,7 +168,7 @@ static int pushPending(Plan* plan, dBodyID body) {
 }
 
 static ssStatus planBody(Plan* plan, dBodyID body) {
-  int added = addSeen(&plan->seen, body);
+  int added = ssPointerSetAdd(&plan->seen, body);
   if (added < 0) return outOfMemory();
   if (added == 0) return SS_OK;
   ssStatus status = requireSameWorld(plan, 0, body);
@@ -304,7 +267,7 @@ static ssStatus planRow(Plan* plan, dJointID joint, int joint_type, ssJointParam
 
 /* Plans the joint's rows and its bodies (queued in pending: walk() goes on from them, AdoptJoint does not). */
 static ssStatus planJoint(Plan* plan, dJointID joint) {
-  int added = addSeen(&plan->seen, joint);
+  int added = ssPointerSetAdd(&plan->seen, joint);
   if (added < 0) return outOfMemory();
   if (added == 0) return SS_OK;
   int type = dJointGetType(joint);

@@ -9,7 +9,9 @@
 #include <string.h>
 
 #include "error.h"
+#include "array.h"
 #include "gears.h"
+#include "pointer_set.h"
 #include "steadystep/limits.h"
 
 void ssKnownFree(ssKnownBodies* known) {
@@ -22,68 +24,32 @@ void ssKnownFree(ssKnownBodies* known) {
   memset(known, 0, sizeof *known);
 }
 
-/* ---- the walk through joints: a growing list with an open-addressing set of the bodies in it ---- */
+/* ---- the walk through joints: a growing list and the set of the bodies in it ---- */
 
 typedef struct BodyWalk {
   dBodyID* list;
   int count, capacity;
-  dBodyID* slots; /* 0: empty */
-  size_t mask;
+  ssPointerSet seen;
   int failed; /* out of memory */
 } BodyWalk;
-
-static size_t slotOf(const BodyWalk* walk, dBodyID body) {
-  return (size_t)((((uintptr_t)body >> 4) * UINT64_C(0x9E3779B97F4A7C15)) >> 17) & walk->mask;
-}
-
-static int insertSlot(BodyWalk* walk, dBodyID body) {
-  size_t i = slotOf(walk, body);
-  while (walk->slots[i] != 0) {
-    if (walk->slots[i] == body) return 0;
-    i = (i + 1) & walk->mask;
-  }
-  walk->slots[i] = body;
-  return 1;
-}
 
 /* Adds body to the walk unless it is there already. */
 static void visitBody(void* context, dBodyID body) {
   BodyWalk* walk = context;
   if (walk->failed || body == 0) return;
-  if (2 * (size_t)(walk->count + 1) > walk->mask + 1) { /* keep the set at most half full */
-    size_t size = 2 * (walk->mask + 1);
-    dBodyID* slots = calloc(size, sizeof *slots);
-    if (slots == NULL) {
-      walk->failed = 1;
-      return;
-    }
-    dBodyID* old = walk->slots;
-    walk->slots = slots;
-    walk->mask = size - 1;
-    for (int i = 0; i < walk->count; ++i) insertSlot(walk, walk->list[i]);
-    free(old);
+  if (walk->count == walk->capacity &&
+      !ssReserveOne((void**)&walk->list, walk->count, &walk->capacity, sizeof *walk->list)) {
+    walk->failed = 1;
+    return;
   }
-  if (walk->count == walk->capacity) {
-    int capacity = walk->capacity > 0 ? 2 * walk->capacity : 64;
-    dBodyID* list = realloc(walk->list, (size_t)capacity * sizeof *list);
-    if (list == NULL) {
-      walk->failed = 1;
-      return;
-    }
-    walk->list = list;
-    walk->capacity = capacity;
-  }
-  if (insertSlot(walk, body)) walk->list[walk->count++] = body;
-}
-
-static int compareIds(const void* a, const void* b) {
-  uintptr_t x = (uintptr_t) * (const dBodyID*)a, y = (uintptr_t) * (const dBodyID*)b;
-  return (x > y) - (x < y);
+  int added = ssPointerSetAdd(&walk->seen, body);
+  if (added < 0) walk->failed = 1;
+  if (added > 0) walk->list[walk->count++] = body;
 }
 
 static const ssKnownBody* findOld(const ssKnownBodies* known, dBodyID body) {
   if (!known->valid) return NULL;
-  const dBodyID* found = bsearch(&body, known->ids, (size_t)known->count, sizeof body, compareIds);
+  const dBodyID* found = bsearch(&body, known->ids, (size_t)known->count, sizeof body, ssCompareHandles);
   return found != NULL ? &known->bodies[found - known->ids] : NULL;
 }
 
@@ -117,8 +83,7 @@ static uint64_t positionBound(dBodyID body) {
 }
 
 ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const dBodyID* watched, int watched_count) {
-  BodyWalk walk = {.slots = calloc(64, sizeof(dBodyID)), .mask = 63};
-  if (walk.slots == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
+  BodyWalk walk = {0};
   ssRegistry_VisitBodies(registry, visitBody, &walk);
   for (int i = 0; i < watched_count; ++i) visitBody(&walk, watched[i]);
   /* what they reach through joints (contacts are transient, and reach only what collision reaches anyway) */
@@ -137,7 +102,7 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
   ssBodyValues* values = walk.failed ? NULL : malloc(room * sizeof *values);
   dJointID* first_joints = walk.failed ? NULL : malloc(room * sizeof *first_joints);
   int* pushed = walk.failed ? NULL : malloc(room * sizeof *pushed);
-  free(walk.slots);
+  ssPointerSetFree(&walk.seen);
   if (bodies == NULL || ids == NULL || values == NULL || first_joints == NULL || pushed == NULL) {
     free(walk.list);
     free(bodies);
@@ -147,7 +112,7 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
     free(pushed);
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
   }
-  if (count > 0) qsort(walk.list, count, sizeof(dBodyID), compareIds);
+  if (count > 0) qsort(walk.list, count, sizeof(dBodyID), ssCompareHandles);
   for (size_t i = 0; i < count; ++i) {
     dBodyID body = walk.list[i];
     const ssKnownBody* old = findOld(known, body);

@@ -7,6 +7,7 @@
 
 #include "error.h"
 #include "ode_bounds.h"
+#include "pointer_set.h"
 #include "registry_layout.h"
 #include "steadystep/adopt.h"
 #include "steadystep/registry.h"
@@ -484,11 +485,6 @@ static void appendBody(void* context, dBodyID body) {
   list->bodies[list->count++] = body;
 }
 
-static int compareBodies(const void* a, const void* b) {
-  uintptr_t x = (uintptr_t) * (const dBodyID*)a, y = (uintptr_t) * (const dBodyID*)b;
-  return (x > y) - (x < y);
-}
-
 void ssRegistry_VisitBodies(const ssRegistry* registry, void (*visit)(void* context, dBodyID body), void* context) {
   if (registry == NULL || visit == NULL) return;
   size_t most = 2 * (size_t)registry->joint_count + (size_t)registry->body_count;
@@ -498,7 +494,7 @@ void ssRegistry_VisitBodies(const ssRegistry* registry, void (*visit)(void* cont
     return;
   }
   visitBodiesRepeated(registry, appendBody, &list);
-  qsort(list.bodies, (size_t)list.count, sizeof(dBodyID), compareBodies);
+  qsort(list.bodies, (size_t)list.count, sizeof(dBodyID), ssCompareHandles);
   for (int i = 0; i < list.count; ++i)
     if (i == 0 || list.bodies[i] != list.bodies[i - 1]) visit(context, list.bodies[i]);
   free(list.bodies);
