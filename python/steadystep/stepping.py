@@ -33,7 +33,9 @@ class Stepping:
 
     cut: FrameCut = FrameCut(_DEFAULT.cut)             # how a frame becomes steps
     mapping: Mapping = Mapping(_DEFAULT.mapping)       # how each spring becomes ERP/CFM for a step
-    frozen_step_s: float = _DEFAULT.frozen_step_s      # s; > 0 freezes the softness at that step (naive); 0: none
+    # s; > 0 freezes the softness at that step (naive); -1 (SS_FROZEN_AT_TUNED_STEP): at the stepper's tuned step;
+    # 0 (default): each step's own length
+    frozen_step_s: float = _DEFAULT.frozen_step_s
     solver: Solver = Solver(_DEFAULT.solver)           # dWorldQuickStep or dWorldStep; UNSET (default) is refused
     quick_iterations: int = _DEFAULT.quick_iterations  # QuickStep iterations set before each frame; 0: the world's
     max_step_s: float = _DEFAULT.max_step_s            # SUBSTEPS: the longest substep (s); 0 (default): the tuned
