@@ -18,7 +18,7 @@ void ssKnownFree(ssKnownBodies* known) {
   free(known->bodies);
   free(known->ids);
   free(known->values);
-  free(known->first_joints);
+  free(known->joints);
   free(known->pushed);
   free(known->geared);
   memset(known, 0, sizeof *known);
@@ -45,6 +45,18 @@ static void visitBody(void* context, dBodyID body) {
   int added = ssPointerSetAdd(&walk->seen, body);
   if (added < 0) walk->failed = 1;
   if (added > 0) walk->list[walk->count++] = body;
+}
+
+/* The body's joints as the stepper sees them (ssJointSignature): a step's contacts are made after the program's
+ * joints and emptied after the step, and hide nothing. */
+static ssJointSignature jointSignature(dBodyID body) {
+  ssJointSignature signature = {0, 0};
+  for (int i = 0, count = dBodyGetNumJoints(body); i < count; ++i) {
+    dJointID joint = dBodyGetJoint(body, i);
+    if (dJointGetType(joint) == dJointTypeContact) continue;
+    if (signature.count++ == 0) signature.first = joint;
+  }
+  return signature;
 }
 
 static const ssKnownBody* findOld(const ssKnownBodies* known, dBodyID body) {
@@ -100,15 +112,15 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
   ssKnownBody* bodies = walk.failed ? NULL : calloc(room, sizeof *bodies);
   dBodyID* ids = walk.failed ? NULL : malloc(room * sizeof *ids);
   ssBodyValues* values = walk.failed ? NULL : malloc(room * sizeof *values);
-  dJointID* first_joints = walk.failed ? NULL : malloc(room * sizeof *first_joints);
+  ssJointSignature* joints = walk.failed ? NULL : malloc(room * sizeof *joints);
   int* pushed = walk.failed ? NULL : malloc(room * sizeof *pushed);
   ssPointerSetFree(&walk.seen);
-  if (bodies == NULL || ids == NULL || values == NULL || first_joints == NULL || pushed == NULL) {
+  if (bodies == NULL || ids == NULL || values == NULL || joints == NULL || pushed == NULL) {
     free(walk.list);
     free(bodies);
     free(ids);
     free(values);
-    free(first_joints);
+    free(joints);
     free(pushed);
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
   }
@@ -121,8 +133,8 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
     values[i] = (ssBodyValues){dBodyGetPosition(body),  dBodyGetLinearVel(body), dBodyGetAngularVel(body),
                                dBodyGetForce(body),     dBodyGetTorque(body),
                                positionBound(body)};
-    /* a body that stays keeps the first joint it was listed with: a joint attached since is still seen as new */
-    first_joints[i] = old != NULL ? known->first_joints[old - known->bodies] : dBodyGetJoint(body, 0);
+    /* a body that stays keeps the joints it was listed with: a joint attached since is still seen as new */
+    joints[i] = old != NULL ? known->joints[old - known->bodies] : jointSignature(body);
   }
   free(walk.list);
   int geared_count = 0;
@@ -132,7 +144,7 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
     free(bodies);
     free(ids);
     free(values);
-    free(first_joints);
+    free(joints);
     free(pushed);
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
   }
@@ -144,7 +156,7 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
   *known = (ssKnownBodies){.bodies = bodies,
                            .ids = ids,
                            .values = values,
-                           .first_joints = first_joints,
+                           .joints = joints,
                            .count = (int)count,
                            .pushed = pushed,
                            .carrying = carrying,
@@ -166,17 +178,11 @@ void ssKnownForget(ssKnownBodies* known, dBodyID body) {
   memmove(&known->bodies[k], &known->bodies[k + 1], after * sizeof *known->bodies);
   memmove(&known->ids[k], &known->ids[k + 1], after * sizeof *known->ids);
   memmove(&known->values[k], &known->values[k + 1], after * sizeof *known->values);
-  memmove(&known->first_joints[k], &known->first_joints[k + 1], after * sizeof *known->first_joints);
+  memmove(&known->joints[k], &known->joints[k + 1], after * sizeof *known->joints);
   known->count -= 1;
   for (int g = 0; g < known->geared_count; ++g)
     if (known->geared[g] == body) known->geared[g--] = known->geared[--known->geared_count];
   listPushed(known);
-}
-
-/* Whether a body's first joint is not the one listed; a contact there hides nothing (ODE attaches the step's
- * contacts after the program's joints, and the stepper empties them after each step). */
-static int firstJointChanged(dJointID first, dJointID listed) {
-  return first != listed && (first == 0 || dJointGetType(first) != dJointTypeContact);
 }
 
 /* How many bodies ahead the passes ask for a body's memory: a large world's bodies are out of cache after ODE's step
@@ -189,13 +195,30 @@ static int prefetchUntil(int count) { return count >= kPrefetchFrom ? count - kP
 
 /* The body and the head of its first joint (where ODE keeps its joint list): what dBodyGetJoint reads. */
 static void prefetchJoints(const ssKnownBodies* known, int k) {
-  const char* joint = (const char*)known->first_joints[k];
+  const char* joint = (const char*)known->joints[k].first;
   __builtin_prefetch(known->ids[k]);
   if (joint != NULL) __builtin_prefetch(joint), __builtin_prefetch(joint + 64);
 }
 
 static int jointsChangedAt(const ssKnownBodies* known, int k) {
-  return firstJointChanged(dBodyGetJoint(known->ids[k], 0), known->first_joints[k]);
+  ssJointSignature now = jointSignature(known->ids[k]);
+  return now.first != known->joints[k].first || now.count != known->joints[k].count;
+}
+
+ssStatus ssKnownCollectJoints(const ssKnownBodies* known, ssPointerSet* joints) {
+  for (int k = 0; k < known->count; ++k) {
+    dBodyID body = known->ids[k];
+    for (int i = 0, count = dBodyGetNumJoints(body); i < count; ++i) {
+      dJointID joint = dBodyGetJoint(body, i);
+      if (dJointGetType(joint) != dJointTypeContact && ssPointerSetAdd(joints, joint) < 0)
+        return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies' joints");
+    }
+  }
+  return SS_OK;
+}
+
+void ssKnownTakeJoints(ssKnownBodies* known) {
+  for (int k = 0; k < known->count; ++k) known->joints[k] = jointSignature(known->ids[k]);
 }
 
 int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body) {

@@ -12,6 +12,7 @@
 
 #include <ode/ode.h>
 
+#include "pointer_set.h"
 #include "steadystep/registry.h"
 #include "steadystep/status.h"
 
@@ -38,11 +39,18 @@ typedef struct ssBodyValues {
   uint64_t position_bound;
 } ssBodyValues;
 
+/* A body's joints other than contacts, as the stepper last saw them: ODE attaches a new joint at the head of its
+ * body's list, so a joint attached since changes the first, and one destroyed or detached the count. */
+typedef struct ssJointSignature {
+  dJointID first;
+  int count;
+} ssJointSignature;
+
 typedef struct ssKnownBodies {
   ssKnownBody* bodies;    /* at a step, read for pushed bodies only (and for all while a force is carried) */
   dBodyID* ids;           /* bodies[i].body, packed */
   ssBodyValues* values;   /* bodies[i]'s values, packed: the checks read nothing else */
-  dJointID* first_joints; /* each body's first joint when listed */
+  ssJointSignature* joints; /* each body's joints when listed */
   int count;
   int* pushed; /* indices into bodies of those with pushed set, and only those */
   int pushed_count;
@@ -66,9 +74,16 @@ int ssKnownContains(const ssKnownBodies* known, dBodyID body);
 /* Takes body off the list at once (it is about to be destroyed). */
 void ssKnownForget(ssKnownBodies* known, dBodyID body);
 
-/* Whether a body's first joint differs from the one listed (a joint was attached or detached since), giving the
- * first such body. */
+/* Whether a body's joints differ from those listed (a joint was attached, detached or destroyed since), giving the
+ * first such body (body may be NULL). */
 int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body);
+
+/* Adds every joint of every listed body (contacts aside) to joints: the joints alive and attached to a known body.
+ * Errors: SS_ERROR_OUT_OF_MEMORY. */
+ssStatus ssKnownCollectJoints(const ssKnownBodies* known, ssPointerSet* joints);
+
+/* Takes the listed bodies' joints as they are now (after the stepper followed a change). */
+void ssKnownTakeJoints(ssKnownBodies* known);
 
 /* Sets every listed body's force and torque accumulators to its frame force (with_frame_forces) or to zero. */
 void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces);

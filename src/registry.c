@@ -252,6 +252,20 @@ ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
   return SS_OK;
 }
 
+int ssRegistryUnbindJointsNotIn(ssRegistry* registry, const ssPointerSet* alive) {
+  ssApplyMaterializeWritten(registry);
+  int kept = 0;
+  for (int i = 0; i < registry->joint_count; ++i)
+    if (ssPointerSetHas(alive, registry->joints[i].joint)) registry->joints[kept++] = registry->joints[i];
+  int unbound = registry->joint_count - kept;
+  if (unbound == 0) return 0;
+  registry->joint_count = kept;
+  reindexJoints(registry);
+  registry->generation += 1;
+  registry->revision += 1;
+  return unbound;
+}
+
 ssBodyBinding* ssRegistryFindBody(ssRegistry* registry, dBodyID body) {
   int position = ssIndexFind(&registry->body_index, body, 0);
   return position >= 0 ? &registry->bodies[position] : NULL;

@@ -2,6 +2,7 @@
 #ifndef STEADYSTEP_REGISTRY_INTERNAL_H
 #define STEADYSTEP_REGISTRY_INTERNAL_H
 
+#include "pointer_set.h"
 #include "row_law.h"
 #include "steadystep/registry.h"
 
@@ -68,6 +69,9 @@ void ssRegistryAppendJointLaw(ssRegistry* registry, dJointID joint, int joint_ty
                               ssRowLaw law);
 void ssRegistryAppendBody(ssRegistry* registry, const ssBodyBinding* binding);
 int ssRegistryHasJoint(const ssRegistry* registry, dJointID joint);
+/* Unbinds every joint row whose joint is not in alive, reading none of them (a joint the program destroyed with
+ * dJointDestroy is freed memory); returns the rows unbound. */
+int ssRegistryUnbindJointsNotIn(ssRegistry* registry, const ssPointerSet* alive);
 int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam param, int axis);
 
 /* The body's binding (0: the world's defaults), or NULL. */

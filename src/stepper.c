@@ -13,6 +13,7 @@
 #include "interpolation_internal.h"
 #include "known_bodies.h"
 #include "ode_bounds.h"
+#include "pointer_set.h"
 #include "registry_internal.h"
 #include "steadystep/adopt.h"
 #include "steadystep/stepper.h"
@@ -46,6 +47,8 @@ struct ssStepper {
   int space_count, space_capacity;
   int apply_due;         /* bindings were added within the frame: the next step applies whatever the mapping */
   int adopt_known_due;   /* the known list was rebuilt: bodies on it the registry has not are adopted (adoptKnown) */
+  ssPointerSet anchored; /* the bodies with a geom in the adopted spaces at the last listing (forgetDestroyed) */
+  int adopt_anchored_due; /* the spaces were listed: their bodies the registry has not are adopted (adoptAnchored) */
   int in_step;           /* inside ssStepper_Step: its callbacks are running */
   int destroy_requested; /* ssStepper_Destroy was called from a callback: done when ssStepper_Step returns */
   int rebase_gears;      /* ssStepper_Reset was called: the next frame has ODE measure its gears afresh (gears.h) */
@@ -133,6 +136,8 @@ static void resolveSpeeds(ssStepping* stepping) {
   if (stepping->max_angular_speed == 0) stepping->max_angular_speed = SS_MAX_SAFE_SPEED;
 }
 
+static ssStatus listSpaces(ssStepper* stepper, ssPointerSet* live);
+
 ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   ssStatus status = ssCheckOdePrecision();
   if (status == SS_OK) status = validateDef(def);
@@ -156,8 +161,11 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
       return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating a stepper");
     }
     stepper->spaces[stepper->space_count++] = (SeenSpace){def->space, -1, 0, 0};
-    if ((status = ssRegistry_Adopt(registry, tuned_step_s, def->space, &stepper->adopted)) != SS_OK) {
+    /* adopted, and the spaces listed as they are: what the program destroys from now on is told by the listing */
+    if ((status = ssRegistry_Adopt(registry, tuned_step_s, def->space, &stepper->adopted)) != SS_OK ||
+        (status = listSpaces(stepper, &stepper->anchored)) != SS_OK) {
       ssRegistry_Destroy(stepper->owned_registry);
+      ssPointerSetFree(&stepper->anchored);
       free(stepper->spaces);
       free(stepper);
       return status;
@@ -172,16 +180,33 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   return SS_OK;
 }
 
+static ssStatus forgetDestroyed(ssStepper* stepper, int look_at_joints);
+static ssStatus followProgram(ssStepper* stepper, ssFrameReport* report);
+
+/* What the stepper adopted goes back to the program's own numbers at the tuned step (the ones it tuned, or wrote
+ * since): the world is the program's again, and a stepper made on it next adopts what the program tuned, not what
+ * this one last wrote for another step. What the program destroyed is forgotten first. Nothing when it adopted
+ * nothing, or when a listing fails (a quadtree space). */
+static void restoreTuned(ssStepper* stepper) {
+  ssRegistry* registry = stepper->def.registry;
+  if (stepper->def.space == 0 || registry == NULL || forgetDestroyed(stepper, 1) != SS_OK) return;
+  ssFrameReport unused = {0};
+  if (followProgram(stepper, &unused) != SS_OK) return; /* a value no spring stands for: left as the program set it */
+  ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, stepper->tuned_step_s, 0, NULL);
+}
+
 void ssStepper_Destroy(ssStepper* stepper) {
   if (stepper == NULL) return;
   if (stepper->in_step) { /* from its own callback: the frame stops, and ssStepper_Step frees it on return */
     stepper->destroy_requested = 1;
     return;
   }
+  restoreTuned(stepper);
   ssRegistry_Destroy(stepper->owned_registry);
   free(stepper->watched);
   ssKnownFree(&stepper->known);
   free(stepper->spaces);
+  ssPointerSetFree(&stepper->anchored);
   ssPoseHistoryDestroy(stepper->poses);
   free(stepper);
 }
@@ -217,8 +242,9 @@ ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body) {
     if (stepper->watched[i] != body) continue;
     stepper->watched[i] = stepper->watched[--stepper->watched_count];
     stepper->watched_generation += 1;
-    /* the program may destroy it next, in a callback too: the pose history forgets it now (a body still known
-     * otherwise starts its history again at the next frame) */
+    /* the program may destroy it next, in a callback too: the known list and the pose history forget it now (a body
+     * still known otherwise is listed again, and starts its history again, at the next look) */
+    ssKnownForget(&stepper->known, body);
     ssPoseHistoryForgetBody(stepper->poses, body);
     return SS_OK;
   }
@@ -422,21 +448,18 @@ static int spaceListed(const ssStepper* stepper, dSpaceID space) {
   return 0;
 }
 
-/* Walks def.space and every space nested in it, at any depth (breadth first: the list is the queue): each geom's
- * body that the registry has not adopted is adopted (a box spawned after the stepper was made, or a body the known
- * list reached through a joint), and the spaces are remembered as they are now. A walk that fails (a body refused,
- * a quadtree space) remembers nothing, so the next look walks again and refuses again until the program repairs it. */
-static ssStatus walkSpaces(ssStepper* stepper) {
-  stepper->space_count = 0;
-  ssStatus status = ssReserveOne((void**)&stepper->spaces, 0, &stepper->space_capacity, sizeof(SeenSpace))
-                        ? SS_OK
-                        : ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
-  if (status == SS_OK) stepper->spaces[stepper->space_count++] = (SeenSpace){stepper->def.space, -1, 0, 0};
+/* Lists def.space and every space nested in it, at any depth (breadth first: the list is the queue), and in live
+ * the bodies their geoms hold now. Reads the spaces and their geoms only: a body destroyed with its geom is not
+ * met, and one destroyed alone left its geoms without a body. A failed listing (a quadtree space) remembers
+ * nothing, so the next look lists again and refuses again until the program takes the space out. */
+static ssStatus listSpaces(ssStepper* stepper, ssPointerSet* live) {
+  stepper->space_count = 1;
+  stepper->spaces[0] = (SeenSpace){stepper->def.space, -1, 0, 0};
+  ssStatus status = SS_OK;
   for (int walked = 0; status == SS_OK && walked < stepper->space_count; ++walked) {
     dSpaceID space = stepper->spaces[walked].space;
     if ((status = ssCheckSpaceListable(walked == 0 ? "def.space" : "nested space", space)) != SS_OK) break;
-    int geoms = dSpaceGetNumGeoms(space);
-    for (int i = 0; i < geoms && status == SS_OK; ++i) {
+    for (int i = 0, geoms = dSpaceGetNumGeoms(space); i < geoms && status == SS_OK; ++i) {
       dGeomID geom = dSpaceGetGeom(space, i);
       if (dGeomIsSpace(geom)) {
         if (spaceListed(stepper, (dSpaceID)geom)) continue;
@@ -445,16 +468,13 @@ static ssStatus walkSpaces(ssStepper* stepper) {
           status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
         else
           stepper->spaces[stepper->space_count++] = (SeenSpace){(dSpaceID)geom, -1, 0, 0};
-        continue;
+      } else if (dGeomGetBody(geom) != 0 && ssPointerSetAdd(live, dGeomGetBody(geom)) < 0) {
+        status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces' bodies");
       }
-      dBodyID body = dGeomGetBody(geom);
-      /* idempotent: a body of two geoms, or reached twice, once */
-      if (body != 0 && !ssRegistryHasBody(stepper->def.registry, body)) status = adoptBody(stepper, body);
     }
   }
-  if (status != SS_OK) { /* nothing remembered: the next look walks again */
+  if (status != SS_OK) { /* nothing remembered: the next look lists again */
     stepper->space_count = 1;
-    stepper->spaces[0] = (SeenSpace){stepper->def.space, -1, 0, 0};
     return status;
   }
   for (int i = 0; i < stepper->space_count; ++i) {
@@ -463,19 +483,84 @@ static ssStatus walkSpaces(ssStepper* stepper) {
     seen->first = seen->geoms > 0 ? dSpaceGetGeom(seen->space, 0) : 0;
     seen->sweep_and_prune = dSpaceGetClass(seen->space) == dSweepAndPruneSpaceClass;
   }
-  return refreshKnown(stepper);
+  return SS_OK;
 }
 
-/* Finds what was made since the last look, before a step: bodies in the adopted spaces, joints attached to known
- * bodies (and the bodies beyond them). */
+/* A body the program destroyed with ODE's own calls (or that lost its geom in the adopted spaces): forgotten by the
+ * known list, the watch list, the registry and the pose history, by its address alone. */
+static void forgetBody(ssStepper* stepper, dBodyID body) {
+  for (int i = 0; i < stepper->watched_count; ++i)
+    if (stepper->watched[i] == body) stepper->watched[i--] = stepper->watched[--stepper->watched_count];
+  ssRegistry* registry = stepper->def.registry;
+  if (registry != NULL && ssRegistryHasBody(registry, body)) ssRegistry_UnbindBody(registry, body);
+  ssKnownForget(&stepper->known, body);
+  ssPoseHistoryForgetBody(stepper->poses, body);
+  stepper->watched_generation += 1;
+}
+
+/* What the program destroyed with ODE's own calls since the last look, found by reading only what is alive:
+ *  - from the adopted spaces (alive while def.space is), when they changed: bodies that had a geom there and have
+ *    none now were destroyed with their geoms (or lost them), and are forgotten; the bodies there now are kept for
+ *    adoption (adoptAnchored);
+ *  - from the known bodies (alive, since a body with a geom was checked above and one without must be destroyed
+ *    with ssStepper_DestroyBody), when their joints changed or a body was forgotten: a bound joint attached to no
+ *    known body any more was destroyed (or detached from all), and is unbound without being read. */
+static ssStatus forgetDestroyed(ssStepper* stepper, int look_at_joints) {
+  int forgot = 0;
+  if (stepper->def.space != 0 && spacesChanged(stepper)) {
+    ssPointerSet live = {NULL, 0, 0};
+    ssStatus status = listSpaces(stepper, &live);
+    if (status != SS_OK) {
+      ssPointerSetFree(&live);
+      return status;
+    }
+    for (size_t i = 0; i < stepper->anchored.capacity; ++i) {
+      dBodyID body = (dBodyID)stepper->anchored.slots[i];
+      if (body == 0 || ssPointerSetHas(&live, body)) continue;
+      forgetBody(stepper, body);
+      forgot += 1;
+    }
+    ssPointerSetFree(&stepper->anchored);
+    stepper->anchored = live;
+    stepper->adopt_anchored_due = 1;
+  }
+  ssRegistry* registry = stepper->def.registry;
+  int rebuild_due = !stepper->known.valid || (registry != NULL && stepper->known.registry_generation !=
+                                                                       ssRegistryGeneration(registry));
+  if (registry == NULL || !(forgot > 0 || ((look_at_joints || rebuild_due) && ssKnownJointsChanged(&stepper->known,
+                                                                                                     NULL))))
+    return SS_OK;
+  ssPointerSet alive = {NULL, 0, 0};
+  ssStatus status = ssKnownCollectJoints(&stepper->known, &alive);
+  if (status == SS_OK && ssRegistryUnbindJointsNotIn(registry, &alive) > 0) stepper->apply_due = 1;
+  ssPointerSetFree(&alive);
+  return status;
+}
+
+/* Adopts the bodies the adopted spaces hold that the registry has not (a box spawned after the stepper was made),
+ * with what their joints reach. */
+static ssStatus adoptAnchored(ssStepper* stepper) {
+  ssStatus status = SS_OK;
+  for (size_t i = 0; i < stepper->anchored.capacity && status == SS_OK; ++i) {
+    dBodyID body = (dBodyID)stepper->anchored.slots[i];
+    if (body != 0 && !ssRegistryHasBody(stepper->def.registry, body)) status = adoptBody(stepper, body);
+  }
+  stepper->adopt_anchored_due = status != SS_OK; /* refused: again at the next look, until repaired */
+  return status;
+}
+
+/* Finds what was made since the last look, and forgets what was destroyed, before a step: bodies in the adopted
+ * spaces, and with look_at_joints the joints attached to known bodies (and the bodies beyond them). */
 static ssStatus findNew(ssStepper* stepper, int look_at_joints) {
-  ssStatus status = refreshKnown(stepper);
-  if (status == SS_OK && stepper->def.space != 0 && spacesChanged(stepper)) status = walkSpaces(stepper);
+  ssStatus status = forgetDestroyed(stepper, look_at_joints);
+  if (status == SS_OK) status = refreshKnown(stepper);
+  if (status == SS_OK && stepper->adopt_anchored_due) status = adoptAnchored(stepper);
+  if (status == SS_OK) status = refreshKnown(stepper);
   if (status == SS_OK && stepper->adopt_known_due) status = adoptKnown(stepper);
   dBodyID changed;
   while (status == SS_OK && look_at_joints && ssKnownJointsChanged(&stepper->known, &changed)) {
     status = adoptBody(stepper, changed);
-    stepper->known.valid = 0; /* rebuilt with what the joint reaches, and the body's first joint as it is now */
+    stepper->known.valid = 0; /* rebuilt with what the joint reaches, and the body's joints as they are now */
     if (status == SS_OK) status = refreshKnown(stepper);
   }
   return status;
@@ -619,11 +704,11 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
   ssApplyReport applied;
   for (int i = 0; i < steps; ++i) {
     double previous_step_s = use_history ? stepper->previous_step_s : 0;
-    /* bodies made in the last step's callbacks (joints made there are found before the next frame) */
-    ssStatus status = i == 0 ? SS_OK : findNew(stepper, 0);
+    /* what the last step's callbacks made or destroyed (joints too, where there are callbacks) */
+    int callbacks = def->before_step || def->collide || def->step_done;
+    ssStatus status = i == 0 ? SS_OK : findNew(stepper, callbacks);
     /* values the program set in the last step's callbacks */
-    if (status == SS_OK && i > 0 && (def->before_step || def->collide || def->step_done))
-      status = followProgram(stepper, report);
+    if (status == SS_OK && i > 0 && callbacks) status = followProgram(stepper, report);
     if (status != SS_OK) return status;
     putForces(stepper, i, step_s, carried_s);
     if (i == 0 || apply_every_step || stepper->apply_due) {
@@ -633,6 +718,9 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
     }
     stepper->current = (ssStepInfo){mapping, step_s, softness_step_s, previous_step_s, i, steps, stepper->time_s};
     if (def->before_step) def->before_step(def->before_step_context, stepper);
+    /* what before_step destroyed with ODE's own calls is forgotten before anything reads it */
+    if (def->before_step && !stepper->destroy_requested && (status = forgetDestroyed(stepper, 1)) != SS_OK)
+      return refuseStep(stepper, status, i);
     /* the boundary before collision: a state before_step (or the last step's step_done) set reaches the program's
      * dSpaceCollide next, and a position far out of range aborts ODE's spaces there (forces wait for the check
      * before the step: collision reads none) */

@@ -47,6 +47,14 @@
  * ssRegistry_AdoptBody, into the registry). ssStepper_Adopted and ssStepper_KnownBodyCount tell what was reached,
  * for a program to compare with the bodies it made.
  *
+ * What the program destroys with ODE's own calls, between frames or in a callback, is forgotten before the stepper
+ * reads it, found from what is alive: a joint attached to known bodies (dJointDestroy: an entity's joint rebuilt each
+ * frame); a body destroyed together with its geoms in the adopted spaces (dGeomDestroy and dBodyDestroy: a prop
+ * despawned); a nested space with its geoms (dSpaceDestroy: a level torn down). What ODE 0.16 gives no way to tell
+ * from freed memory must go through the stepper: a body with no geom in the adopted spaces (a bob on a joint, a
+ * watched body) is destroyed with ssStepper_DestroyBody (or unwatched first, then destroyed). The world is destroyed
+ * after its stepper: ssStepper_Destroy writes the program's own numbers back (see there).
+ *
  * The boundary with ODE. ODE 0.16 aborts the process inside a step or a collision rather than return an error for
  * a state it cannot handle, so the stepper checks every known body before the frame (before any callback) and
  * again just before every physics step (after before_step and collide, whatever they did): position within
@@ -197,7 +205,11 @@ SS_API ssStatus ssCheckOdePrecision(void);
 SS_API ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out);
 
 /** Destroys the stepper (and the registry it made for def.space). NULL is a no-op. From the stepper's own callback
- *  it is deferred to the end of that ssStepper_Step (see the top). */
+ *  it is deferred to the end of that ssStepper_Step (see the top). A stepper that adopted (def.space) first writes
+ *  back into ODE the program's own numbers, as tuned at the tuned step (or as the program wrote them since): the
+ *  world is the program's again, and a stepper made on it next adopts what the program tuned, not what this one
+ *  wrote for another step. So the world, its spaces and the bodies must still exist: destroy the stepper before
+ *  them. */
 SS_API void ssStepper_Destroy(ssStepper* stepper);
 
 /** Advances the world by one frame of frame_s seconds (0 <= frame_s <= SS_MAX_FRAME_S; 0 takes no step). report may
