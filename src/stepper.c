@@ -867,16 +867,20 @@ ssStatus ssStepper_Step(ssStepper* stepper, double frame_s, ssFrameReport* repor
                        (double)SS_MAX_FRAME_S);
     return refused;
   }
+  report->time_s = stepper->time_s;
   ssStatus status = startFrame(stepper, report);
   if (status != SS_OK) return status;
-  report->time_s = stepper->time_s;
   stepper->report = report;
   stepper->in_step = 1;
   status = stepper->def.stepping.cut == SS_CUT_FIXED ? stepFixed(stepper, frame_s, report)
                                                       : stepFrame(stepper, frame_s, report);
   stepper->in_step = 0;
   stepper->report = NULL;
-  if (stepper->destroy_requested) ssStepper_Destroy(stepper);
+  if (stepper->destroy_requested) {
+    ssStepper_Destroy(stepper);
+    return status;
+  }
+  describeNextStep(stepper); /* between frames, ssStepper_CurrentStep tells the next step, at the stepper's time */
   return status;
 }
 

@@ -405,6 +405,27 @@ TEST_F(StepperTest, ALongSubstepFrameIsCappedAndTheDroppedTimeReported) {
   EXPECT_EQ(ssDefaultStepping().max_steps_per_frame, 32);
 }
 
+// The stepper's clock: each step starts at the sum of the steps before it; between frames ssStepper_CurrentStep
+// tells the next step, at the clock's time, and a frame refused before its first step reports the time as it was.
+TEST_F(StepperTest, TheClockIsTheSumOfTheStepsTakenAndTheNextStepStartsThere) {
+  OscillatorRig rig;
+  ASSERT_EQ(rig.Build(), SS_OK);  // max_step_s = 1/60
+  double sum = 0;
+  for (double frame_s : {1.0 / 60, 0.05, 1.0 / 144, 0.0, 0.03}) {
+    ssFrameReport report;
+    ASSERT_EQ(ssStepper_Step(rig.stepper, frame_s, &report), SS_OK) << ssLastError();
+    for (int i = 0; i < report.steps; ++i) sum += report.step_s;  // equal substeps
+    EXPECT_EQ(report.time_s, sum) << frame_s;
+    EXPECT_EQ(ssStepper_CurrentStep(rig.stepper).time_s, sum) << frame_s;
+    EXPECT_EQ(ssStepper_CurrentStep(rig.stepper).index, 0);
+  }
+  dBodySetLinearVel(rig.body, NAN, 0, 0);  // refused before the frame's first step
+  ssFrameReport report;
+  EXPECT_EQ(ssStepper_Step(rig.stepper, 0.05, &report), SS_ERROR_BLOWUP);
+  EXPECT_EQ(report.time_s, sum);
+  EXPECT_EQ(report.steps, 0);
+}
+
 // The slack: a frame a little longer than the largest step (jitter, a 59 Hz display, a frame time kept in a float)
 // is one step, not two; beyond the slack the frame is cut as before, and no step is ever longer than the slack
 // allows: the guard against instability stays.
