@@ -17,6 +17,10 @@ from steadystep._native_ffi import ffi
 LIBRARY_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_native", "libsteadystep_lab.so")
 
 lib = ffi.dlopen(LIBRARY_PATH)
+# The library reads and writes ODE's dReal: a libode of the other precision loaded in its place would step every
+# world wrongly without a word (ssCheckOdePrecision names both precisions).
+if lib.ssCheckOdePrecision() != 0:
+    raise ImportError("steadystep: " + ffi.string(lib.ssLastError()).decode("utf-8", "replace"))
 
 
 class SteadystepError(Exception):

@@ -52,11 +52,12 @@ class Stepping:
     max_angular_speed: float = _DEFAULT.max_angular_speed  # rad/s, likewise
 
     @classmethod
-    def for_policy(cls, policy: str, reference_step_s: float = 1.0 / 60.0, **fields) -> "Stepping":
+    def for_policy(cls, policy: str, reference_step_s: float = 0.0, **fields) -> "Stepping":
         """The named preset's cut, mapping, frozen step and step_seed use (policy_names()) over Stepping(**fields):
         naive sets step_seed to -1 (ODE's generator left alone), every other preset a negative step_seed to 0 and
-        keeps one chosen. reference_step_s (s) is the step naive freezes its softness at, e.g. the step the program
-        was tuned for.
+        keeps one chosen. reference_step_s (s) is the step naive freezes its softness at: 0 (the default) for the
+        stepper's tuned step, what an adopted program's numbers mean (a stepper with a tuned step refuses any
+        other), or a step for springs bound by hand.
         Raises SteadystepError ("parse error") naming an unknown policy."""
         out = ffi.new("ssStepping*", cls(**fields).as_c_fields())
         check(lib.ssSteppingForPolicy(c_string("policy", policy), number("reference_step_s", reference_step_s, "s"),
