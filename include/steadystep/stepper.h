@@ -269,6 +269,51 @@ SS_API ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
  *  of creating its joint). */
 SS_API ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2);
 
+/** The most contacts ssStepper_CollideByRule asks dCollide for per pair of geoms. */
+#define SS_MAX_RULE_CONTACTS 4096
+
+/** A near callback as a rule (ssStepper_CollideByRule): the one of ODE's demos and PyODE's tutorials, applied in C.
+ *  Start from ssDefaultContactRule(): new fields keep working defaults. */
+typedef struct ssContactRule {
+  dWorldID world;              /* the world the contact joints are made in: the stepper's. Required */
+  dSpaceID space;              /* the space whose pairs of geoms are collided. Required */
+  dJointGroupID contact_group; /* the group the contact joints are made in: the stepper's def.contact_group, which
+                                * it empties after every step. Required */
+  /* Required: every contact gets this contact's surface (mode, mu, bounce, soft_erp/soft_cfm as tuned at the
+   * tuned step, ...) and fdir1; its geom is not read. mu, mu2, rho, rho2 and rhoN in [0, infinity], bounce in
+   * [0, 1], bounce_vel, slip1 and slip2 finite and >= 0, motion1, motion2, motionN and fdir1 finite */
+  const dContact* surface;
+  int max_contacts;            /* contacts asked of dCollide per pair of geoms, in [1, SS_MAX_RULE_CONTACTS];
+                                * default 4 (PyODE's ode.collide asks 150) */
+  int skip_connected;          /* 1: no contact between two bodies that a joint other than a contact connects
+                                * (dAreConnectedExcluding), as ODE's demos do; 0 (the default): every pair */
+} ssContactRule;
+
+/** What one ssStepper_CollideByRule made. */
+typedef struct ssContactRuleReport {
+  int pairs;    /* pairs of geoms dCollide was asked about (pairs of two static geoms are skipped) */
+  int contacts; /* contact joints made, each softened (counted in the frame report's contacts) */
+  int dropped;  /* contacts whose position, normal or depth was not finite, dropped without a joint (ODE 0.16's
+                 * sphere-cylinder collider makes them) */
+} ssContactRuleReport;
+
+/** The defaults listed at each field (the required ones NULL). */
+SS_API ssContactRule ssDefaultContactRule(void);
+
+/** In the stepper's collide callback, instead of dSpaceCollide with a near callback: collides rule->space
+ *  (dSpaceCollide; a nested space with its partner, dSpaceCollide2) and, for every pair of geoms not both static
+ *  (nor connected by a joint, with skip_connected), asks dCollide for up to max_contacts contacts; each gets the
+ *  rule's surface and fdir1, is softened for the step about to be taken (ssStepper_SoftenContact: the rule's
+ *  soft_erp/soft_cfm where its mode has them, else the world's, as tuned) and becomes a contact joint in
+ *  contact_group attached to the geoms' bodies, in the order dSpaceCollide gives the pairs: the joints a near
+ *  callback that does the same would make, bit for bit, with no call into the program per contact. report may be
+ *  NULL. Like ssStepper_SoftenContact it needs the stepper's adoption (a tuned step).
+ *  Errors, with no joint made: SS_ERROR_OUT_OF_RANGE (stepper, rule or a required field NULL, max_contacts or
+ *  skip_connected out of range, a surface value out of its range, a body in the space of another world than
+ *  rule->world, and those of ssStepper_SoftenContact: no tuned step, a tuned erp outside [0, 1] or cfm < 0);
+ *  SS_ERROR_NOT_FINITE (a surface value NaN, or a tuned value not finite); SS_ERROR_OUT_OF_MEMORY. */
+SS_API ssStatus ssStepper_CollideByRule(ssStepper* stepper, const ssContactRule* rule, ssContactRuleReport* report);
+
 /** Adds a body to the known bodies: forces kept for the whole frame and checks at each step.
  *  Errors: SS_ERROR_OUT_OF_RANGE (NULL, or a body of another world), SS_ERROR_OUT_OF_MEMORY. */
 SS_API ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body);
