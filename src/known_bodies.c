@@ -217,8 +217,9 @@ ssStatus ssKnownCollectJoints(const ssKnownBodies* known, ssPointerSet* joints) 
   return SS_OK;
 }
 
-void ssKnownTakeJoints(ssKnownBodies* known) {
-  for (int k = 0; k < known->count; ++k) known->joints[k] = jointSignature(known->ids[k]);
+void ssKnownTakeJointsOf(ssKnownBodies* known, dBodyID body) {
+  const ssKnownBody* found = findOld(known, body);
+  if (found != NULL) known->joints[found - known->bodies] = jointSignature(body);
 }
 
 int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body) {

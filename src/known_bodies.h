@@ -82,8 +82,8 @@ int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body);
  * Errors: SS_ERROR_OUT_OF_MEMORY. */
 ssStatus ssKnownCollectJoints(const ssKnownBodies* known, ssPointerSet* joints);
 
-/* Takes the listed bodies' joints as they are now (after the stepper followed a change). */
-void ssKnownTakeJoints(ssKnownBodies* known);
+/* Takes body's joints as they are now, once the stepper followed their change (adopted what they reach). */
+void ssKnownTakeJointsOf(ssKnownBodies* known, dBodyID body);
 
 /* Sets every listed body's force and torque accumulators to its frame force (with_frame_forces) or to zero. */
 void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces);

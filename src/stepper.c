@@ -47,6 +47,7 @@ struct ssStepper {
   int space_count, space_capacity;
   int apply_due;         /* bindings were added within the frame: the next step applies whatever the mapping */
   int adopt_known_due;   /* the known list was rebuilt: bodies on it the registry has not are adopted (adoptKnown) */
+  int relist_due;        /* the known list is listed again at the next look, keeping what stays (joints changed) */
   ssPointerSet anchored; /* the bodies with a geom in the adopted spaces at the last listing (forgetDestroyed) */
   int adopt_anchored_due; /* the spaces were listed: their bodies the registry has not are adopted (adoptAnchored) */
   int in_step;           /* inside ssStepper_Step: its callbacks are running */
@@ -137,6 +138,7 @@ static void resolveSpeeds(ssStepping* stepping) {
 }
 
 static ssStatus listSpaces(ssStepper* stepper, ssPointerSet* live);
+static ssStatus refreshKnown(ssStepper* stepper);
 
 ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   ssStatus status = ssCheckOdePrecision();
@@ -176,6 +178,12 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   stepper->row_order_seed = rowOrderSeed(stepping.step_seed);
   stepper->contact_cache = ssContactCacheEmpty();
   describeNextStep(stepper);
+  /* the known bodies and their joints listed now, while everything is alive: what the program destroys before the
+   * first frame is then told from them (forgetDestroyed) */
+  if ((status = refreshKnown(stepper)) != SS_OK) {
+    ssStepper_Destroy(stepper);
+    return status;
+  }
   *out = stepper;
   return SS_OK;
 }
@@ -377,9 +385,10 @@ static ssStatus refreshKnown(ssStepper* stepper) {
   const ssRegistry* registry = stepper->def.registry;
   unsigned generation = registry != NULL ? ssRegistryGeneration(registry) : 0;
   ssKnownBodies* known = &stepper->known;
-  if (known->valid && known->registry_generation == generation &&
+  if (known->valid && !stepper->relist_due && known->registry_generation == generation &&
       known->watched_generation == stepper->watched_generation)
     return SS_OK;
+  stepper->relist_due = 0;
   ssStatus status = ssKnownRebuild(known, registry, stepper->watched, stepper->watched_count);
   if (status != SS_OK) return status;
   known->registry_generation = generation;
@@ -558,10 +567,13 @@ static ssStatus findNew(ssStepper* stepper, int look_at_joints) {
   if (status == SS_OK) status = refreshKnown(stepper);
   if (status == SS_OK && stepper->adopt_known_due) status = adoptKnown(stepper);
   dBodyID changed;
+  /* a body whose joints changed: what they reach adopted, then its joints taken as they are (a refusal leaves the
+   * change seen, so the next look refuses again until the program repairs it) */
   while (status == SS_OK && look_at_joints && ssKnownJointsChanged(&stepper->known, &changed)) {
     status = adoptBody(stepper, changed);
-    stepper->known.valid = 0; /* rebuilt with what the joint reaches, and the body's joints as they are now */
+    stepper->relist_due = 1; /* listed again with what its joints reach now */
     if (status == SS_OK) status = refreshKnown(stepper);
+    if (status == SS_OK) ssKnownTakeJointsOf(&stepper->known, changed);
   }
   return status;
 }
