@@ -75,8 +75,7 @@ static ssStatus checkSurface(const dContact* surface_contact) {
   return status;
 }
 
-static ssStatus checkRule(const ssStepper* stepper, const ssContactRule* rule) {
-  if (stepper == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "stepper = NULL: a stepper is required");
+ssStatus ssValidateContactRule(const ssContactRule* rule) {
   if (rule == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "rule = NULL: a rule is required");
   const char* missing = rule->world == 0           ? "world"
                         : rule->space == 0         ? "space"
@@ -144,7 +143,8 @@ static void keepContacts(void* data, dGeomID geom1, dGeomID geom2) {
 
 ssStatus ssStepper_CollideByRule(ssStepper* stepper, const ssContactRule* rule, ssContactRuleReport* report) {
   if (report != NULL) memset(report, 0, sizeof *report);
-  ssStatus status = checkRule(stepper, rule);
+  if (stepper == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "stepper = NULL: a stepper is required");
+  ssStatus status = ssValidateContactRule(rule);
   if (status != SS_OK) return status;
   RulePass pass = {rule, NULL, 0, 0, 0, SS_OK};
   dSpaceCollide(rule->space, &pass, keepContacts);

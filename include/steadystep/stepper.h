@@ -300,6 +300,11 @@ typedef struct ssContactRuleReport {
 /** The defaults listed at each field (the required ones NULL). */
 SS_API ssContactRule ssDefaultContactRule(void);
 
+/** Checks a rule as ssStepper_CollideByRule does before it collides (its fields and its surface's values).
+ *  Errors: SS_ERROR_OUT_OF_RANGE (rule or a required field NULL, max_contacts or skip_connected out of range, a
+ *  surface value out of its range), SS_ERROR_NOT_FINITE (a surface value NaN), each named. */
+SS_API ssStatus ssValidateContactRule(const ssContactRule* rule);
+
 /** In the stepper's collide callback, instead of dSpaceCollide with a near callback: collides rule->space
  *  (dSpaceCollide; a nested space with its partner, dSpaceCollide2) and, for every pair of geoms not both static
  *  (nor connected by a joint, with skip_connected), asks dCollide for up to max_contacts contacts; each gets the

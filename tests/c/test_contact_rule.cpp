@@ -242,12 +242,18 @@ TEST_F(ContactRuleRefusals, NameTheValueAndMakeNoJoint) {
     dContact spoilt = surface;
     rule.surface = &spoilt;
     c.spoil(&rule, &spoilt);
+    if (std::string(c.named) != "cfm = -1") {  // the rule's own values: refused alike without a stepper
+      EXPECT_EQ(ssValidateContactRule(&rule), c.status) << c.named;
+      EXPECT_NE(std::string(ssLastError()).find(c.named), std::string::npos) << ssLastError();
+    }
     ssContactRuleReport report = {1, 1, 1};
     EXPECT_EQ(ssStepper_CollideByRule(stepper, &rule, &report), c.status) << c.named;
     EXPECT_NE(std::string(ssLastError()).find(c.named), std::string::npos) << ssLastError();
     EXPECT_EQ(dBodyGetNumJoints(box), 0) << c.named;
     EXPECT_EQ(report.contacts, 0);
   }
+  EXPECT_EQ(ssValidateContactRule(&good), SS_OK) << ssLastError();
+  EXPECT_EQ(ssValidateContactRule(nullptr), SS_ERROR_OUT_OF_RANGE);
   EXPECT_EQ(ssStepper_CollideByRule(nullptr, &good, nullptr), SS_ERROR_OUT_OF_RANGE);
   EXPECT_EQ(ssStepper_CollideByRule(stepper, nullptr, nullptr), SS_ERROR_OUT_OF_RANGE);
 
