@@ -1,4 +1,5 @@
-"""ODE handles from Python: an odepy handle as it is, or a plain integer address, as the C type the library takes.
+"""ODE handles from Python: an odepy handle as it is, a PyODE object (steadystep.pyode: its pointer read from its
+checked layout), or a plain integer address, as the C type the library takes.
 
 odepy (PyPI ode-python) types its handles as ctypes pointers to opaque structs named after ODE's own (dWorldID is
 POINTER(dxWorld), dBodyID POINTER(dxBody), ...), so the kind of a handle is checked by that name, without importing
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import ctypes
 
+from steadystep import pyode
 from steadystep._native import SteadystepError, ffi, shown
 from steadystep.enums import Status
 
@@ -23,16 +25,33 @@ KINDS = {
     "joint group": ("dxJointGroup", "dJointGroupID"),
 }
 _ADDRESS_LIMIT = 2**64
+# The C types, and their NULLs, looked up once: a near callback converts its handles for every contact.
+_C_TYPES = {kind: ffi.typeof(c_type) for kind, (_, c_type) in KINDS.items()}
+_NULLS = {kind: ffi.cast(c_type, 0) for kind, c_type in _C_TYPES.items()}
+_CONTACT_POINTER = ffi.typeof("dContact*")
+_FIELD_TYPES = {kind: ffi.typeof(f"{c_type}*") for kind, (_, c_type) in KINDS.items()}  # a PyODE object's field
+_PYODE_NAMES = {"world": "World", "body": "Body", "joint": "Joint", "space": "Space", "joint group": "JointGroup",
+                "contact": "Contact"}
 
 
 def _wrong(name: str, kind: str, value, what: str) -> SteadystepError:
     return SteadystepError(Status.OUT_OF_RANGE, f"{name} = {shown(value)}: {what}; must be an ODE {kind} (an odepy "
-                           f"{KINDS[kind][1] if kind in KINDS else 'dContact'} or an integer address)")
+                           f"{KINDS[kind][1] if kind in KINDS else 'dContact'}, a PyODE {_PYODE_NAMES[kind]} or an "
+                           "integer address)")
 
 
-def address(name: str, kind: str, value) -> int:
+def address(name: str, kind: str, value, checked: bool = True) -> int:
     """The address of the ODE object `value` of the given kind ("world", "body", "joint", "space", "joint group"),
-    0 for NULL. Raises SteadystepError naming the parameter for a handle of another kind or a foreign object."""
+    0 for NULL. Raises SteadystepError naming the parameter for a handle of another kind or a foreign object. A
+    PyODE object's pointer is read from its checked layout; checked: the object is also read through it and
+    compared with PyODE's getters (steadystep.pyode.address)."""
+    family = pyode.FAMILY.get(type(value))
+    if family is not None:  # a PyODE object of a class already met: its pointer read at once when not checked
+        if family == kind and not checked and kind != "space":
+            pointer = pyode.pointer_of(value)
+            if pointer:
+                return pointer
+        return pyode.address(name, kind, value, checked)
     struct_name, c_type = KINDS[kind]
     if value is None:
         return 0
@@ -54,17 +73,28 @@ def address(name: str, kind: str, value) -> int:
         if ctype.kind == "pointer" and ctype.item.cname in (f"struct {struct_name}", "void"):
             return int(ffi.cast("uintptr_t", value))
         raise _wrong(name, kind, value, f"a C {ctype.cname}")
+    if pyode.is_pyode(value):
+        return pyode.address(name, kind, value, checked)
     raise _wrong(name, kind, value, f"a {type(value).__name__}")
 
 
-def handle(name: str, kind: str, value):
+def handle(name: str, kind: str, value, checked: bool = True):
     """value as the library's handle type (dWorldID ...), NULL included: see address()."""
-    return ffi.cast(KINDS[kind][1], address(name, kind, value))
+    if value is None:
+        return _NULLS[kind]
+    if not checked and pyode.FAMILY.get(type(value)) == kind and kind != "space":
+        held = ffi.cast(_FIELD_TYPES[kind], id(value) + pyode.FIELD_OFFSET)[0]  # its checked layout's field
+        if held != ffi.NULL:
+            return held
+    return ffi.cast(_C_TYPES[kind], address(name, kind, value, checked))
 
 
 def contact(name: str, value):
     """An ODE dContact as the library's `dContact*`: an odepy dContact (a ctypes Structure, by its address), a
-    ctypes pointer to one, or an integer address; None or 0 is NULL (refused by the library by name)."""
+    ctypes pointer to one, a PyODE Contact (the dContact it holds), or an integer address; None or 0 is NULL
+    (refused by the library by name)."""
+    if pyode.FAMILY.get(type(value)) == "contact":
+        return ffi.cast(_CONTACT_POINTER, id(value) + pyode.FIELD_OFFSET)
     if value is None:
         return ffi.NULL
     if isinstance(value, bool):
@@ -82,4 +112,6 @@ def contact(name: str, value):
         if pointee != "dContact":
             raise _wrong(name, "contact", value, f"a pointer to {pointee}, not to dContact")
         return ffi.cast("dContact*", ctypes.cast(value, ctypes.c_void_p).value or 0)
+    if pyode.is_pyode(value):
+        return ffi.cast("dContact*", pyode.address(name, "contact", value))
     raise _wrong(name, "contact", value, f"a {type(value).__name__}")
