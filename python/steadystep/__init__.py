@@ -1,9 +1,10 @@
 """steadystep: frame-rate independent constraint softness for the Open Dynamics Engine, from Python.
 
-On a program's own ODE world (built with odepy, PyPI ode-python): ``Registry`` (bind springs, adopt what the program
-tuned), ``Stepper`` (one call per frame: substeps or fixed steps, mappings, forces held until the next frame, per-step
-logic in ``before_step``, failures refused until reset), ``Stepper.soften_contact`` in the near callback, and
-``Stepping`` for how frames become steps. The conversions (``implicit_euler_softness`` ..., scalars or numpy arrays),
+On a program's own ODE world (built with odepy, PyPI ode-python, or PyODE, ``import ode``: ``steadystep.pyode``):
+``Registry`` (bind springs, adopt what the program tuned), ``Stepper`` (one call per frame: substeps or fixed steps,
+mappings, forces held until the next frame, per-step logic in ``before_step``, failures refused until reset),
+``Stepper.soften_contact`` in the near callback or a ``ContactRule`` applied in C, and ``Stepping`` for how frames
+become steps. The conversions (``implicit_euler_softness`` ..., scalars or numpy arrays),
 the lab's profiles and runs on built-in scenes (``steadystep.runs``, ``steadystep.profiles``), the article's model
 (``steadystep.article``), metrics, ``sweep`` of independent runs over any ``concurrent.futures.Executor``
 (``make_executor``: a process pool, Dask); figures and the HTML report need the ``report`` extra (``pip install
@@ -11,7 +12,7 @@ steadystep[report]``). Every failure raises ``SteadystepError`` naming the value
 (``Status``) and ``status`` its name: ``InvalidValue`` (also a ValueError) for a refused value, ``SimulationFailure``
 for a simulation that failed (a blow-up, a speed or position limit, a frame after a failure). Importing the package
 changes no global state and parses nothing (the cffi declarations were prepared from the headers when the package was
-built).
+built). Imported after a PyODE whose joint parameter numbers are ODE 0.15's, it warns once (steadystep.pyode).
 """
 
 from steadystep._native import InvalidValue, SimulationFailure, SteadystepError
@@ -21,18 +22,22 @@ from steadystep.enums import FrameCut, JointParam, Mapping, Solver, Status
 from steadystep.profiles import Profile, frame_times
 from steadystep.registry import (AdoptReport, ApplyReport, Registry, ServedCounts, contact_soften,
                                  joint_effective_mass, joint_supports)
-from steadystep.stepper import FrameReport, Stepper, StepInfo
+from steadystep.stepper import ContactRule, ContactRuleReport, FrameReport, Stepper, StepInfo
 from steadystep.stepping import Stepping, policy_names
 from steadystep.study import grid, make_executor, sweep
 
 __all__ = [
-    "AdoptReport", "ApplyReport", "FrameCut", "FrameReport", "InvalidValue", "JointParam", "Mapping", "Profile",
-    "Registry", "ServedCounts", "SimulationFailure", "Softness", "Solver", "Spring", "Status", "StepInfo", "Stepper",
-    "SteadystepError", "Stepping", "contact_soften",
+    "AdoptReport", "ApplyReport", "ContactRule", "ContactRuleReport", "FrameCut", "FrameReport", "InvalidValue",
+    "JointParam", "Mapping", "Profile", "Registry", "ServedCounts", "SimulationFailure", "Softness", "Solver", "Spring",
+    "Status", "StepInfo", "Stepper", "SteadystepError", "Stepping", "contact_soften",
     "exact_softness", "frame_times", "frequency_from_spring", "grid", "implicit_euler_softness",
     "joint_effective_mass", "joint_supports", "make_executor", "matched_softness", "policy_names", "softness_for",
     "spring_from_frequency", "spring_from_softness", "sweep",
 ]
+
+from steadystep import pyode as _pyode  # noqa: E402 - after the binding: it checks a PyODE already imported
+
+_pyode.warn_if_mismatched()
 
 
 def __getattr__(name: str):

@@ -26,18 +26,26 @@ which prints an exception and goes on: a refusal of the stepper's own calls made
 kept for step() all the same, and wrapping the near callback, odepy.dNearCallback(stepper.near_callback(near)),
 keeps any exception it raises.
 
-Handles (world, bodies, joints, the contact group) are odepy handles or integer addresses, borrowed: the world and
-the registry must outlive the stepper (it keeps its Registry alive; close() the stepper before dWorldDestroy).
+Handles (world, bodies, joints, the contact group) are odepy handles, PyODE objects (steadystep.pyode) or integer
+addresses, borrowed: the world and the registry must outlive the stepper (it keeps its Registry alive; close() the
+stepper before dWorldDestroy). A PyODE JointGroup given as contact_group is emptied through PyODE's own
+JointGroup.empty() (PyODE keeps a wrapper for each joint in it), after every step and after a refused frame.
+
+Contacts at the cost of C: a ContactRule, contact_rule=ContactRule(surface, max_contacts=...), replaces a near
+callback that gives every contact one surface: the stepper collides the space, softens and joins every contact in C
+at every step (ssStepper_CollideByRule), with no Python call per contact; stepper.collide_by_rule(rule) does the
+same from the program's own collide.
 """
 
 from __future__ import annotations
 
+import atexit
 import dataclasses
 import weakref
 from collections.abc import Callable
 
-from steadystep import _handles
-from steadystep._native import SteadystepError, check, ffi, last_error, lib, number, shown
+from steadystep import _handles, _libode, pyode
+from steadystep._native import SteadystepError, check, ffi, integer, last_error, lib, number, shown
 from steadystep._structs import StructView, address_of
 from steadystep.enums import Mapping, Solver, Status
 from steadystep.registry import AdoptReport, Registry  # also declares ServedCounts, the view of rows, contacts
@@ -67,12 +75,64 @@ class FrameReport(StructView, c_type="ssFrameReport", convert={"failed_body": ad
     __slots__ = ()
 
 
+class ContactRuleReport(StructView, c_type="ssContactRuleReport"):
+    """What one collision by a ContactRule made (ssContactRuleReport), read-only: pairs (pairs of geoms dCollide
+    was asked about), contacts (contact joints made, each softened and counted in the frame report), dropped
+    (contacts whose position, normal or depth was not finite, dropped without a joint)."""
+
+    __slots__ = ()
+
+
+@dataclasses.dataclass(frozen=True)
+class ContactRule:
+    """A near callback that gives every contact one surface, as a rule the stepper applies in C (ssContactRule,
+    stepper.h): for every pair of geoms of space (the stepper's space when None) not both static, dCollide asks for
+    up to max_contacts contacts (1 to 4096; PyODE's ode.collide asks 150, ODE's demos 4 to 10); each gets the
+    surface (mode, mu, bounce, soft ERP/CFM as tuned, ...) and fdir1 of `surface`, is softened for the step as
+    Stepper.soften_contact softens it, and becomes a contact joint attached to the geoms' bodies, in the order
+    dSpaceCollide gives the pairs: the joints the near callback would make, bit for bit. skip_connected: no
+    contact between two bodies a joint other than a contact connects (as ODE's demos do).
+
+    surface: a PyODE ode.Contact, an odepy dContact or an address, read at every step (the rule keeps it alive):
+    change it with its setters between frames and the next step uses the new surface."""
+
+    surface: object
+    max_contacts: int = 4
+    skip_connected: bool = False
+    space: object = None
+
+
 # The per-frame path, looked up once. ssStepper_Step zeroes its report before anything else, on every path
 # (src/stepper.c; tests/python/test_lifetimes.py holds it to that), so the report's memory is not cleared twice.
 _FRAME_REPORT = ffi.typeof("ssFrameReport*")
 _new_frame_report = ffi.new_allocator(should_clear_after_alloc=False)
 _step_frame = lib.ssStepper_Step
 _frame_report = FrameReport.of
+_collide_by_rule = lib.ssStepper_CollideByRule
+_soften = lib.ssStepper_SoftenContact
+_body = _handles.handle
+# PyODE's objects in the near callback (soften_contact), their classes' layout checked (steadystep.pyode.FAMILY)
+_FAMILY = pyode.FAMILY
+_OFFSET = pyode.FIELD_OFFSET
+_cast = ffi.cast
+_CONTACT_POINTER = ffi.typeof("dContact*")
+_BODY_FIELD = ffi.typeof("dBodyID*")
+_NULL_BODY = ffi.cast("dBodyID", 0)
+
+
+def _pyode_body(body):
+    """A PyODE Body's ODE body, read from its checked layout; None for anything else (the generic path names it)."""
+    if _FAMILY.get(type(body)) == "body":
+        held = _cast(_BODY_FIELD, id(body) + _OFFSET)[0]
+        if held != _NULL_BODY:
+            return held
+    return None
+
+
+def _contact(value):
+    return _handles.contact("contact", value)
+
+_RULE_REPORT = ffi.typeof("ssContactRuleReport*")
 
 
 def _checked_callable(name: str, value):
@@ -91,8 +151,11 @@ class Stepper:
     says it. stepping: a Stepping, or policy: a preset's name (policy_names()), whose naive softness is frozen at
     reference_step_s (s; default the tuned step, else 1/60 s); neither: the defaults. max_step_s and fixed_step_s
     of 0 (the defaults) are the tuned step. before_step(stepper), collide(stepper): called before each physics
-    step; step_done(step_s): after each step that passed the checks. contact_group: an odepy dJointGroupID emptied
-    after every step, or None. Raises SteadystepError naming a bad value.
+    step; step_done(step_s): after each step that passed the checks. contact_group: an odepy dJointGroupID (or an
+    address) emptied in C after every step, a PyODE JointGroup emptied through its empty() after every step and
+    after a refused frame, or None. contact_rule: a ContactRule applied at every step after collide (contacts made
+    in contact_group, or in a group of the stepper's own when that is PyODE's or None). Raises SteadystepError
+    naming a bad value.
 
     before_step is the program's per-step logic: it reads the step from stepper.current_step() (a StepInfo: time_s,
     the simulated time at the step's start, and step_s, its length, both in s). A before_step that requires two
@@ -104,7 +167,8 @@ class Stepper:
                  policy: str | None = None, reference_step_s: float | None = None,
                  before_step: Callable[["Stepper"], object] | Callable[["Stepper", StepInfo], object] | None = None,
                  collide: Callable[["Stepper"], object] | None = None,
-                 step_done: Callable[[float], object] | None = None, contact_group=None):
+                 step_done: Callable[[float], object] | None = None, contact_group=None,
+                 contact_rule: ContactRule | None = None):
         if registry is not None and not isinstance(registry, Registry):
             raise SteadystepError(Status.OUT_OF_RANGE,
                                   f"registry = {shown(registry)}: must be a steadystep.Registry or "
@@ -124,9 +188,16 @@ class Stepper:
         self._user = {"before_step": before_step,
                       "collide": _checked_callable("collide", collide),
                       "step_done": _checked_callable("step_done", step_done)}
+        if contact_rule is not None and not isinstance(contact_rule, ContactRule):
+            raise SteadystepError(Status.OUT_OF_RANGE, f"contact_rule = {shown(contact_rule)}: must be a "
+                                  "steadystep.ContactRule or None")
         self._pending: BaseException | None = None  # the first exception a callback raised in this frame
         self._in_frame = False
         self._stepper = None
+        self._rules: dict = {}  # id(ContactRule) -> (the rule, its ssContactRule): made once per rule
+        # A PyODE JointGroup is emptied through PyODE (its wrappers); the C side then empties a group of its own,
+        # where a ContactRule makes its joints (as it does when the program gives no group).
+        self._pyode_group = contact_group if pyode.is_joint_group(contact_group) else None
 
         definition = ffi.new("ssStepperDef*", lib.ssDefaultStepperDef())
         definition.world = _handles.handle("world", "world", world)
@@ -134,28 +205,56 @@ class Stepper:
         definition.tuned_step_s = tuned_step_s
         definition.registry = registry._handle() if registry is not None else ffi.NULL
         definition.stepping = self._stepping.as_c_fields()
-        definition.contact_group = _handles.handle("contact_group", "joint group", contact_group)
-        # The C callbacks hold only a weak reference, so that the stepper can be collected; they live as long as
-        # the stepper (self._callbacks), which is what C needs.
-        me = weakref.ref(self)
-        self._callbacks = []
-        if before_step is not None:
-            definition.before_step = self._callback("ssStepCallback*", lambda context, handle: _call(me, "before_step"))
-        if collide is not None:
-            definition.collide = self._callback("ssStepCallback*", lambda context, handle: _call(me, "collide"))
-        if step_done is not None:
-            definition.step_done = self._callback("ssStepDoneCallback*",
-                                                  lambda context, step_s: _call(me, "step_done", step_s))
+        if self._pyode_group is None:
+            definition.contact_group = _handles.handle("contact_group", "joint group", contact_group)
+        self._world = definition.world
+        self._space = definition.space
         if self._stepping.solver == Solver.UNSET and definition.world != ffi.NULL:  # (C names a NULL world first)
             raise SteadystepError(Status.UNSUPPORTED, "solver = None: say which ODE step the program calls "
                                   "(Solver.QUICK for dWorldQuickStep, Solver.STEP for dWorldStep)")
+        own_group = 0
+        if definition.contact_group == ffi.NULL and (contact_rule is not None or self._pyode_group is not None):
+            own_group = _libode.ode().dJointGroupCreate(0) or 0
+            if own_group == 0:
+                raise SteadystepError(Status.OUT_OF_MEMORY, "dJointGroupCreate: ODE made no joint group")
+            definition.contact_group = ffi.cast("dJointGroupID", own_group)
+        self._contact_group = definition.contact_group
         out = ffi.new("ssStepper**")
-        check(lib.ssStepper_Create(definition, out))
-        # The destructor holds the C registry, so that however the two are collected, the stepper goes first.
-        kept = registry._registry if registry is not None else None
-        self._stepper = ffi.gc(out[0], lambda stepper, kept=kept: lib.ssStepper_Destroy(stepper))
+        try:
+            # The C callbacks hold only a weak reference, so that the stepper can be collected; they live as long
+            # as the stepper (self._callbacks), which is what C needs.
+            me = weakref.ref(self)
+            self._callbacks = []
+            if before_step is not None:
+                definition.before_step = self._callback("ssStepCallback*",
+                                                        lambda context, handle: _call(me, "before_step"))
+            if contact_rule is not None:
+                self._c_rule(contact_rule)  # checked now (ssValidateContactRule): refused before anything is made
+                self._user["collide"] = _collide_with_rule(self._user["collide"], contact_rule)
+            if self._user["collide"] is not None:
+                definition.collide = self._callback("ssStepCallback*", lambda context, handle: _call(me, "collide"))
+            if self._pyode_group is not None:
+                group = self._pyode_group
+                definition.step_done = self._callback("ssStepDoneCallback*",
+                                                      lambda context, step_s: _emptied_then(me, group, step_s))
+            elif step_done is not None:
+                definition.step_done = self._callback("ssStepDoneCallback*",
+                                                      lambda context, step_s: _call(me, "step_done", step_s))
+            check(lib.ssStepper_Create(definition, out))
+        except BaseException:
+            if own_group:
+                _libode.ode().dJointGroupDestroy(own_group)
+            raise
+        # The destructor holds the C registry, so that however the two are collected, the stepper goes first (and
+        # then the group of its own, which it empties); and what the program gave, so that PyODE, which destroys
+        # an object when its last reference goes, keeps the world and the spaces until the stepper has written
+        # the program's own numbers back into them (ssStepper_Destroy).
+        kept = (registry._registry if registry is not None else None, world, space, contact_group, contact_rule)
+        self._stepper = ffi.gc(out[0], lambda stepper, kept=kept, group=own_group: _destroy(stepper, group))
         if registry is not None:
             registry._add_stepper(self)
+        if any(pyode.is_pyode(given) for given in (world, space, contact_group)):
+            _PYODE_STEPPERS.add(self)  # closed at exit, before the program's PyODE objects go in any order
 
     def _callback(self, ctype: str, function):
         made = ffi.callback(ctype, function)
@@ -224,6 +323,8 @@ class Stepper:
         finally:
             self._in_frame = False
         if status or self._pending is not None:
+            if self._pyode_group is not None:
+                self._pyode_group.empty()  # a step refused before or after ODE's step: its contacts go, as in C
             self._raise_for_frame(status, _frame_report(report))
         return _frame_report(report)
 
@@ -234,15 +335,22 @@ class Stepper:
             error = SteadystepError(status, last_error())
             if made.failed_body:  # a body refused at the boundary, or that blew up or ran away in a step
                 error.report = made
-        if pending is not None:
-            try:
-                pending.steadystep_report = made
-            except AttributeError:
-                pass
-            if error is not None:
-                raise pending from error
-            raise pending
-        raise error
+        try:
+            if pending is not None:
+                try:
+                    pending.steadystep_report = made
+                except AttributeError:
+                    pass
+                if error is not None:
+                    raise pending from error
+                raise pending
+            raise error
+        finally:
+            # No reference cycle through this frame (an error held by a local of the frame its traceback holds):
+            # garbage in a cycle is freed by the cycle collector, which frees PyODE's objects in any order (a World
+            # before its Bodies: a crash inside PyODE), and the caller's frames, with the program's objects, would
+            # be part of it.
+            pending = error = None
 
     @property
     def adopted(self) -> AdoptReport:
@@ -287,14 +395,70 @@ class Stepper:
         soft_cfm where surface.mode has them, else the world's ERP/CFM, as tuned at the registry's tuned step) into
         the softness for the step about to be taken: implicit Euler's under every mapping (matched and exact serve no
         contact and count it in report.contacts.handed_to_implicit_euler). contact: an odepy dContact (or its
-        address); body1, body2 its bodies (None for the static world). Raises SteadystepError with the contact
-        unchanged (adopt first)."""
+        address) or a PyODE Contact (before ode.ContactJoint copies it); body1, body2 its bodies (None for the
+        static world). Raises SteadystepError with the contact unchanged (adopt first). One Python call per contact:
+        a ContactRule makes a step's contacts in C."""
+        stepper = self._stepper
+        if stepper is not None and _FAMILY.get(type(contact)) == "contact":  # PyODE's: the fast path
+            first = _NULL_BODY if body1 is None else _pyode_body(body1)
+            second = _NULL_BODY if body2 is None else _pyode_body(body2)
+            if first is not None and second is not None:
+                status = _soften(stepper, _cast(_CONTACT_POINTER, id(contact) + _OFFSET), first, second)
+                if status:
+                    raise self._refused(SteadystepError(status, last_error()))
+                return
         try:
-            check(lib.ssStepper_SoftenContact(self._handle(), _handles.contact("contact", contact),
-                                              _handles.handle("body1", "body", body1),
-                                              _handles.handle("body2", "body", body2)))
+            if stepper is None:
+                self._handle()
+            # the bodies are not read (stepper.h): a PyODE Body's pointer is taken from its checked layout alone
+            status = _soften(stepper, _contact(contact), _body("body1", "body", body1, False),
+                             _body("body2", "body", body2, False))
+            if status:
+                check(status)
         except SteadystepError as error:
             raise self._refused(error)
+
+    def collide_by_rule(self, rule: ContactRule) -> ContactRuleReport:
+        """In collide: what the near callback rule stands for, done in C for the step about to be taken
+        (ssStepper_CollideByRule; see ContactRule): every contact made, softened and joined in the stepper's
+        contact group (or its own), with no Python call per contact. Returns the ContactRuleReport. Raises
+        SteadystepError naming a bad value, with no joint made (a stepper given no contact group and no
+        contact_rule has no group to make them in)."""
+        try:
+            made = self._c_rule(rule)
+            report = ffi.new(_RULE_REPORT)
+            check(_collide_by_rule(self._handle(), made, report))
+        except SteadystepError as error:
+            raise self._refused(error)
+        return ContactRuleReport.of(report)
+
+    def _c_rule(self, rule: ContactRule):
+        """rule as the library's ssContactRule, made and checked once per rule (the rule keeps its surface)."""
+        known = self._rules.get(id(rule))
+        if known is not None and known[0] is rule:
+            return known[1]
+        if not isinstance(rule, ContactRule):
+            raise SteadystepError(Status.OUT_OF_RANGE, f"rule = {shown(rule)}: must be a steadystep.ContactRule")
+        if self._contact_group == ffi.NULL:
+            raise SteadystepError(Status.OUT_OF_RANGE, "rule: the stepper has no contact group to make the contacts "
+                                  "in: make it with contact_group=... or contact_rule=...")
+        made = ffi.new("ssContactRule*", lib.ssDefaultContactRule())
+        made.world = self._world
+        made.space = (_handles.handle("rule.space", "space", rule.space) if rule.space is not None
+                      else self._space)
+        if made.space == ffi.NULL:
+            raise SteadystepError(Status.OUT_OF_RANGE, "rule.space = None: the stepper has no space either; give the "
+                                  "rule the space to collide")
+        made.contact_group = self._contact_group
+        made.surface = _handles.contact("rule.surface", rule.surface)
+        made.max_contacts = integer("rule.max_contacts", rule.max_contacts, -2**31, 2**31 - 1)
+        if not isinstance(rule.skip_connected, bool):
+            raise SteadystepError(Status.OUT_OF_RANGE,
+                                  f"rule.skip_connected = {shown(rule.skip_connected)}: must be True or False")
+        made.skip_connected = int(rule.skip_connected)
+        check(lib.ssValidateContactRule(made))
+        self._rules[id(rule)] = (rule, made)
+        return made
 
     def interpolated_pose(self, body) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
         """The pose to draw body at after the last frame (steadystep/interpolation.h): (position in m, rotation as
@@ -342,14 +506,19 @@ class Stepper:
 
     def destroy_body(self, body) -> None:
         """Destroys a body the stepper may know (unwatched, unbound, its joints unbound, then dBodyDestroy). Use it
-        instead of odepy.dBodyDestroy for any known body."""
+        instead of odepy.dBodyDestroy for any known body. A PyODE Body is left empty (its pointer NULL, so that
+        PyODE does not destroy it again): drop it."""
         check(lib.ssStepper_DestroyBody(self._between_frames("destroy_body"), _handles.handle("body", "body", body)))
+        if pyode.is_pyode(body):
+            pyode.forget_body(body)  # PyODE must not destroy it again: the Body is left empty, drop it
 
     def destroy_joint(self, joint) -> None:
         """Destroys a joint (unbound, then dJointDestroy). Use it instead of odepy.dJointDestroy for a bound or
-        adopted joint."""
+        adopted joint. A PyODE joint is then let go of as PyODE's JointGroup does (its _destroyed())."""
         check(lib.ssStepper_DestroyJoint(self._between_frames("destroy_joint"),
                                          _handles.handle("joint", "joint", joint)))
+        if pyode.is_pyode(joint):
+            joint._destroyed()  # PyODE's own way to let go of a joint destroyed behind it
 
     def close(self) -> None:
         """Destroys the stepper now (the world and the registry are left as they are). Call it before destroying
@@ -384,3 +553,48 @@ def _call(stepper_ref, which: str, *args) -> None:
         function(*args) if which == "step_done" else function(stepper)
     except BaseException as error:  # noqa: BLE001 - re-raised by step(), KeyboardInterrupt included
         stepper._pending = error
+
+
+_PYODE_STEPPERS: weakref.WeakSet = weakref.WeakSet()
+
+
+@atexit.register
+def _close_pyode_steppers() -> None:
+    """At exit, while the program's PyODE objects are all alive: every stepper of a PyODE world closed (when the
+    interpreter clears the modules, PyODE destroys bodies and geoms in any order, and a stepper closed after one of
+    its bodies went would read freed memory)."""
+    for stepper in list(_PYODE_STEPPERS):
+        if not stepper.closed and not stepper._in_frame:
+            stepper.close()
+
+
+def _destroy(stepper, own_group: int) -> None:
+    lib.ssStepper_Destroy(stepper)
+    if own_group:
+        _libode.ode().dJointGroupDestroy(own_group)
+
+
+def _collide_with_rule(collide, rule: ContactRule):
+    """The program's collide (or none), then the rule, as one collide callback."""
+    def collide_and_rule(stepper) -> None:
+        if collide is not None:
+            collide(stepper)
+        stepper.collide_by_rule(rule)
+
+    return collide_and_rule
+
+
+def _emptied_then(stepper_ref, group, step_s: float) -> None:
+    """step_done with a PyODE contact group: the group emptied through PyODE after every step (whatever a callback
+    raised before), then the program's step_done."""
+    stepper = stepper_ref()
+    if stepper is None:
+        return
+    try:
+        group.empty()
+    except BaseException as error:  # noqa: BLE001 - raised by step(), as a callback's
+        if stepper._pending is None:
+            stepper._pending = error
+    if stepper._user["step_done"] is not None:
+        _call(stepper_ref, "step_done", step_s)
+
