@@ -120,15 +120,6 @@ _BODY_FIELD = ffi.typeof("dBodyID*")
 _NULL_BODY = ffi.cast("dBodyID", 0)
 
 
-def _pyode_body(body):
-    """A PyODE Body's ODE body, read from its checked layout; None for anything else (the generic path names it)."""
-    if _FAMILY.get(type(body)) == "body":
-        held = _cast(_BODY_FIELD, id(body) + _OFFSET)[0]
-        if held != _NULL_BODY:
-            return held
-    return None
-
-
 def _contact(value):
     return _handles.contact("contact", value)
 
@@ -400,9 +391,15 @@ class Stepper:
         a ContactRule makes a step's contacts in C."""
         stepper = self._stepper
         if stepper is not None and _FAMILY.get(type(contact)) == "contact":  # PyODE's: the fast path
-            first = _NULL_BODY if body1 is None else _pyode_body(body1)
-            second = _NULL_BODY if body2 is None else _pyode_body(body2)
-            if first is not None and second is not None:
+            # its bodies (None, or PyODE Bodies whose ODE body is alive) read from their checked layout, inline
+            first = second = _NULL_BODY
+            if body1 is not None:
+                first = (_cast(_BODY_FIELD, id(body1) + _OFFSET)[0] if _FAMILY.get(type(body1)) == "body"
+                         else _NULL_BODY)
+            if body2 is not None:
+                second = (_cast(_BODY_FIELD, id(body2) + _OFFSET)[0] if _FAMILY.get(type(body2)) == "body"
+                          else _NULL_BODY)
+            if (body1 is None or first != _NULL_BODY) and (body2 is None or second != _NULL_BODY):
                 status = _soften(stepper, _cast(_CONTACT_POINTER, id(contact) + _OFFSET), first, second)
                 if status:
                     raise self._refused(SteadystepError(status, last_error()))
