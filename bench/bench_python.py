@@ -136,7 +136,7 @@ class PyodeProgram:
     def build(self, variant: str):
         vehicle = self.example.Vehicle()
         if variant == "own":
-            return vehicle, lambda frame_s: self.example.own_frame(vehicle, frame_s), None
+            return vehicle, lambda frame_s: self.example.own_step(vehicle, frame_s), None
         stepper = self.example.adopt(vehicle, "naive", variant)
         return vehicle, stepper.step, stepper
 

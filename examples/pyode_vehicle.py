@@ -15,7 +15,7 @@ in C from one Contact, the near callback's surface, instead of a Python call per
 
 Prints CSV t_s,chassis_x_m,chassis_y_m,crates_x_m,crates_y_m (the chassis' position, the crates' mean position)
 with full precision: a row at t = 0, then one row a frame. For ``steadystep audit --python``: build_world() and
-read_quantities(world) below.
+read_quantities(world) below (and own_frame(world, time_s, frame_s), its own loop).
 """
 
 from __future__ import annotations
@@ -107,7 +107,7 @@ def near_callback(args, geom1, geom2):
         joint.attach(geom1.getBody(), geom2.getBody())
 
 
-def own_frame(vehicle: Vehicle, frame_s: float) -> None:
+def own_step(vehicle: Vehicle, frame_s: float) -> None:
     """The program's own loop: one step of the frame's length, as PyODE's examples step."""
     vehicle.space.collide((vehicle, None), near_callback)
     vehicle.world.quickStep(frame_s)
@@ -150,6 +150,11 @@ def read_quantities(world) -> dict:
     return world.extra["vehicle"].quantities()
 
 
+def own_frame(world, time_s: float, frame_s: float) -> None:
+    """The audit's "own" variant: a frame of the program's own loop."""
+    own_step(world.extra["vehicle"], frame_s)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--loop", choices=("adopted", "own"), default="adopted", help="default adopted")
@@ -170,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
     print(",".join(repr(v) for v in (time_s, *vehicle.quantities().values())))
     for frame_s in ss.profiles.frames_within(args.profile, args.duration, args.seed):
         if stepper is None:
-            own_frame(vehicle, frame_s)
+            own_step(vehicle, frame_s)
             time_s += frame_s
         else:
             time_s = stepper.step(frame_s).time_s

@@ -186,7 +186,7 @@ def run(profile: str, variant: str, duration_s: float = 2.0) -> bytes:
     contacts = 0
     for frame_s in ss.profiles.frames_within(profile, duration_s, 1):
         if stepper is None:
-            pyode_vehicle.own_frame(vehicle, frame_s)
+            pyode_vehicle.own_step(vehicle, frame_s)
         else:
             report = stepper.step(frame_s)
             contacts += report.contacts.by_mapping
@@ -310,3 +310,15 @@ def test_the_example_adopted_keeps_its_memory_flat_over_60_s(contacts):
     assert done.returncode == 0, done.stderr
     at_10_s, at_60_s = (int(line) for line in done.stdout.split())
     assert at_60_s - at_10_s < 1024, (at_10_s, at_60_s)  # KB
+
+
+def test_the_example_audited_with_python_completes(tmp_path):
+    """steadystep audit --python on the PyODE example: its world handed over as PyODE's objects, stepped by the
+    audit's Stepper (contacts by rule through stepper.collide_by_rule, PyODE's group emptied through PyODE)."""
+    out = tmp_path / "audit"
+    done = subprocess.run([sys.executable, "-W", "ignore", "-m", "steadystep.cli", "audit", "--python",
+                           str(REPO / "examples" / "pyode_vehicle.py"), "--out", str(out), "--profiles", "fixed:60",
+                           "uniform:15:45", "--seeds", "1", "--policies", "naive", "implicit-euler", "--duration", "1"],
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    assert (out / "audit.html").is_file() and (out / "metrics.json").is_file()
