@@ -51,8 +51,8 @@
  * reads it, found from what is alive: a joint attached to known bodies (dJointDestroy: an entity's joint rebuilt each
  * frame); a body destroyed together with its geoms in the adopted spaces (dGeomDestroy and dBodyDestroy: a prop
  * despawned); a nested space with its geoms (dSpaceDestroy: a level torn down). What ODE 0.16 gives no way to tell
- * from freed memory must go through the stepper: a body with no geom in the adopted spaces (a bob on a joint, a
- * watched body) is destroyed with ssStepper_DestroyBody (or unwatched first, then destroyed). The world is destroyed
+ * from freed memory must go through the stepper: a body with no geom in the adopted spaces (a bob on a joint), and
+ * any watched body, is destroyed with ssStepper_DestroyBody (or a watched one unwatched first, then destroyed). The world is destroyed
  * after its stepper: ssStepper_Destroy writes the program's own numbers back (see there).
  *
  * The boundary with ODE. ODE 0.16 aborts the process inside a step or a collision rather than return an error for

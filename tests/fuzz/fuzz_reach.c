@@ -116,6 +116,11 @@ static void setStops(dJointID joint, double erp, double cfm) {
 
 static dJointID makeHinge(Program* p, dBodyID a, dBodyID b, double erp, double cfm) {
   if (p->joint_count == MAX_JOINTS || a == 0) return 0;
+  if (b != 0) { /* a program joins what is near, once: a joint far from holding is its own to answer for */
+    const dReal *pa = dBodyGetPosition(a), *pb = dBodyGetPosition(b);
+    if (fabs(pa[0] - pb[0]) + fabs(pa[1] - pb[1]) + fabs(pa[2] - pb[2]) > 2) return 0;
+    if (dAreConnectedExcluding(a, b, dJointTypeContact)) return 0;
+  }
   dJointID joint = dJointCreateHinge(p->world, 0);
   dJointAttach(joint, a, b);
   const dReal* at = dBodyGetPosition(a);
@@ -154,8 +159,16 @@ static int boxIndex(const Program* p, uint8_t byte) {
   return -1;
 }
 
+/* A watched body is the program's to unwatch before ODE destroys it (stepper.h): the stepper may never have seen
+ * its geom (made and destroyed between two frames). */
+static void unwatch(Program* p, int i) {
+  if (p->bodies[i].watched) checkStatus(ssStepper_UnwatchBody(p->stepper, p->bodies[i].body), "unwatch");
+  p->bodies[i].watched = 0;
+}
+
 /* A box destroyed by ODE's own calls, its geom with it. */
 static void destroyBoxPlainly(Program* p, int i) {
+  unwatch(p, i);
   dGeomDestroy(p->bodies[i].geom);
   dBodyDestroy(p->bodies[i].body);
   forgetBody(p, i);
@@ -181,7 +194,11 @@ static void destroyNestedSpace(Program* p, int s) {
       if (k == s) doomed[i] = 1;
   for (int i = 0; i < p->body_count;) {
     if (p->bodies[i].space >= 0 && doomed[p->bodies[i].space]) {
-      dBodyDestroy(p->bodies[i].body); /* its geom goes with the space */
+      /* its geom goes with the space. A body in a quadtree is in no space the stepper can list: the stepper may know
+       * it (watched, or through a joint) without seeing its geom, so it goes through the stepper (stepper.h) */
+      if (underQuadTree(p, p->bodies[i].space)) checkStatus(ssStepper_DestroyBody(p->stepper, p->bodies[i].body),
+                                                            "ssStepper_DestroyBody");
+      else unwatch(p, i), dBodyDestroy(p->bodies[i].body);
       forgetBody(p, i);
     } else {
       ++i;
@@ -223,6 +240,31 @@ static int reachable(const Program* p) {
   }
   for (int i = 0; i < p->body_count; ++i) count += reached[i];
   return count;
+}
+
+/* Moves body i to x (any double: NaN, huge) and every body jointed to it, directly or not, by the same offset. */
+static void teleport(Program* p, int i, double x) {
+  int moved[MAX_BODIES] = {0};
+  moved[i] = 1;
+  for (int changed = 1; changed;) {
+    changed = 0;
+    for (int j = 0; j < p->joint_count; ++j) {
+      dBodyID a = dJointGetBody(p->joints[j], 0), b = dJointGetBody(p->joints[j], 1);
+      for (int k = 0; k < p->body_count; ++k)
+        for (int l = 0; l < p->body_count; ++l)
+          if (!moved[l] && moved[k] && ((p->bodies[k].body == a && p->bodies[l].body == b) ||
+                                        (p->bodies[k].body == b && p->bodies[l].body == a)))
+            moved[l] = changed = 1;
+    }
+  }
+  double offset = x - dBodyGetPosition(p->bodies[i].body)[0];
+  for (int k = 0; k < p->body_count; ++k) {
+    if (!moved[k] || k == i) continue;
+    const dReal* at = dBodyGetPosition(p->bodies[k].body);
+    dBodySetPosition(p->bodies[k].body, at[0] + offset, at[1], at[2]);
+  }
+  const dReal* at = dBodyGetPosition(p->bodies[i].body);
+  dBodySetPosition(p->bodies[i].body, x, at[1], at[2]); /* exactly as asked */
 }
 
 /* The program repairs its bodies (a good state, at rest, near the origin) and its numbers (springs), as after a
@@ -284,8 +326,18 @@ static void operate(Program* p, int code, FuzzInput* in, int inside) {
       makeHinge(p, p->bodies[x].body, other, erp, cfm);
       break;
     }
-    case 6: { /* rewrite numbers, as from the program's settings */
-      double erp = fuzzDouble(in), cfm = fuzzDouble(in);
+    case 6: { /* rewrite numbers, as from the program's settings: springs, or (between frames, where the stepper
+               * looks before ODE steps) values no spring stands for, which it must refuse by name. A program that
+               * writes those inside a step hands them to ODE itself: plain ODE aborts on some (cfm 0 in a loop of
+               * hinges under dWorldStep), so the callbacks write springs only. */
+      double erp = 0.05 + 0.9 * (fuzz_byte(in) / 255.0), cfm = 1e-8 * pow(10, fuzz_byte(in) % 6);
+      if (!inside && b % 4 == 0) {
+        erp = fuzzDouble(in);
+        cfm = fuzzDouble(in);
+        /* cfm 0 is a hard row, which a program may tune: with two hinges on one pair of bodies, plain dWorldStep
+         * then factors a singular matrix and aborts, the program's own doing; the refusals are what is fuzzed */
+        if (cfm == 0) cfm = -1;
+      }
       switch (a % 3) {
         case 0:
           if (isfinite(erp) && isfinite(cfm)) dWorldSetERP(p->world, erp), dWorldSetCFM(p->world, cfm);
@@ -298,11 +350,8 @@ static void operate(Program* p, int code, FuzzInput* in, int inside) {
       }
       break;
     }
-    case 7: /* teleport */
-      if (p->body_count > 0) {
-        double x = fuzzDouble(in);
-        dBodySetPosition(p->bodies[a % p->body_count].body, x, 0, 1);
-      }
+    case 7: /* teleport, as a program moves an assembly: the body and all it is jointed to, by one offset */
+      if (p->body_count > 0) teleport(p, a % p->body_count, fuzzDouble(in));
       break;
     case 8: /* spin */
       if (p->body_count > 0) dBodySetAngularVel(p->bodies[a % p->body_count].body, fuzzDouble(in), 0, 0);
