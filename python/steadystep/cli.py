@@ -158,6 +158,7 @@ def build_parser() -> argparse.ArgumentParser:
                                   "metrics.csv and the figures to --out. " + RUN_BOUND_HELP)
     compare.add_argument("--out", type=_out_dir, default=Path("report"), metavar="DIR",
                          help="output directory (default: ./report)")
+    compare.add_argument("--force", action="store_true", help="replace an earlier report's files in --out")
     compare.add_argument("--scenes", nargs="+", metavar="SCENE", help="default: every scene")
     compare.add_argument("--profiles", nargs="+", metavar="SPEC", default=list(DEFAULT_PROFILES),
                          help=f"frame-time profiles (default: {' '.join(DEFAULT_PROFILES)})")
@@ -313,6 +314,10 @@ def _figure(args, argv) -> int:
     return 0
 
 
+# The files of a report in --out (report.write), which compare replaces only with --force.
+REPORT_FILES = ("report.html", "index.html", "metrics.json", "metrics.csv")
+
+
 def _compare(args, argv) -> int:
     _require_report_extra("compare")
     from steadystep import report
@@ -322,6 +327,10 @@ def _compare(args, argv) -> int:
                                               ("max_step_s", args.max_step)) if values}
     # Everything checked before any directory is made or any worker started.
     report.validate(args.scenes, args.profiles, args.policies, args.duration, args.seed, grid)
+    found = [args.out / name for name in REPORT_FILES if os.path.lexists(args.out / name)]
+    if found and not args.force:  # a link planted there counts as a file: replaced only when forced, never followed
+        raise _UsageError(f"steadystep compare: {found[0]}: an earlier report is there; pass --force to replace it, "
+                          "or --out another directory")
     with _executor("compare", args.executor) as executor:
         args.out.mkdir(parents=True, exist_ok=True)
         result = report.compare(args.scenes, args.profiles, args.policies, args.duration, args.seed,

@@ -56,6 +56,11 @@ def _trial(scene: str, policy: str, step_s: float, duration_s: float, bounds: di
         if error.status != "no finite mapping":  # a mapping with nothing to offer at this step is a failure of it
             raise SteadystepError(error.code, f"{name} = {step_s:g} s: {error.message}") from None
         return f"{error.status}: {error.message}"
+    if result.step_count == 0:  # a fixed cut steps whole steps only: a trial shorter than its step takes none
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{name} = {step_s:g} s: policy {policy} takes no step of "
+                              f"{step_s:g} s within duration_s = {duration_s:g} s (a fixed cut steps whole steps "
+                              f"only), so nothing is probed: give a duration of at least {step_s:g} s or a shorter "
+                              f"{name}")
     if result.failed:  # blew up or broke
         return f"{result.status}: {result.message}"
     for name, (low, high) in bounds.items():

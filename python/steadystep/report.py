@@ -15,7 +15,7 @@ from pathlib import Path
 
 from steadystep import report_aggregate, report_tasks, runs
 from steadystep._native import printable
-from steadystep.files import atomic_write_text
+from steadystep.files import write_output_text
 from steadystep.profiles import DEFAULT_PROFILES, seed_value
 from steadystep.report_aggregate import deviation as _deviation  # noqa: F401  (tests measure runs with it)
 from steadystep.report_export import CSV_COLUMNS, as_csv, as_json_text
@@ -75,9 +75,9 @@ def write(report: Report, out_dir: Path, command: str, article_paths: list[Path]
     from steadystep.report_html import as_html  # Jinja2: only where a page is written
 
     out_dir, command = Path(out_dir), printable(command)
-    atomic_write_text(out_dir / "metrics.json", as_json_text(report, command))
-    atomic_write_text(out_dir / "metrics.csv", as_csv(report))
-    path = atomic_write_text(out_dir / "report.html", as_html(report, command, article_paths or []))
-    atomic_write_text(out_dir / "index.html", '<!doctype html><meta charset="utf-8"><title>steadystep report</title>'
+    write_output_text(out_dir / "metrics.json", as_json_text(report, command))
+    write_output_text(out_dir / "metrics.csv", as_csv(report))
+    path = write_output_text(out_dir / "report.html", as_html(report, command, article_paths or []))
+    write_output_text(out_dir / "index.html", '<!doctype html><meta charset="utf-8"><title>steadystep report</title>'
                       '<meta http-equiv="refresh" content="0; url=report.html"><a href="report.html">report</a>\n')
     return path

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from steadystep import animation, cost, probe, runs, study
-from steadystep.files import write_bytes
+from steadystep.files import write_output_bytes
 from steadystep.profiles import frame_times
 from steadystep.report_aggregate import deviation, exact_curve
 from steadystep.report_validate import with_spring
@@ -162,7 +162,7 @@ def run_phases(report, units: dict[tuple, dict], executor, progress: bool | None
 
         def figures_done(scene: str, files: list[tuple[str, bytes]]):
             paths = report.figures.setdefault(scene, [])
-            paths += [write_bytes(figure_dir / name, data) for name, data in files]
+            paths += [write_output_bytes(figure_dir / name, data) for name, data in files]
             paths.sort(key=lambda path: (path.name.startswith("deviation_"), path.name))  # as drawn in order
             bar.set_postfix_str(f"{scene} figures", refresh=False)
             bar.update()
