@@ -1,0 +1,22 @@
+# The audit's test programs (tests/audit_programs/*.c), linked to the core alone: STEADYSTEP_AUDIT_PROGRAMS_CORE
+# (default the project's steadystep target; tests/audit_programs/CMakeLists.txt sets the installed one). Each is
+# built as steadystep_audit_<name>; ctest checks each one's protocol header and t = 0 row, and that it refuses a
+# bad flag with exit 2.
+if(NOT DEFINED STEADYSTEP_AUDIT_PROGRAMS_CORE)
+  set(STEADYSTEP_AUDIT_PROGRAMS_CORE steadystep)
+endif()
+set(STEADYSTEP_AUDIT_PROGRAMS_DIR ${CMAKE_CURRENT_LIST_DIR})
+foreach(name box_stack ragdoll maze hopper)
+  add_executable(steadystep_audit_${name} ${STEADYSTEP_AUDIT_PROGRAMS_DIR}/${name}.c)
+  target_link_libraries(steadystep_audit_${name} PRIVATE ${STEADYSTEP_AUDIT_PROGRAMS_CORE} m)
+  if(BUILD_TESTING OR STEADYSTEP_TESTS)
+    add_test(NAME audit_program_${name}_csv
+             COMMAND steadystep_audit_${name} --policy fixed --profile fixed:30 --duration 0.1)
+    set_tests_properties(audit_program_${name}_csv PROPERTIES PASS_REGULAR_EXPRESSION
+                         "^t_s,[^\n]+,steps,rows_by_mapping,[^\n]+\n0,[^\n]+,0,0,0,0,0,0,0\n0\\.0[0-9]+,[^\n]+\n")
+    add_test(NAME audit_program_${name}_bad_flag
+             COMMAND sh -c "\"$1\" --policy sideways 2>&1; echo exit $?" sh $<TARGET_FILE:steadystep_audit_${name}>)
+    set_tests_properties(audit_program_${name}_bad_flag PROPERTIES PASS_REGULAR_EXPRESSION
+                         "${name}: --policy sideways: [^\n]*\nexit 2\n")
+  endif()
+endforeach()
