@@ -7,6 +7,9 @@ released at rest from x0 = 0.5 m with no gravity, and pushed by the program's pe
 computed before every step, not once a frame, so that under the fixed policies the motion is the same at every
 frame rate.
 
+Its own stepping (own_frame), as a program without the library writes it: the stop's ERP and CFM as the spring's at
+the 60 fps step it was tuned for, the push once a frame, one dWorldQuickStep of the frame.
+
     .venv/bin/steadystep audit --python examples/audit_slider.py --out audit-slider
 """
 
@@ -23,6 +26,12 @@ from steadystep.audit import PythonWorld
 MASS_KG = 1.0
 SPRING = ss.Spring(stiffness=40.0, damping=1.0)  # N/m, N·s/m
 X0_M = 0.5
+TUNED_STEP_S = 1.0 / 60.0
+
+
+def push_n(time_s: float) -> float:
+    """The program's input at time_s (s): a force along x (N)."""
+    return 2.0 * math.sin(2 * math.pi * time_s / 1.7)
 
 
 def build_world() -> PythonWorld:
@@ -43,13 +52,25 @@ def build_world() -> PythonWorld:
     registry.bind_joint(slider, ss.JointParam.STOP, 1, SPRING)  # effective mass from the body: 1 kg
 
     def push(time_s: float, step_s: float) -> None:  # before every physics step: its start time and length (s)
-        odepy.dBodyAddForce(body, 2.0 * math.sin(2 * math.pi * time_s / 1.7), 0.0, 0.0)
+        odepy.dBodyAddForce(body, push_n(time_s), 0.0, 0.0)
 
     def close() -> None:
         registry.close()
         odepy.dWorldDestroy(world)
 
-    return PythonWorld(world=world, registry=registry, before_step=push, close=close, extra={"body": body})
+    return PythonWorld(world=world, registry=registry, before_step=push, close=close,
+                       extra={"body": body, "slider": slider})
+
+
+def own_frame(world: PythonWorld, time_s: float, frame_s: float) -> None:
+    """One frame of the program's own stepping, without the library: the stop's ERP and CFM as tuned at 60 fps
+    (the article's erp = hk / (hk + c), cfm = 1 / (hk + c) at h = 1/60 s), the push once a frame, one QuickStep."""
+    h, k, c = TUNED_STEP_S, SPRING.stiffness, SPRING.damping
+    slider = world.extra["slider"]
+    odepy.dJointSetSliderParam(slider, odepy.dParamStopERP, h * k / (h * k + c))
+    odepy.dJointSetSliderParam(slider, odepy.dParamStopCFM, 1.0 / (h * k + c))
+    odepy.dBodyAddForce(world.extra["body"], push_n(time_s), 0.0, 0.0)
+    odepy.dWorldQuickStep(world.world, frame_s)
 
 
 def read_quantities(world: PythonWorld) -> dict[str, float]:

@@ -2,28 +2,28 @@
 fine-step reference that the audit checks itself (docs/audit.md).
 
     from steadystep import audit
-    result = audit.audit(audit.Executable(("build/my_game_steadystep",), own=("build/my_game",)))
+    result = audit.audit(audit.Executable(("build/my_game_steadystep",), own=("build/my_game",)),
+                         out_dir=Path("audit"))
     audit.write(result, Path("audit"), "steadystep audit build/my_game_steadystep --own build/my_game")
 
-Variants: every policy (the program run with --policy NAME) and, given a second program that steps the same world
-without the library, its own stepping ("own"). Each variant runs under every profile; random profiles (all but
-fixed: and trace:) once per seed. The reference is the program under implicit-euler at REFERENCE_FPS frames a
-second (1 ms frames, one step each); the check of the reference is the same at CHECK_FPS.
-
-For each followed quantity q, with A_q = max - min of q over the reference:
-- spread (across profiles) = sqrt(mean over the variant's runs after its first, of the mean over the first run's
-  times of (q_run - q_first)^2) / A_q, every run interpolated linearly onto those times;
-- deviation (from the reference) = sqrt(mean over all the variant's runs of the mean over the reference's times of
-  (q_run - q_reference)^2) / A_q.
-Both are given over the whole run and over the times where the reference holds (check_reference); every claim of
-the recommendation uses those. A variant with a failed run has spread and deviation inf.
+Variants: the program's own stepping ("own": a second program, or a Python program's own_frame), every policy, and
+the diagnosis variants (implicit-euler with the largest step halved, and with four times QuickStep's iterations).
+Each runs under every profile, random profiles once per seed, each run a process of its own (audit_run.py). The
+reference is the program under implicit-euler at REFERENCE_FPS frames a second (1 ms frames, one step each), its
+check the same at CHECK_FPS. The numbers are audit_measure.py's, the claims audit_claims.py's, the page
+audit_page.py's. Finished runs are kept in OUT/runs, so that an audit interrupted and run again resumes.
 """
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
 import json
 import math
+import os
 import platform
+import shutil
+import stat
 import statistics
 import time
 from dataclasses import dataclass, field
@@ -31,13 +31,14 @@ from pathlib import Path
 
 import numpy as np
 
-from steadystep import study
-from steadystep._native import SteadystepError, number, printable
-from steadystep.enums import Status
-from steadystep.audit_run import (OWN, SERVED_COLUMNS, STEP_COLUMN, TIME_COLUMN, BadProgram,
-                                  Executable, PythonProgram, PythonWorld, Run)
+from steadystep import audit_measure as measure_
+from steadystep._native import SteadystepError, printable
+from steadystep.audit_run import (DIAGNOSIS_FLAGS, HALF_STEP, MORE_ITERATIONS, OWN, SERVED_COLUMNS, STEP_COLUMN,
+                                  TIME_COLUMN, BadProgram, Executable, PythonProgram, PythonWorld, Run)
 from steadystep.audit_run import run as run_program
-from steadystep.profiles import Profile, frame_count, seed_value
+from steadystep.audit_run import supports
+from steadystep.enums import Status
+from steadystep.profiles import Profile, seed_value
 
 __all__ = ["Audit", "BadProgram", "Executable", "PythonProgram", "PythonWorld", "audit", "write",
            "DEFAULT_PROFILES", "DEFAULT_SEEDS"]
@@ -48,15 +49,13 @@ DEFAULT_DURATION_S = 10.0
 REFERENCE_POLICY = "implicit-euler"
 REFERENCE_FPS = 1000   # the reference's frames: 1 ms, one physics step each (max_step_s 1/60 s or less)
 CHECK_FPS = 4000       # the check of the reference: four times finer
-# The reference holds while the two references' RMS difference over a centred window of REFERENCE_WINDOW_S (or a
-# fifth of the run, if shorter) stays within REFERENCE_TOLERANCE of the quantity's range, for every quantity.
-REFERENCE_TOLERANCE = 0.05
-REFERENCE_WINDOW_S = 1.0
-# A reference that holds for less than this fraction of the run leaves too little to claim anything.
-MIN_WINDOW_FRACTION = 0.2
-# Costs within this fraction of the cheapest are not told apart by one set of runs.
-COST_TIE = 0.1
 DETERMINISTIC_KINDS = ("fixed:", "trace:")
+CONTROL = "substeps-frozen"  # shown, never recommended: what the cut alone gives
+DIAGNOSIS = (HALF_STEP, MORE_ITERATIONS)
+COST_METHODS = ("auto", "instructions", "time", "none")
+TIME_REPEATS = 3  # CPU-time samples of each variant's cost run when instructions are not counted
+OUTPUT_FILES = ("audit.html", "metrics.json", "metrics.csv")
+RUNS_DIRECTORY = "runs"
 
 
 def profile_runs(profiles, seeds) -> list[tuple[str, int]]:
@@ -70,9 +69,16 @@ def profile_runs(profiles, seeds) -> list[tuple[str, int]]:
     return out
 
 
+def roles(variants: list[str]) -> dict[str, str]:
+    """Each variant's role: own (the program's own stepping), control (shown, never advice), diagnosis (a variant
+    that changes one thing of implicit-euler) or advice (a policy the recommendation may name)."""
+    return {v: OWN if v == OWN else "control" if v == CONTROL else "diagnosis" if v in DIAGNOSIS else "advice"
+            for v in variants}
+
+
 @dataclass
 class Audit:
-    """Everything the page, metrics.json and metrics.csv show."""
+    """Everything the page, metrics.json and metrics.csv show (docs/audit.md, "Files")."""
 
     program: str
     own: str | None
@@ -80,25 +86,34 @@ class Audit:
     runs_per_variant: list[tuple[str, int]]
     duration_s: float
     quantities: list[str]
-    amplitudes: dict[str, float]
-    reference: dict                     # check_reference(): where the reference holds
-    spread: dict = field(default_factory=dict)      # "whole" / "window" -> variant -> quantity -> value
-    deviation: dict = field(default_factory=dict)   # likewise
-    runs: list[dict] = field(default_factory=list)  # one per run: variant, profile, seed, status, steps, cost...
-    cost: dict = field(default_factory=dict)        # variant -> cpu_ms_per_simulated_s (median over its runs)
-    served: dict = field(default_factory=dict)      # variant -> column -> sum over its runs (columns present)
-    claims: list[dict] = field(default_factory=list)
-    trajectories: dict = field(default_factory=dict)  # for the figures: reference, check, each variant's first run
+    language: str = "C"  # the program's: "C" (an executable) or "Python"; its snippet comes first
+    roles: dict = field(default_factory=dict)
+    units: dict = field(default_factory=dict)
+    scales: dict = field(default_factory=dict)       # quantity -> the scale every number is divided by
+    scale_source: str = "reference"
+    deciding: list = field(default_factory=list)      # the quantities that may decide a claim
+    reference: dict = field(default_factory=dict)     # audit_measure.check_reference, sanity and usability
+    spread: dict = field(default_factory=dict)        # variant -> quantity -> value (whole run)
+    spread_runs: dict = field(default_factory=dict)   # variant -> quantity -> per-run values
+    spread_error: dict = field(default_factory=dict)  # variant -> quantity -> standard error over its runs
+    deviation: dict = field(default_factory=dict)     # "window" / "whole" -> variant -> quantity -> value
+    deviation_runs: dict = field(default_factory=dict)   # variant -> quantity -> per-run values (window)
+    deviation_error: dict = field(default_factory=dict)  # variant -> quantity -> standard error (window)
+    repeat: dict = field(default_factory=dict)        # the repeated run and its difference per quantity
+    runs: list = field(default_factory=list)          # one per run: variant, profile, seed, status, steps, cost...
+    cost: dict = field(default_factory=dict)          # method, per_simulated_s, noise, samples, unit
+    served: dict = field(default_factory=dict)        # variant -> column -> sum over its runs (columns present)
+    not_measured: dict = field(default_factory=dict)  # diagnosis variant -> why it was not run
+    claims: list = field(default_factory=list)
+    trajectories: dict = field(default_factory=dict)  # reference, check, and (variant, profile, seed) -> columns
     elapsed_s: float = 0.0
-    language: str = "C"  # the program's: "C" (an executable) or "Python"; its snippet comes first (code_to_write)
+    reused_runs: int = 0
 
 
 def validate(program, profiles, seeds, policies, duration_s: float) -> None:
-    """Checks the program, profiles, seeds, policies and duration before anything runs (SteadystepError naming the
-    value; BadProgram for the program)."""
+    """Checks the profiles, seeds, policies and duration before anything runs (SteadystepError naming the value)."""
     from steadystep.stepping import policy_names
 
-    program.check()
     if not profiles:
         raise SteadystepError(Status.OUT_OF_RANGE, "profiles = []: name at least one frame-time profile")
     if not seeds:
@@ -110,179 +125,316 @@ def validate(program, profiles, seeds, policies, duration_s: float) -> None:
     known = policy_names()
     for policy in policies:
         if policy not in known:
-            raise SteadystepError(Status.PARSE, f"policy = {policy!r}: unknown; use one of {', '.join(known)}")
-    duration_s = number("duration_s", duration_s, "s")
-    if not (math.isfinite(duration_s) and duration_s > 0):
-        raise SteadystepError(Status.OUT_OF_RANGE, f"duration_s = {duration_s!r} s: must be finite and above 0")
+            raise SteadystepError(Status.OUT_OF_RANGE, f"policy {policy!r}: not a policy of the library "
+                                  f"({', '.join(known)})")
+    if not (isinstance(duration_s, (int, float)) and math.isfinite(duration_s) and duration_s > 0):
+        raise SteadystepError(Status.OUT_OF_RANGE, f"duration = {duration_s!r} s: must be finite and above 0")
 
 
-def _unit(program, variant: str, profile: str, seed: int, duration_s: float) -> Run:
-    return run_program(program, variant, profile, seed, duration_s)
+# ---- kept runs ----------------------------------------------------------------------------------------------------
+
+class RunStore:
+    """Finished runs kept in OUT/runs, one JSON file each, named by what the run depends on (the program's files
+    and commands, the variant, profile, seed, duration and kind): a run found there is not run again. Files are
+    written whole and never through a link; a link or anything but a directory at OUT/runs is refused."""
+
+    def __init__(self, out_dir: Path | None, identity: dict, duration_s: float):
+        self.directory = None if out_dir is None else Path(out_dir) / RUNS_DIRECTORY
+        self.identity = {"program": identity, "duration_s": float(duration_s)}
+        self.made = False  # whether this audit made the directory (removed when the program is refused)
+        self.out_existed = out_dir is not None and os.path.lexists(out_dir)
+        if self.directory is not None and os.path.lexists(self.directory):
+            mode = os.lstat(self.directory).st_mode
+            if not stat.S_ISDIR(mode):
+                raise SteadystepError(Status.OUT_OF_RANGE, f"{self.directory}: is "
+                                      f"{'a symbolic link' if stat.S_ISLNK(mode) else 'not a directory'}: the audit "
+                                      "keeps its runs there and writes through no link; remove it")
+
+    def _path(self, key: tuple) -> Path:
+        digest = hashlib.sha256(json.dumps([self.identity, list(key)], sort_keys=True).encode()).hexdigest()[:20]
+        return self.directory / (".".join(measure_.sanitize_name(str(part)) for part in key) + f".{digest}.json")
+
+    def get(self, key: tuple) -> Run | None:
+        if self.directory is None:
+            return None
+        path = self._path(key)
+        try:
+            if not stat.S_ISREG(os.lstat(path).st_mode):
+                return None
+            with open(path, "rb") as file:
+                return Run.from_json(json.loads(file.read()))
+        except (OSError, ValueError, TypeError, KeyError):
+            return None
+
+    def put(self, key: tuple, run: Run) -> None:
+        from steadystep.files import write_output_text
+
+        if self.directory is None:
+            return
+        if not os.path.lexists(self.directory):
+            self.directory.mkdir(parents=True)
+            self.made = True
+        write_output_text(self._path(key), json.dumps(run.as_json()))
+
+    def forget(self) -> None:
+        """Removes the kept runs (the directory, when this audit made it)."""
+        if self.directory is not None and self.made:
+            shutil.rmtree(self.directory, ignore_errors=True)
+            if not self.out_existed:
+                with contextlib.suppress(OSError):
+                    self.directory.parent.rmdir()  # only when empty
+
+
+def clear_kept_runs(out_dir: Path) -> None:
+    """Removes OUT/runs's files (an audit replaced with --force runs everything again)."""
+    directory = Path(out_dir) / RUNS_DIRECTORY
+    if os.path.lexists(directory) and stat.S_ISDIR(os.lstat(directory).st_mode):
+        for entry in os.scandir(directory):
+            if entry.is_file(follow_symlinks=False) or entry.is_symlink():
+                os.unlink(entry.path)
+
+
+# ---- the audit ----------------------------------------------------------------------------------------------------
+
+def _unit(program, variant: str, profile: str, seed: int, duration_s: float, count: bool = False) -> Run:
+    return run_program(program, variant, profile, seed, duration_s, count)
+
+
+def _cost_method(program, cost: str) -> str:
+    if cost not in COST_METHODS:
+        raise SteadystepError(Status.OUT_OF_RANGE, f"cost = {cost!r}: one of {', '.join(COST_METHODS)}")
+    if cost == "auto":
+        return "instructions" if isinstance(program, Executable) and shutil.which("valgrind") else "time"
+    if cost == "instructions" and not (isinstance(program, Executable) and shutil.which("valgrind")):
+        raise SteadystepError(Status.OUT_OF_RANGE, "cost = 'instructions': needs valgrind on the PATH and an "
+                              "executable (a Python program's cost is its stepping loop's CPU time)")
+    return cost
+
+
+def cost_run(runs_per_variant: list[tuple[str, int]]) -> tuple[str, int]:
+    """The (profile, seed) whose run measures each variant's cost: the first of a random profile, else the first."""
+    return next(((p, s) for p, s in runs_per_variant if not p.startswith(DETERMINISTIC_KINDS)), runs_per_variant[0])
 
 
 def audit(program, profiles=DEFAULT_PROFILES, seeds=DEFAULT_SEEDS, policies=None,
           duration_s: float = DEFAULT_DURATION_S, executor=None, progress: bool | None = None,
-          reference_fps: int = REFERENCE_FPS, check_fps: int = CHECK_FPS) -> Audit:
-    """Runs program (Executable or PythonProgram) as every variant under every profile run, plus the reference and
-    its check, through executor (any concurrent.futures.Executor, a name for study.make_executor, or None: here),
-    and measures them. policies: default every policy the library names."""
+          reference_fps: int = REFERENCE_FPS, check_fps: int = CHECK_FPS, out_dir: Path | None = None,
+          cost: str = "auto", diagnosis: bool = True) -> Audit:
+    """Runs program (Executable or PythonProgram) as every variant under every profile run, plus the reference, its
+    check, a repeat and the cost runs, through executor (any concurrent.futures.Executor, a name for
+    study.make_executor, or None: here), and measures them. policies: default every policy the library names.
+    out_dir: where finished runs are kept (OUT/runs) and found again; None keeps none. cost: "auto"
+    (instructions under valgrind for an executable when valgrind is there, else CPU time over repeats),
+    "instructions", "time" or "none". diagnosis: run the diagnosis variants (when the program takes their flags)."""
+    from steadystep import study
     from steadystep.stepping import policy_names
 
     started = time.perf_counter()
     policies = list(policies) if policies else policy_names()
     profiles, seeds = list(profiles), [seed_value(s) for s in seeds]
     validate(program, profiles, seeds, policies, duration_s)
-    variants = ([OWN] if program.own is not None else []) + policies
+    method = _cost_method(program, cost)
+    has_own = program.check()
+    not_measured = {}
+    extra = []
+    if diagnosis and REFERENCE_POLICY in policies:
+        for variant in DIAGNOSIS:
+            if supports(program, variant):
+                extra.append(variant)
+            else:
+                flag = DIAGNOSIS_FLAGS[variant][0]
+                not_measured[variant] = (f"the program does not take {flag} (steadystep/audit/protocol.h does): "
+                                         "not measured")
+    variants = ([OWN] if has_own else []) + policies + extra
     runs_per_variant = profile_runs(profiles, seeds)
     tasks = {("reference",): dict(variant=REFERENCE_POLICY, profile=f"fixed:{reference_fps}", seed=1),
              ("check",): dict(variant=REFERENCE_POLICY, profile=f"fixed:{check_fps}", seed=1)}
     for variant in variants:
         for profile, seed in runs_per_variant:
             tasks[variant, profile, seed] = dict(variant=variant, profile=profile, seed=seed)
-    units = [dict(program=program, duration_s=float(duration_s), **task) for task in tasks.values()]
-    done = dict(zip(tasks, study.sweep(_unit, units, executor, progress, f"steadystep audit {program.name}", "run",
-                                       lambda task: f"{task['variant']} {task['profile']} seed {task['seed']}")))
-    result = measure(program, variants, runs_per_variant, float(duration_s), done)
+    first_profile, first_seed = runs_per_variant[0]
+    tasks["repeat",] = dict(variant=variants[0], profile=first_profile, seed=first_seed)
+    cost_profile, cost_seed = cost_run(runs_per_variant)
+    costed = [v for v in variants if v not in DIAGNOSIS]
+    if method == "instructions":
+        for variant in costed:
+            tasks["count", variant] = dict(variant=variant, profile=cost_profile, seed=cost_seed, count=True)
+        tasks["count-repeat",] = dict(variant=costed[0], profile=cost_profile, seed=cost_seed, count=True)
+    elif method == "time":
+        for variant in costed:
+            for i in range(1, TIME_REPEATS):
+                tasks["time", variant, i] = dict(variant=variant, profile=cost_profile, seed=cost_seed)
+    store = RunStore(out_dir, program.identity(), duration_s)
+    done = {key: store.get(key) for key in tasks}
+    reused = sum(run is not None for run in done.values())
+    missing = [key for key in tasks if done[key] is None]
+    units = [dict(program=program, duration_s=float(duration_s), **tasks[key]) for key in missing]
+    try:
+        for index, made in study.as_completed(_unit, units, executor, progress, f"steadystep audit {program.name}",
+                                              "run", lambda t: f"{t['variant']} {t['profile']} seed {t['seed']}"):
+            done[missing[index]] = made
+            store.put(missing[index], made)
+    except BadProgram:
+        store.forget()  # a refused program: its runs are of no use (its files change before it is audited again)
+        raise
+    result = measure(program, variants, runs_per_variant, float(duration_s), done, method, (cost_profile, cost_seed),
+                     has_own, not_measured)
+    result.reused_runs = reused
     result.elapsed_s = time.perf_counter() - started
     return result
 
 
-def _on(t: np.ndarray, run: Run, quantity: str) -> np.ndarray:
-    return np.interp(t, run.columns[TIME_COLUMN], run.columns[quantity])
+# ---- the numbers ----------------------------------------------------------------------------------------------
+
+def _name(variant: str) -> str:
+    return "own stepping" if variant == OWN else variant
 
 
-def _rms_against(runs: list[Run], against: Run, quantity: str, holds=None) -> float:
-    """sqrt(mean over runs of the mean over against's times where the reference holds (holds(t); None: every time)
-    of (q_run - q_against)^2)."""
-    t = against.columns[TIME_COLUMN]
-    inside = np.ones(len(t), bool) if holds is None else holds(t)
-    if not np.any(inside):
-        return math.nan
-    truth = against.columns[quantity][inside]
-    return float(np.sqrt(np.mean([np.mean((_on(t[inside], run, quantity) - truth) ** 2) for run in runs])))
+def _simulated_s(run: Run) -> float:
+    t = run.columns[TIME_COLUMN]
+    return float(t[-1]) if len(t) else 0.0
 
 
-def _relative(rms: float, amplitude: float) -> float:
-    """rms over the reference's range; a quantity the reference holds still: 0 when the run does too, else inf (as
-    metrics.rms_deviation)."""
-    if amplitude > 0 or math.isnan(rms):
-        return rms / amplitude if amplitude > 0 else rms
-    return 0.0 if rms == 0 else math.inf
-
-
-def check_reference(reference: Run, check: Run, quantities: list[str], amplitudes: dict, duration_s: float,
-                    reference_fps: int, check_fps: int) -> dict:
-    """Where the reference holds: on the reference's times, the two references' difference per quantity over its
-    range, as an RMS over a centred moving window of REFERENCE_WINDOW_S (a fifth of the run if shorter); the
-    reference holds where that stays within REFERENCE_TOLERANCE for every quantity. A stretch where it holds that is
-    shorter than the moving window, between two where it does not, counts as not held (two chaotic runs that cross
-    by chance). Returns the stretches not held ([start, end] s), the time held, and the differences."""
-    t = reference.columns[TIME_COLUMN]
-    width_s = min(REFERENCE_WINDOW_S, duration_s / 5)
-    half = max(1, int(round(width_s / 2 * reference_fps)))
-    holds = np.ones(len(t), bool)
-    moving, largest, parted_by = {}, {}, []
-    index = np.arange(len(t))
-    lo, hi = np.clip(index - half, 0, len(t)), np.clip(index + half + 1, 0, len(t))
-    for q in quantities:
-        d = (_on(t, check, q) - reference.columns[q]) / amplitudes[q] if amplitudes[q] > 0 else np.zeros_like(t)
-        squares = np.concatenate(([0.0], np.cumsum(d ** 2)))
-        moving[q] = np.sqrt((squares[hi] - squares[lo]) / (hi - lo))
-        largest[q] = float(np.max(moving[q]))
-        if largest[q] > REFERENCE_TOLERANCE:
-            parted_by.append(q)
-            holds &= moving[q] <= REFERENCE_TOLERANCE
-    stretches = _stretches(t, ~holds)
-    for (_, end_a), (start_b, _) in zip(stretches, stretches[1:]):
-        if start_b - end_a < 2 * half / reference_fps:
-            holds[(t >= end_a) & (t <= start_b)] = False
-    not_held = _stretches(t, ~holds)
-    step = np.diff(t, append=t[-1])
-    held_s = float(np.sum(step[holds]))
-    floor = {q: float(np.sqrt(np.mean((_on(t[holds], check, q) - reference.columns[q][holds]) ** 2)) / amplitudes[q])
-             if amplitudes[q] > 0 and np.any(holds) else 0.0 for q in quantities}
-    return {"reference_fps": reference_fps, "check_fps": check_fps, "tolerance": REFERENCE_TOLERANCE,
-            "window_s": 2 * half / reference_fps, "holds_whole_run": not parted_by, "not_held": not_held,
-            "held_s": held_s, "parted_by": parted_by, "usable": held_s >= MIN_WINDOW_FRACTION * duration_s,
-            "largest_moving_difference": largest, "difference_in_window": floor,
-            "_moving": moving, "_t": t, "_holds": holds}
-
-
-def _stretches(t: np.ndarray, mask: np.ndarray) -> list[list[float]]:
-    """The [first, last] times of each run of True in mask."""
-    edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.astype(int), [0]))))
-    return [[float(t[a]), float(t[b - 1])] for a, b in zip(edges[::2], edges[1::2])]
-
-
-def holds_at(checked: dict):
-    """A function of times (s) that is True where the reference holds (both neighbours on its times hold)."""
-    t, holds = checked["_t"], checked["_holds"].astype(float)
-    return lambda times: np.interp(times, t, holds) >= 1.0
-
-
-def measure(program, variants: list[str], runs_per_variant, duration_s: float, done: dict) -> Audit:
-    """The audit's numbers from its finished runs (done: by task key)."""
+def measure(program, variants: list[str], runs_per_variant, duration_s: float, done: dict, method: str = "none",
+            cost_profile: tuple[str, int] | None = None, has_own: bool = False,
+            not_measured: dict | None = None) -> Audit:
+    """The audit's numbers from its finished runs (done: by task key; docs/audit.md, "What it measures")."""
     reference, check = done["reference",], done["check",]
     for name, run in (("reference", reference), ("check of the reference", check)):
         if not run.ok:
             raise BadProgram(f"{program.name}: the {name} ({REFERENCE_POLICY}, {run.profile}) "
                              f"failed, so nothing can be measured: {run.status}")
-    for run in (reference, check):  # a program that ignores --profile would measure the same run everywhere
-        expected = frame_count(run.profile, duration_s, run.seed)
-        if run.frames and abs(run.frames - expected) > 1:
-            raise BadProgram(f"{program.name}: under --profile {run.profile} --duration "
-                             f"{duration_s:g} it printed {run.frames} frames, not the profile's {expected}: it does "
-                             "not follow --profile (one CSV row per frame of the profile, after a t = 0 row)")
     quantities = reference.quantities()
     for key, run in done.items():
         if run.quantities() != quantities:
             raise BadProgram(f"{program.name}: the {run.variant} run under {run.profile} prints the "
                              f"columns {', '.join(run.quantities())}, the reference {', '.join(quantities)}: every "
                              "run must follow the same quantities")
-    amplitudes = {q: float(np.ptp(reference.columns[q])) for q in quantities}
-    reference_fps = int(round(1 / np.median(np.diff(reference.columns[TIME_COLUMN]))))
-    check_fps = int(round(1 / np.median(np.diff(check.columns[TIME_COLUMN]))))
-    checked = check_reference(reference, check, quantities, amplitudes, duration_s, reference_fps, check_fps)
-    result = Audit(program.name, None if program.own is None else Path(program.own[0]).name, variants,
-                   list(runs_per_variant), duration_s, quantities, amplitudes, checked,
-                   language="Python" if isinstance(program, PythonProgram) else "C")
-    for window, holds in (("whole", None), ("window", holds_at(checked))):
-        result.spread[window], result.deviation[window] = {}, {}
-        for variant in variants:
-            runs = [done[variant, profile, seed] for profile, seed in runs_per_variant]
-            failed = not all(run.ok for run in runs)
-            result.spread[window][variant] = {
-                q: math.inf if failed else (_relative(_rms_against(runs[1:], runs[0], q, holds), amplitudes[q])
-                                            if len(runs) > 1 else math.nan) for q in quantities}
-            result.deviation[window][variant] = {
-                q: math.inf if failed else _relative(_rms_against(runs, reference, q, holds), amplitudes[q])
-                for q in quantities}
+    by_variant = {v: [done[(v, p, s)] for p, s in runs_per_variant] for v in variants}
+    ok_runs = [run.columns for runs in by_variant.values() for run in runs if run.ok]
+    sanity = measure_.reference_sanity(reference.columns, ok_runs, quantities)
+    base = OWN if OWN in variants else ("naive" if "naive" in variants else variants[0])
+    spanned = [r.columns for r in by_variant[base] if r.ok]
+    scale_source = f"the {_name(base)} runs"
+    if sanity["sane"]:
+        spanned.append(reference.columns)
+        scale_source += " and the reference"
+    scales = measure_.scales_of(spanned or [reference.columns], quantities)
+    decide = measure_.deciding(quantities, scales)
+    checked = measure_.check_reference(reference.columns, check.columns, quantities, scales, duration_s, decide)
+    checked.update(sanity)
+    checked["reference_fps"] = int(float(reference.profile.split(":")[1]))
+    checked["check_fps"] = int(float(check.profile.split(":")[1]))
+    reasons = []
+    if not sanity["sane"]:
+        reasons.append("unphysical")
+    if not checked["check_finer"]:
+        reasons.append("unchecked")
+    if checked["held_s"] < measure_.MIN_WINDOW_FRACTION * duration_s:
+        reasons.append("parted early")
+    checked["usable"] = not reasons
+    checked["not_usable_because"] = reasons
+    holds = measure_.holds_at(checked)
+
+    result = Audit(program.name, None if not has_own else (Path(program.own[0]).name if program.own else
+                                                           f"{program.name}: own_frame()"),
+                   variants, list(runs_per_variant), duration_s, quantities,
+                   language=program.language, roles=roles(variants),
+                   units={q: measure_.unit_of(q) for q in quantities}, scales=scales, scale_source=scale_source,
+                   deciding=decide, reference=checked)
+    result.deviation = {"window": {}, "whole": {}}
     for variant in variants:
-        costs = []
+        runs = by_variant[variant]
+        failed = not all(run.ok for run in runs)
+        result.spread[variant], result.spread_runs[variant], result.spread_error[variant] = {}, {}, {}
+        result.deviation_runs[variant], result.deviation_error[variant] = {}, {}
+        result.deviation["window"][variant], result.deviation["whole"][variant] = {}, {}
+        for q in quantities:
+            if failed:
+                per_run = [math.inf] * (len(runs) - 1)
+            else:
+                per_run = [measure_.compared(r.columns, runs[0].columns, q)[0] / scales[q] for r in runs[1:]]
+            result.spread_runs[variant][q] = per_run
+            result.spread[variant][q], result.spread_error[variant][q] = (
+                measure_.rms_and_error(per_run) if per_run else (math.nan, 0.0))
+            for window, inside in (("window", holds), ("whole", None)):
+                per_run = ([math.inf] * len(runs) if failed else
+                           [measure_.against_reference(r.columns, reference.columns, q, inside)[0] / scales[q]
+                            for r in runs])
+                value, error = measure_.rms_and_error(per_run)
+                result.deviation[window][variant][q] = value
+                if window == "window":
+                    result.deviation_runs[variant][q], result.deviation_error[variant][q] = per_run, error
+    repeated = done["repeat",]
+    original = done[(variants[0], *runs_per_variant[0])]
+    result.repeat = {"variant": variants[0], "profile": runs_per_variant[0][0], "seed": runs_per_variant[0][1],
+                     "difference": {q: (measure_.compared(repeated.columns, original.columns, q)[0] / scales[q]
+                                        if repeated.ok and original.ok else 0.0) for q in quantities},
+                     "status": repeated.status}
+    for variant in variants:
         for profile, seed in runs_per_variant:
             run = done[variant, profile, seed]
-            simulated_s = float(run.columns[TIME_COLUMN][-1]) if len(run.columns[TIME_COLUMN]) else 0.0
-            steps = run.columns.get(STEP_COLUMN)
-            result.runs.append({
-                "variant": variant, "profile": profile, "seed": seed, "status": run.status, "frames": run.frames,
-                "simulated_s": simulated_s,
-                "steps_per_frame": float(np.sum(steps)) / run.frames if steps is not None and run.frames else None,
-                "cpu_s": run.cpu_s, "wall_s": run.wall_s,
-                "cpu_ms_per_simulated_s": 1000 * run.cpu_s / simulated_s if simulated_s > 0 else None,
-                "served": {name: int(np.sum(run.columns[name])) for name in SERVED_COLUMNS if name in run.columns}})
-            if run.ok and simulated_s > 0:
-                costs.append(1000 * run.cpu_s / simulated_s)
-        result.cost[variant] = statistics.median(costs) if costs else None
+            result.runs.append(_run_row(run, reference, runs_per_variant, by_variant[variant][0]))
         served = [r["served"] for r in result.runs if r["variant"] == variant]
         if served and served[0]:
             result.served[variant] = {name: sum(s.get(name, 0) for s in served) for name in served[0]}
-    first = runs_per_variant[0]
+    result.cost = _cost(done, variants, method, cost_profile)
+    result.not_measured = dict(not_measured or {})
     result.trajectories = {"reference": reference.columns, "check": check.columns,
-                           **{variant: done[(variant, *first)].columns for variant in variants}}
+                           **{(v, p, s): done[v, p, s].columns for v in variants for p, s in runs_per_variant}}
     from steadystep.audit_claims import claims
 
     result.claims = claims(result)
     return result
+
+
+def _run_row(run: Run, reference: Run, runs_per_variant, first: Run) -> dict:
+    simulated_s = _simulated_s(run)
+    steps = run.columns.get(STEP_COLUMN)
+    compared = ("baseline" if run is first else
+                measure_.compared(run.columns, first.columns, run.quantities()[0])[1] if run.ok and first.ok else "-")
+    return {"variant": run.variant, "profile": run.profile, "seed": run.seed, "status": run.status,
+            "frames": run.frames, "simulated_s": simulated_s,
+            "steps_per_frame": float(np.sum(steps)) / run.frames if steps is not None and run.frames else None,
+            "cpu_s": run.cpu_s, "wall_s": run.wall_s, "compared_at": compared,
+            "cpu_ms_per_simulated_s": 1000 * run.cpu_s / simulated_s if simulated_s > 0 else None,
+            "served": {name: int(np.sum(run.columns[name])) for name in SERVED_COLUMNS if name in run.columns}}
+
+
+def _cost(done: dict, variants: list[str], method: str, cost_profile) -> dict:
+    """The cost table: per variant (not the diagnosis ones) its cost per simulated second and the noise of that
+    value. instructions: valgrind's count of the cost run (one count, repeated once for the first variant), noise
+    the larger of the repeat's difference and COUNT_RESOLUTION of the value; time: the median of TIME_REPEATS CPU
+    times of the cost run, noise their range."""
+    out = {"method": method, "profile": cost_profile[0] if cost_profile else None,
+           "seed": cost_profile[1] if cost_profile else None, "per_simulated_s": {}, "noise": {}, "samples": {},
+           "unit": {"instructions": "instructions per simulated s", "time": "CPU ms per simulated s"}.get(method)}
+    if method == "none":
+        return out
+    costed = [v for v in variants if v not in DIAGNOSIS]
+    if method == "instructions":
+        repeat = done["count-repeat",]
+        first = done["count", costed[0]]
+        repeat_difference = abs(repeat.instructions - first.instructions) / max(first.instructions, 1)
+        out["repeat_difference"] = repeat_difference
+        for v in costed:
+            run = done["count", v]
+            simulated_s = _simulated_s(run)
+            if not run.ok or simulated_s <= 0:
+                continue
+            value = run.instructions / simulated_s
+            out["per_simulated_s"][v] = value
+            out["samples"][v] = [value]
+            out["noise"][v] = max(repeat_difference, measure_.COUNT_RESOLUTION) * value
+        return out
+    for v in costed:
+        runs = [done[(v, *cost_profile)]] + [done["time", v, i] for i in range(1, TIME_REPEATS)]
+        samples = [1000 * r.cpu_s / _simulated_s(r) for r in runs if r.ok and _simulated_s(r) > 0]
+        if len(samples) == len(runs):
+            out["per_simulated_s"][v] = statistics.median(samples)
+            out["samples"][v] = samples
+            out["noise"][v] = max(samples) - min(samples)
+    return out
 
 
 def recommended(result: Audit) -> str | None:
@@ -301,24 +453,37 @@ def code_to_write(result: Audit) -> str:
 
 # ---- writing ------------------------------------------------------------------------------------------------------
 
-OUTPUT_FILES = ("audit.html", "metrics.json", "metrics.csv")
-
-
 def existing_outputs(out_dir: Path) -> list[Path]:
-    """The files of an earlier audit in out_dir, which write() replaces only when forced."""
-    return [Path(out_dir) / name for name in OUTPUT_FILES if (Path(out_dir) / name).exists()]
+    """The files of an earlier audit in out_dir (a link there counts, dangling or not), which write() replaces only
+    when forced."""
+    return [Path(out_dir) / name for name in OUTPUT_FILES if os.path.lexists(Path(out_dir) / name)]
+
+
+def refuse_earlier(out_dir: Path, force: bool) -> None:
+    """SteadystepError naming an earlier audit's file in out_dir unless force."""
+    found = existing_outputs(out_dir)
+    if found and not force:
+        link = " (a symbolic link: it is replaced, never written through)" if found[0].is_symlink() else ""
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{found[0]}: an earlier audit is there{link}; pass --force to "
+                              "replace it, or --out another directory")
 
 
 def as_json(result: Audit, command: str) -> dict:
     """metrics.json (docs/audit.md): every table of the page and every claim, strict JSON (inf and nan as null)."""
     reference = {k: v for k, v in result.reference.items() if not k.startswith("_")}
     data = {"command": printable(command), "program": result.program, "own": result.own,
-            "duration_s": result.duration_s, "variants": result.variants,
-            "profile_runs": [{"profile": p, "seed": s} for p, s in result.runs_per_variant],
-            "reference_policy": REFERENCE_POLICY, "quantities": result.quantities, "amplitudes": result.amplitudes,
-            "reference_check": reference, "spread": result.spread, "deviation": result.deviation,
-            "runs": result.runs, "cost_cpu_ms_per_simulated_s": result.cost, "served": result.served,
-            "claims": result.claims, "elapsed_s": result.elapsed_s, "machine": platform.node()}
+            "language": result.language, "duration_s": result.duration_s, "variants": result.variants,
+            "roles": result.roles, "profile_runs": [{"profile": p, "seed": s} for p, s in result.runs_per_variant],
+            "reference_policy": REFERENCE_POLICY, "quantities": result.quantities, "units": result.units,
+            "scales": result.scales, "scale_source": result.scale_source, "deciding": result.deciding,
+            "noise_rule": {"sigmas": measure_.NOISE_SIGMAS, "tiny_range": measure_.TINY_RANGE,
+                           "count_resolution": measure_.COUNT_RESOLUTION},
+            "reference_check": reference, "spread": result.spread, "spread_runs": result.spread_runs,
+            "spread_error": result.spread_error, "deviation": result.deviation,
+            "deviation_runs": result.deviation_runs, "deviation_error": result.deviation_error,
+            "repeat": result.repeat, "runs": result.runs, "cost": result.cost, "served": result.served,
+            "not_measured": result.not_measured, "claims": result.claims, "elapsed_s": result.elapsed_s,
+            "reused_runs": result.reused_runs, "machine": platform.node()}
     return _strict(data)
 
 
@@ -330,13 +495,13 @@ def _strict(value):
         return [_strict(v) for v in value]
     if isinstance(value, (float, np.floating)):
         return float(value) if math.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
+    if isinstance(value, (np.integer, np.bool_)):
+        return value.item()
     return value
 
 
-CSV_COLUMNS = ("variant", "quantity", "spread", "deviation", "spread_in_window", "deviation_in_window",
-               "cpu_ms_per_simulated_s", "runs_failed")
+CSV_COLUMNS = ("variant", "role", "quantity", "scale", "spread", "spread_error", "deviation_in_window",
+               "deviation_error", "deviation_whole", "cost_per_simulated_s", "cost_unit", "runs_failed")
 
 
 def as_csv(result: Audit) -> str:
@@ -344,27 +509,27 @@ def as_csv(result: Audit) -> str:
     lines = [",".join(CSV_COLUMNS)]
     for variant in result.variants:
         failed = sum(1 for r in result.runs if r["variant"] == variant and r["status"] != "ok")
+        cost = result.cost.get("per_simulated_s", {}).get(variant)
         for q in result.quantities:
-            values = [result.spread["whole"][variant][q], result.deviation["whole"][variant][q],
-                      result.spread["window"][variant][q], result.deviation["window"][variant][q],
-                      result.cost[variant]]
+            values = [result.scales[q], result.spread[variant][q], result.spread_error[variant][q],
+                      result.deviation["window"][variant][q], result.deviation_error[variant][q],
+                      result.deviation["whole"][variant][q], cost]
             cells = ["" if v is None or not math.isfinite(v) else f"{v:.9g}" for v in values]
-            lines.append(",".join([variant, q, *cells, str(failed)]))
+            lines.append(",".join([variant, result.roles[variant], q, *cells[:6], cells[6],
+                                   (result.cost.get("unit") or "") if cost is not None else "", str(failed)]))
     return "\n".join(lines) + "\n"
 
 
 def write(result: Audit, out_dir: Path, command: str, force: bool = False) -> Path:
     """Writes audit.html (figures embedded, also beside it as PNG), metrics.json and metrics.csv to out_dir, each
-    whole. Refuses (SteadystepError naming the file) to replace an earlier audit's files unless force."""
+    whole, never through a link (files.write_output_text). Refuses (SteadystepError naming the file) to replace an
+    earlier audit's files unless force."""
     from steadystep import audit_page
-    from steadystep.files import atomic_write_text
+    from steadystep.files import write_output_text
 
     out_dir = Path(out_dir)
-    found = existing_outputs(out_dir)
-    if found and not force:
-        raise SteadystepError(Status.OUT_OF_RANGE, f"{found[0]}: an earlier audit is there; pass --force to replace it, or "
-                              "--out another directory")
+    refuse_earlier(out_dir, force)
     out_dir.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out_dir / "metrics.json", json.dumps(as_json(result, command), indent=1, allow_nan=False))
-    atomic_write_text(out_dir / "metrics.csv", as_csv(result))
-    return atomic_write_text(out_dir / "audit.html", audit_page.page(result, out_dir, command))
+    write_output_text(out_dir / "metrics.json", json.dumps(as_json(result, command), indent=1, allow_nan=False))
+    write_output_text(out_dir / "metrics.csv", as_csv(result))
+    return write_output_text(out_dir / "audit.html", audit_page.page(result, out_dir, command))

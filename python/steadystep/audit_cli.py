@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import shlex
 from pathlib import Path
 
@@ -13,11 +14,13 @@ HELP = ("audit your own program: its frame-rate dependence under every policy, a
 DESCRIPTION = (
     "Runs PROGRAM (an executable taking --profile SPEC --seed N --duration S --policy NAME and printing CSV "
     "t_s,<quantity>_<unit>,... on stdout, one row per frame; exit 0 done, 1 a frame failed) or a Python file "
-    "(--python FILE defining build_world() and read_quantities(world)) under every frame-time profile and policy, "
-    "and the program's own stepping (--own: the same flags but --policy), against a fine-step reference "
-    "(implicit-euler at 1000 frames a second) that it checks at 4000. Writes audit.html, metrics.json and "
-    "metrics.csv to --out (docs/audit.md). A program that does not exist, is not executable, prints no or "
-    "malformed CSV, hangs past --time-limit or crashes is refused with exit 2, naming it.")
+    "(--python FILE defining build_world() and read_quantities(world), and own_frame(world, time_s, frame_s) for "
+    "its own stepping) under every frame-time profile and policy, and the program's own stepping (--own: the same "
+    "flags but --policy), each run a process of its own, against a fine-step reference (implicit-euler at 1000 "
+    "frames a second) that it checks at 4000. Writes audit.html, metrics.json and metrics.csv to --out "
+    "(docs/audit.md), and keeps every finished run in --out/runs: an audit interrupted and run again resumes. A "
+    "program that does not exist, is not executable, prints no or malformed CSV, hangs past --time-limit, exits or "
+    "crashes is refused with exit 2, naming it.")
 
 
 def _positive(text: str) -> float:
@@ -56,8 +59,13 @@ def add_parser(commands, seed_type, executor_argument) -> None:
     parser.add_argument("--duration", type=_positive, default=audit.DEFAULT_DURATION_S, metavar="S",
                         help=f"simulated seconds per run (default {audit.DEFAULT_DURATION_S:g})")
     parser.add_argument("--time-limit", type=_positive, default=60.0, metavar="S",
-                        help="wall seconds a run of an executable may take before it is killed and the program "
-                        "refused (default 60)")
+                        help="CPU seconds a run may use before it is killed and the program refused (default 60); "
+                        "a run that sleeps is killed after this much wall time once it has used no CPU for 1 s")
+    parser.add_argument("--cost", choices=audit.COST_METHODS, default="auto",
+                        help="how cost is measured: instructions (valgrind, an executable), time (CPU time of "
+                        "repeated runs), none; auto (default): instructions when valgrind is there")
+    parser.add_argument("--no-diagnosis", action="store_true", help="skip the diagnosis variants (half-step, "
+                        "more-iterations)")
     executor_argument(parser)
 
 
@@ -65,17 +73,14 @@ def command(args, argv) -> int:
     from steadystep import audit
     from steadystep.audit_run import Executable, PythonProgram
 
-    found = audit.existing_outputs(args.out)
-    if found and not args.force:  # refused before anything runs
-        raise SteadystepError(Status.OUT_OF_RANGE, f"{found[0]}: an earlier audit is there; pass --force to replace it, or "
-                              "--out another directory")
-    if args.out.exists() and not args.out.is_dir():
+    if os.path.lexists(args.out) and not args.out.is_dir():
         raise SteadystepError(Status.OUT_OF_RANGE, f"--out {args.out}: exists and is not a directory")
+    audit.refuse_earlier(args.out, args.force)  # refused before anything runs
     if args.python:
         if args.own:
-            raise SteadystepError(Status.OUT_OF_RANGE, f"--own {args.own}: a --python program is stepped by the library "
-                                  "and has no own stepping to compare")
-        program = PythonProgram(args.python)
+            raise SteadystepError(Status.OUT_OF_RANGE, f"--own {args.own}: a --python program's own stepping is its "
+                                  "own_frame(world, time_s, frame_s), not a second program")
+        program = PythonProgram(args.python, args.time_limit)
     else:
         words = shlex.split(args.program)
         if not words:
@@ -85,13 +90,18 @@ def command(args, argv) -> int:
     audit.validate(program, args.profiles, args.seeds, args.policies or [], args.duration)
     from steadystep import study
 
+    if args.force:
+        audit.clear_kept_runs(args.out)  # a replaced audit runs everything again
     try:
         with study.make_executor(args.executor) as executor:
-            result = audit.audit(program, args.profiles, args.seeds, args.policies, args.duration, executor)
+            result = audit.audit(program, args.profiles, args.seeds, args.policies, args.duration, executor,
+                                 out_dir=args.out, cost=args.cost, diagnosis=not args.no_diagnosis)
     except study.ExecutorUnavailable as error:
         raise SteadystepError(Status.OUT_OF_RANGE, f"steadystep audit: {error}") from None
     path = audit.write(result, args.out, shlex.join(["steadystep", *argv]), force=args.force)
     print(path)
+    if result.reused_runs:
+        print(f"({result.reused_runs} finished runs kept in {args.out / audit.RUNS_DIRECTORY} were not run again)")
     for claim in result.claims:
         print(f"- {claim['text']}")
     code = audit.code_to_write(result)

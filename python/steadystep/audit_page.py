@@ -1,5 +1,7 @@
-"""The audit's page (audit.html): the recommendation first, each claim linked to its table, then the tables and
-figures it rests on. The same look as the report's page; figures drawn with figures.py's colours and style."""
+"""The audit's page (audit.html): the recommendation first, each claim linked to its table, then what it is about,
+each chosen quantity under the program's own stepping and under the recommended policy across the audited frame
+rates (the article's figure, for the user's program), then the tables and figures the claims rest on. Figures drawn
+with figures.py's colours and style; every text escaped."""
 
 from __future__ import annotations
 
@@ -17,6 +19,8 @@ from steadystep import figures
 from steadystep.audit_run import OWN, SERVED_COLUMNS, TIME_COLUMN
 
 OWN_COLOR = "#000000"
+PROFILE_COLORS = ("#1f5fbf", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf")
+FIGURE_QUANTITIES = 4  # the deciding quantities drawn across frame rates, at most
 
 
 def _color(variant: str) -> str:
@@ -31,9 +35,15 @@ def _number(value, digits: int = 3) -> str:
     return f"{value:.{digits}g}"
 
 
-def _variant(variant: str) -> str:
-    label = "own stepping" if variant == OWN else variant
-    return f'<span class="dot" style="background:{_color(variant)}"></span>{html.escape(label)}'
+def _label(variant: str) -> str:
+    return "own stepping" if variant == OWN else variant
+
+
+def _variant(result, variant: str) -> str:
+    role = result.roles.get(variant, "")
+    mark = {"control": " <span class=small>(control)</span>",
+            "diagnosis": " <span class=small>(diagnosis)</span>"}.get(role, "")
+    return (f'<span class="dot" style="background:{_color(variant)}"></span>{html.escape(_label(variant))}{mark}')
 
 
 def _table(header: list[str], rows: list[list[str]], anchor: str) -> str:
@@ -42,61 +52,101 @@ def _table(header: list[str], rows: list[list[str]], anchor: str) -> str:
     return f"<table id='{anchor}'><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
 
 
-def _by_quantity(result, table: dict, anchor: str) -> str:
-    """variant x quantity, over the window and the whole run; the smallest of a column (in the window) in bold."""
-    header = ["variant"] + [f"{html.escape(q)} (window)" for q in result.quantities] + \
-             [f"{html.escape(q)} (whole run)" for q in result.quantities]
+def _quantity_header(result, q: str) -> str:
+    mark = "" if q in result.deciding else " <span class=small>(error-like: does not decide alone)</span>"
+    return html.escape(q) + mark
+
+
+def _values_table(result, table: dict, errors: dict, anchor: str) -> str:
+    """variant x quantity with the standard error over runs, and the largest over the deciding quantities; the
+    smallest of each column in bold."""
+    header = ["variant"] + [_quantity_header(result, q) for q in result.quantities] + ["largest (deciding)"]
     best = {}
     for q in result.quantities:
-        finite = [table["window"][v][q] for v in result.variants if math.isfinite(table["window"][v][q])]
+        finite = [table[v][q] for v in result.variants if math.isfinite(table[v][q])]
         best[q] = min(finite) if finite else None
     rows = []
     for v in result.variants:
-        cells = [_variant(v)]
+        cells = [_variant(result, v)]
         for q in result.quantities:
-            text = _number(table["window"][v][q], 4)
-            cells.append(f"<b>{text}</b>" if table["window"][v][q] == best[q] else text)
-        cells += [_number(table["whole"][v][q], 4) for q in result.quantities]
+            text = _number(table[v][q], 3)
+            if math.isfinite(table[v][q]) and errors[v][q] > 0:
+                text += f" ± {_number(errors[v][q], 2)}"
+            cells.append(f"<b>{text}</b>" if table[v][q] == best[q] else text)
+        deciding = [(table[v][q], q) for q in result.deciding if not math.isnan(table[v][q])]
+        value, q = max(deciding) if deciding else (math.nan, "")
+        cells.append(f"{_number(value, 3)} <span class=small>{html.escape(q)}</span>")
         rows.append(cells)
     return _table(header, rows, anchor)
+
+
+def _whole_deviation_table(result) -> str:
+    header = ["variant"] + [html.escape(q) for q in result.quantities]
+    rows = [[_variant(result, v)] + [_number(result.deviation["whole"][v][q], 3) for q in result.quantities]
+            for v in result.variants]
+    return _table(header, rows, "deviation-whole")
 
 
 def _runs_table(result) -> str:
     rows = []
     for r in result.runs:
         status = "ok" if r["status"] == "ok" else f"<span class=bad>{html.escape(r['status'])}</span>"
-        rows.append([_variant(r["variant"]), html.escape(r["profile"]), str(r["seed"]), str(r["frames"]),
-                     _number(r["simulated_s"], 4), _number(r["steps_per_frame"]), _number(r["cpu_s"] * 1000, 3),
-                     _number(r["cpu_ms_per_simulated_s"]), status])
-    return _table(["variant", "profile", "seed", "frames", "simulated (s)", "steps / frame", "CPU (ms)",
-                   "CPU ms / simulated s", "status"], rows, "runs")
+        rows.append([_variant(result, r["variant"]), html.escape(r["profile"]), str(r["seed"]), str(r["frames"]),
+                     _number(r["simulated_s"], 4), _number(r["steps_per_frame"]), html.escape(r["compared_at"]),
+                     _number(r["cpu_s"] * 1000, 3), status])
+    return _table(["variant", "profile", "seed", "frames", "simulated (s)", "steps / frame", "compared at",
+                   "CPU (ms)", "status"], rows, "runs")
 
 
 def _cost_table(result) -> str:
-    own = result.cost.get(OWN)
+    cost = result.cost
+    own = cost.get("per_simulated_s", {}).get(OWN)
     rows = []
     for v in result.variants:
         steps = [r["steps_per_frame"] for r in result.runs if r["variant"] == v and r["steps_per_frame"] is not None]
-        cost = result.cost[v]
-        rows.append([_variant(v), _number(float(np.median(steps))) if steps else "-", _number(cost),
-                     _number(cost / own) if cost is not None and own else "-"])
-    return _table(["variant", "steps / frame (median over runs)", "CPU ms / simulated s (median over runs)",
-                   "/ own stepping"], rows, "cost")
+        value = cost.get("per_simulated_s", {}).get(v)
+        noise = cost.get("noise", {}).get(v)
+        rows.append([_variant(result, v), _number(float(np.median(steps))) if steps else "-",
+                     _number(value, 4) + (f" ± {_number(noise, 2)}" if value is not None and noise else ""),
+                     _number(value / own, 3) if value is not None and own else "-"])
+    unit = cost.get("unit") or "not measured"
+    return _table(["variant", "steps / frame (median over runs)", html.escape(unit), "/ own stepping"], rows, "cost")
 
 
 def _served_table(result) -> str:
     columns = [c for c in SERVED_COLUMNS if any(c in s for s in result.served.values())]
-    rows = [[_variant(v)] + [str(result.served[v].get(c, "-")) for c in columns] for v in result.variants
+    rows = [[_variant(result, v)] + [str(result.served[v].get(c, "-")) for c in columns] for v in result.variants
             if v in result.served]
     return _table(["variant"] + [html.escape(c.replace("_", " ")) for c in columns], rows, "served")
 
 
 def _reference_table(result) -> str:
     r = result.reference
-    rows = [[html.escape(q), _number(result.amplitudes[q], 4), _number(r["largest_moving_difference"][q], 3),
-             _number(r["difference_in_window"][q], 3)] for q in result.quantities]
-    return _table(["quantity", "range A of the reference", f"largest RMS difference over {r['window_s']:.3g} s / A",
-                   "RMS difference in the window / A"], rows, "reference")
+    rows = [[_quantity_header(result, q), html.escape(result.units[q]), _number(result.scales[q], 4),
+             _number(r["largest_moving_difference"][q], 3), _number(r["difference_in_window"][q], 3),
+             _number(result.repeat["difference"][q], 3)] for q in result.quantities]
+    table = _table(["quantity", "unit", f"scale ({html.escape(result.scale_source)} range)",
+                    f"largest RMS difference of the check over {r['window_s']:.3g} s / scale",
+                    "RMS difference while held / scale (the reference's uncertainty)",
+                    "a repeated run's difference / scale"], rows, "reference")
+    steps = (f"Mean step: the reference {_number(1000 * r['reference_step_s'] if r['reference_step_s'] else None)} "
+             f"ms, its check {_number(1000 * r['check_step_s'] if r['check_step_s'] else None)} ms "
+             f"({'finer' if r['check_finer'] else 'not finer'}). Parted at: "
+             f"{'never' if r['parted_at'] is None else _number(r['parted_at']) + ' s'}. Physical: "
+             f"{'yes' if r['sane'] else 'no'}. Usable for deviation: {'yes' if r['usable'] else 'no'}.")
+    return table + f"<p class=small>{html.escape(steps)}</p>"
+
+
+def _diagnosis_table(result) -> str:
+    claim = next((c for c in result.claims if c["kind"] == "diagnosis"), None)
+    if claim is None:
+        return ("<p id='diagnosis' class=small>No diagnosis: it needs the program's own stepping (or naive) with a "
+                "spread above 0.</p>")
+    rows = [[html.escape(s["step"]), _variant(result, s["from"]) + " → " + _variant(result, s["to"]),
+             _number(s["from_value"]), _number(s["to_value"]), _number(s["noise"]),
+             f"{s['share_removed']:.0%}", html.escape(s["verdict"])] for s in claim["steps"]]
+    return _table(["what changes", "from → to", "largest spread before", "after", "noise", "share removed",
+                   "verdict"], rows, "diagnosis")
 
 
 def _code(result) -> str:
@@ -118,23 +168,38 @@ def _embed(path: Path) -> str:
     return f'<img src="data:image/png;base64,{data}" alt="{html.escape(Path(path).name)}">'
 
 
-def _draw_quantity(result, quantity: str) -> Figure:
-    figure = Figure(figsize=(11, 3.6))
-    ax = figure.add_subplot()
-    t = result.trajectories
-    first = result.runs_per_variant[0]
-    for variant in result.variants:
-        run = t[variant]
-        ax.plot(run[TIME_COLUMN], run[quantity], color=_color(variant), lw=1.1,
-                label=f"{'own stepping' if variant == OWN else variant} ({first[0]})")
-    for name, style in (("reference", "--"), ("check", ":")):
-        ax.plot(t[name][TIME_COLUMN], t[name][quantity], color=figures.REFERENCE_COLOR, ls=style, lw=1.3,
-                label=f"{name} ({result.reference['reference_fps' if name == 'reference' else 'check_fps']} fps)")
-    _mark_window(ax, result)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel(quantity)
-    ax.set_title(f"{result.program}: {quantity}, every variant under {first[0]} against the reference")
-    ax.legend(ncol=3, loc="best")
+def _shown_pair(result) -> tuple[str, str]:
+    """The two variants the page draws across frame rates: own stepping (or naive, or the first variant) and the
+    recommended policy (or the least spread)."""
+    from steadystep import audit
+
+    left = OWN if OWN in result.variants else ("naive" if "naive" in result.variants else result.variants[0])
+    right = audit.recommended(result) or next((c["variant"] for c in result.claims if c["kind"] == "least_spread"),
+                                              result.variants[-1])
+    return left, right
+
+
+def _draw_across(result, quantity: str) -> Figure:
+    """One quantity under the program's own stepping and under the recommended policy, each in every audited
+    profile run, with the reference dashed: how much each depends on the frame rate."""
+    left, right = _shown_pair(result)
+    figure = Figure(figsize=(11, 3.4))
+    axes = figure.subplots(1, 2, sharey=True)
+    reference = result.trajectories["reference"]
+    for ax, variant in zip(axes, (left, right)):
+        for i, (profile, seed) in enumerate(result.runs_per_variant):
+            run = result.trajectories[(variant, profile, seed)]
+            ax.plot(run[TIME_COLUMN], run[quantity], color=PROFILE_COLORS[i % len(PROFILE_COLORS)], lw=1.0,
+                    label=f"{profile} seed {seed}")
+        ax.plot(reference[TIME_COLUMN], reference[quantity], color=figures.REFERENCE_COLOR, ls="--", lw=1.0,
+                label=f"reference ({result.reference['reference_fps']} fps)")
+        _mark_parting(ax, result)
+        spread = result.spread[variant][quantity]
+        ax.set_title(f"{_label(variant)}: spread {_number(spread)} of the scale")
+        ax.set_xlabel("t (s)")
+    axes[0].set_ylabel(quantity)
+    axes[1].legend(loc="best", fontsize=7)
+    figure.suptitle(f"{result.program}: {quantity} at every audited frame rate", fontsize=10)
     figure.tight_layout()
     return figure
 
@@ -145,11 +210,11 @@ def _draw_reference(result) -> Figure:
     r = result.reference
     for q, values in r["_moving"].items():
         ax.plot(r["_t"], np.maximum(values, 1e-7), lw=1.2, label=q)  # a log axis: exact agreement drawn at 1e-7
-    ax.axhline(r["tolerance"], color="#b00", ls="--", lw=1, label=f"tolerance {r['tolerance']:.0%} of A")
-    _mark_window(ax, result)
+    ax.axhline(r["tolerance"], color="#b00", ls="--", lw=1, label=f"tolerance {r['tolerance']:.0%} of the scale")
+    _mark_parting(ax, result)
     ax.set_yscale("log")
     ax.set_xlabel("t (s)")
-    ax.set_ylabel("RMS difference / A")
+    ax.set_ylabel("RMS difference / scale")
     ax.set_title(f"The reference against its check ({r['reference_fps']} and {r['check_fps']} fps), RMS over "
                  f"{r['window_s']:.3g} s")
     ax.legend(loc="best")
@@ -157,64 +222,80 @@ def _draw_reference(result) -> Figure:
     return figure
 
 
-def _mark_window(ax, result) -> None:
-    for i, (start, end) in enumerate(result.reference["not_held"]):
-        ax.axvspan(start, end, color="#f3d6d6", alpha=0.6, label="reference does not hold" if i == 0 else None)
+def _mark_parting(ax, result) -> None:
+    parted_at = result.reference["parted_at"]
+    if parted_at is not None:
+        ax.axvspan(parted_at, result.duration_s, color="#f3d6d6", alpha=0.6, label="reference not held")
 
 
 def draw(result, out_dir: Path) -> list[Path]:
-    """The figures, as PNG beside the page: one per quantity, and the reference's check."""
+    """The figures, as PNG beside the page: each deciding quantity across frame rates (at most FIGURE_QUANTITIES),
+    and the reference's check."""
     import matplotlib
 
     paths = []
     with matplotlib.rc_context(figures.STYLE):
-        for i, q in enumerate(result.quantities):
-            paths += figures.save(_draw_quantity(result, q), out_dir, f"audit_{i}_{q}", formats=("png",))
+        for i, q in enumerate(result.deciding[:FIGURE_QUANTITIES]):
+            paths += figures.save(_draw_across(result, q), out_dir, f"audit_{i}_{q}", formats=("png",))
         paths += figures.save(_draw_reference(result), out_dir, "audit_reference", formats=("png",))
     return paths
 
 
 def page(result, out_dir: Path, command: str) -> str:
     paths = draw(result, Path(out_dir))
+    across, reference_figure = paths[:-1], paths[-1]
     claims = "".join(f"<li>{html.escape(c['text'])} <a href='#{c['table']}'>({c['table']} table)</a></li>"
                      for c in result.claims)
-    first = result.runs_per_variant[0]
     runs_text = ", ".join(f"{p} seed {s}" for p, s in result.runs_per_variant)
+    left, right = _shown_pair(result)
+    usable = result.reference["usable"]
     parts = [
         f"<h1>steadystep audit: {html.escape(result.program)}</h1>",
         f"<p>The program ran {result.duration_s:g} s under {html.escape(runs_text)}, as each of "
-        f"{html.escape(', '.join('own stepping' if v == OWN else v for v in result.variants))}"
+        f"{html.escape(', '.join(_label(v) for v in result.variants))}"
         + (f" (own stepping: {html.escape(result.own)})" if result.own else "")
-        + ", against a fine-step reference checked at a finer step (docs/audit.md).</p>",
+        + ", each run a process of its own, against a fine-step reference checked at a finer step "
+        "(docs/audit.md).</p>",
         "<section id='recommendation'><h2>Recommendation for this program</h2>"
         "<p class=small>Every line is computed from the tables below (metrics.json holds them and these claims) "
-        "and links to its table.</p>"
+        "and links to its table. A value is better than another only beyond the noise of their difference.</p>"
         f"<ul class='answers'>{claims}</ul>{_code(result)}</section>",
-        "<h2>Spread across frame rates</h2>", _by_quantity(result, result.spread, "spread"),
-        f"<p class=small>Spread: each run after the first ({html.escape(first[0])} seed {first[1]}) against the "
-        "first of the same variant on the first's times, RMS over runs and time, divided by the reference's range A "
-        "(max − min). Window: the times where the reference holds (below). Bold: the smallest of a column; failed: a "
-        "run of that variant failed.</p>",
-        "<h2>Deviation from the fine-step reference</h2>", _by_quantity(result, result.deviation, "deviation"),
-        "<p class=small>Deviation: every run of the variant against the reference on the reference's times, RMS "
-        "over runs and time, divided by A.</p>",
-        "<h2>The reference, checked</h2>", _reference_table(result),
-        "<p class=small>The reference (implicit-euler, one step per frame of "
-        f"1/{result.reference['reference_fps']} s) against the same at 1/{result.reference['check_fps']} s: the "
-        "RMS of their difference over a moving window, divided by A. Where it exceeds the tolerance, the two "
-        "fine-step runs part, and so would any two runs: the window ends there.</p>",
+        f"<h2>{html.escape(_label(left))} and {html.escape(_label(right))} at every audited frame rate</h2>",
+        "<p class=small>Each deciding quantity in every profile run: the closer the curves of one panel, the less "
+        "that stepping depends on the frame rate.</p>",
+        *[_embed(p) for p in across],
+        "<h2>Spread across frame rates (whole run)</h2>", _values_table(result, result.spread, result.spread_error,
+                                                                        "spread"),
+        f"<p class=small>Spread: each run after the first ({html.escape(result.runs_per_variant[0][0])}) against "
+        "the first of the same variant, at the simulated times the two share when they share most of them (runs "
+        "identical there score exactly 0), else interpolated onto the first's times; RMS over time, then over runs, "
+        "divided by the quantity's scale; ± its standard error over the runs. Over the whole run, whatever the "
+        "reference does. Bold: the smallest of a column.</p>",
+        "<h2>Deviation from the fine-step reference</h2>",
+        _values_table(result, result.deviation["window"], result.deviation_error, "deviation"),
+        "<p class=small>" + ("Deviation: every run against the reference interpolated at the run's own times, "
+                             "while the reference holds; RMS over time, then over runs, divided by the scale."
+                             if usable else "Not claimed: the reference is not usable (see below); shown for "
+                             "completeness.") + " Over the whole run:</p>",
+        _whole_deviation_table(result),
+        "<h2>Where the dependence comes from</h2>", _diagnosis_table(result),
+        "<h2>The reference, checked</h2>", _reference_table(result), _embed(reference_figure),
         "<h2>Steps per frame and cost</h2>", _cost_table(result),
-        "<p class=small>Steps per frame from the program's steps column (- when it prints none). CPU time: the "
-        "whole process of an executable (start-up and CSV included), the stepping loop of a Python program.</p>"]
+        "<p class=small>Instructions: counted by valgrind over the whole process (start-up included, the same for "
+        "every variant). CPU time: the whole process of an executable, the stepping loop of a Python program.</p>"]
     if result.served:
         parts += ["<h2>What each mapping served</h2>", _served_table(result),
                   "<p class=small>Row-steps (every bound row counted once per physics step) and contacts, summed "
                   "over the variant's runs, from the program's optional columns.</p>"]
-    parts += ["<h2>Every run</h2>", _runs_table(result), "<h2>Figures</h2>"]
-    parts += [_embed(p) for p in paths]
-    parts += ["<h2>Regenerate</h2>", f"<pre>{html.escape(command)}</pre>",
+    if result.not_measured:
+        parts += ["<p class=small>" + html.escape("Not measured: " + "; ".join(
+            f"{v}: {why}" for v, why in result.not_measured.items())) + "</p>"]
+    parts += ["<h2>Every run</h2>", _runs_table(result),
+              "<h2>Regenerate</h2>", f"<pre>{html.escape(command)}</pre>",
               f"<p class=small>Made in {result.elapsed_s:.1f} s on {html.escape(platform.node())}, "
-              f"{time.strftime('%Y-%m-%d %H:%M:%S %Z')}.</p>"]
+              f"{time.strftime('%Y-%m-%d %H:%M:%S %Z')}"
+              + (f"; {result.reused_runs} finished runs kept from an interrupted audit" if result.reused_runs else "")
+              + ".</p>"]
     return _PAGE.format(title=html.escape(f"steadystep audit: {result.program}"), body="\n".join(parts))
 
 

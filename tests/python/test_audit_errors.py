@@ -80,7 +80,7 @@ def test_usage_errors(tmp_path):
     good = script(tmp_path, "good", GOOD)
     refused(audit("--out", tmp_path / "out", *QUICK), "PROGRAM", "--python")
     refused(audit("--python", tmp_path / "x.py", "--own", good, "--out", tmp_path / "out", *QUICK), "--own",
-            "no own stepping")
+            "own_frame")
     refused(audit(good, "--out", tmp_path / "out", "--profiles", "uniform:45:15"), "uniform:45:15")
     refused(audit(good, "--out", tmp_path / "out", "--policies", "sideways"), "sideways")
     refused(audit(good, "--out", tmp_path / "out", "--duration", "-1"), "-1")
