@@ -139,6 +139,7 @@ static void resolveSpeeds(ssStepping* stepping) {
 
 static ssStatus listSpaces(ssStepper* stepper, ssPointerSet* live);
 static ssStatus refreshKnown(ssStepper* stepper);
+static int knownListDue(const ssStepper* stepper);
 
 ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   ssStatus status = ssCheckOdePrecision();
@@ -243,6 +244,15 @@ ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body) {
   return SS_OK;
 }
 
+/* Whether a body would stay known without its watch: bound in the registry, or joined (not by a contact) to
+ * another body. */
+static int bodyKnownOtherwise(const ssStepper* stepper, dBodyID body) {
+  if (stepper->def.registry != NULL && ssRegistryHasBody(stepper->def.registry, body)) return 1;
+  for (int i = 0, count = dBodyGetNumJoints(body); i < count; ++i)
+    if (dJointGetType(dBodyGetJoint(body, i)) != dJointTypeContact) return 1;
+  return 0;
+}
+
 ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body) {
   REQUIRE_STEPPER(stepper);
   if (body == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "body = NULL: a body is required");
@@ -250,9 +260,10 @@ ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body) {
     if (stepper->watched[i] != body) continue;
     stepper->watched[i] = stepper->watched[--stepper->watched_count];
     stepper->watched_generation += 1;
-    /* the program may destroy it next, in a callback too: the known list and the pose history forget it now (a body
-     * still known otherwise is listed again, and starts its history again, at the next look) */
-    ssKnownForget(&stepper->known, body);
+    /* the program may destroy it next, in a callback too: a body known through the watch alone leaves the known
+     * list and the pose history now. One bound or joined to others stays listed (the list must hold every body whose
+     * joints tell what the program destroyed); the pose history starts it again at the next frame. */
+    if (!bodyKnownOtherwise(stepper, body)) ssKnownForget(&stepper->known, body);
     ssPoseHistoryForgetBody(stepper->poses, body);
     return SS_OK;
   }
@@ -380,14 +391,23 @@ ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID 
 
 /* ---- the bodies the stepper knows ---- */
 
-/* The known list, rebuilt when the registry's bindings or the watch list changed since it was built. */
+/* Whether the known list is to be built again (refreshKnown): the registry's bindings or the watch list changed
+ * since it was built, or a body's joints did. Building it reads every bound joint: what the program destroyed is
+ * forgotten first (forgetDestroyed). */
+static int knownListDue(const ssStepper* stepper) {
+  const ssRegistry* registry = stepper->def.registry;
+  unsigned generation = registry != NULL ? ssRegistryGeneration(registry) : 0;
+  const ssKnownBodies* known = &stepper->known;
+  return !known->valid || stepper->relist_due || known->registry_generation != generation ||
+         known->watched_generation != stepper->watched_generation;
+}
+
+/* The known list, built again when it is due (knownListDue). */
 static ssStatus refreshKnown(ssStepper* stepper) {
   const ssRegistry* registry = stepper->def.registry;
   unsigned generation = registry != NULL ? ssRegistryGeneration(registry) : 0;
   ssKnownBodies* known = &stepper->known;
-  if (known->valid && !stepper->relist_due && known->registry_generation == generation &&
-      known->watched_generation == stepper->watched_generation)
-    return SS_OK;
+  if (!knownListDue(stepper)) return SS_OK;
   stepper->relist_due = 0;
   ssStatus status = ssKnownRebuild(known, registry, stepper->watched, stepper->watched_count);
   if (status != SS_OK) return status;
@@ -534,10 +554,8 @@ static ssStatus forgetDestroyed(ssStepper* stepper, int look_at_joints) {
     stepper->adopt_anchored_due = 1;
   }
   ssRegistry* registry = stepper->def.registry;
-  int rebuild_due = !stepper->known.valid || (registry != NULL && stepper->known.registry_generation !=
-                                                                       ssRegistryGeneration(registry));
-  if (registry == NULL || !(forgot > 0 || ((look_at_joints || rebuild_due) && ssKnownJointsChanged(&stepper->known,
-                                                                                                     NULL))))
+  if (registry == NULL || !(forgot > 0 || ((look_at_joints || knownListDue(stepper)) &&
+                                           ssKnownJointsChanged(&stepper->known, NULL))))
     return SS_OK;
   ssPointerSet alive = {NULL, 0, 0};
   ssStatus status = ssKnownCollectJoints(&stepper->known, &alive);
