@@ -179,6 +179,8 @@ def reference_sanity(reference: dict, runs: list[dict], quantities: list[str]) -
     where no run goes). Returns {"sane": bool, "unphysical": [{quantity, rate, runs_rate, at_s, reached, low,
     high}]}."""
     found = []
+    if not runs:  # nothing to hold it against
+        return {"sane": True, "unphysical": found}
     t_ref, ref = by_time(reference)
     for q in quantities:
         runs_rate = max((float(np.max(_rate(r, q))) for r in runs), default=0.0)

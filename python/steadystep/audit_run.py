@@ -424,8 +424,11 @@ def _quoted(stderr: str) -> str:
 # ---- the process -------------------------------------------------------------------------------------------------
 
 def _limits(cpu_s: float, output_bytes: int) -> Callable[[], None]:
+    parent = os.getpid()
+
     def limit() -> None:
-        """In the child, before exec: its CPU time and file size bounded, killed when its parent dies (Linux)."""
+        """In the child, before exec: its CPU time and file size bounded, killed when its parent dies (Linux), or
+        gone at once when the parent died before that was set."""
         seconds = max(1, int(cpu_s + 0.999))
         resource.setrlimit(resource.RLIMIT_CPU, (seconds, seconds + 2))
         resource.setrlimit(resource.RLIMIT_FSIZE, (output_bytes, output_bytes))
@@ -433,6 +436,8 @@ def _limits(cpu_s: float, output_bytes: int) -> Callable[[], None]:
 
         with contextlib.suppress(OSError, AttributeError):
             ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+        if os.getppid() != parent:
+            os._exit(1)
 
     return limit
 
@@ -498,7 +503,9 @@ def _kill_leftovers(before: set[int], group: int) -> None:
 
 def run_process(command: list[str], env: dict | None, limit_s: float, output_bytes: int, shown: str):
     """Runs command with stdin empty and stdout and stderr to files, bounded (the module's docstring). Returns
-    (wait status, resource usage, stdout, stderr, wall seconds); BadProgram when it cannot start or hangs."""
+    (wait status, resource usage, stdout, stderr, wall seconds); BadProgram when it cannot start, hangs or writes past
+    output_bytes. This process becomes a subreaper (PR_SET_CHILD_SUBREAPER) on the first call: orphans of what it
+    runs become its children, and those born during a run are killed when it ends."""
     _become_subreaper()
     before = _children()
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
