@@ -47,12 +47,14 @@ static ssStatus followRows(ssRegistry* registry, double step_s, FollowedRow** ou
   int capacity = 0;
   for (int i = 0; i < registry->joint_count; ++i) {
     const JointBinding* binding = &registry->joints[i];
-    if (binding->writer.set == NULL) continue; /* plane-2D: ODE cannot read it back */
+    /* the row's getter, with the numbers its writer resolved at binding: no lookup of the joint's type */
+    ssParamGetter get = binding->writer.set != NULL ? ssRowGetterOfType(binding->joint_type) : NULL;
+    if (get == NULL) continue; /* plane-2D: ODE cannot read it back */
     ssSoftness written = writtenOf(registry, binding);
     if (isnan(written.cfm)) continue;
-    double erp, cfm;
-    ssJointReadSoftness(binding->joint, binding->param, binding->axis, &erp, &cfm);
     int has_erp = binding->writer.erp_number >= 0;
+    double cfm = get(binding->joint, binding->writer.cfm_number);
+    double erp = has_erp ? get(binding->joint, binding->writer.erp_number) : 0;
     if (ssSameInOde(cfm, written.cfm) && (!has_erp || ssSameInOde(erp, written.erp))) continue;
     /* a motor row (no erp) stands for a damper: its law is read with erp 0, as adoption reads it */
     ssSoftness held = {has_erp ? erp : 0, cfm};

@@ -142,6 +142,26 @@ static double getParam(dJointID joint, int axis, int param) {
   }
 }
 
+ssParamGetter ssRowGetterOfType(int joint_type) {
+  switch (joint_type) {
+    case dJointTypeBall: return dJointGetBallParam;
+    case dJointTypeFixed: return dJointGetFixedParam;
+    case dJointTypeDBall: return dJointGetDBallParam;
+    case dJointTypeDHinge: return dJointGetDHingeParam;
+    case dJointTypeTransmission: return dJointGetTransmissionParam;
+    case dJointTypeHinge: return dJointGetHingeParam;
+    case dJointTypeSlider: return dJointGetSliderParam;
+    case dJointTypeUniversal: return dJointGetUniversalParam;
+    case dJointTypeHinge2: return dJointGetHinge2Param;
+    case dJointTypePR: return dJointGetPRParam;
+    case dJointTypePU: return dJointGetPUParam;
+    case dJointTypePiston: return dJointGetPistonParam;
+    case dJointTypeAMotor: return dJointGetAMotorParam;
+    case dJointTypeLMotor: return dJointGetLMotorParam;
+    default: return NULL;
+  }
+}
+
 void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* erp, double* cfm) {
   int erp_param, cfm_param;
   if (!softnessParams(param, &erp_param, &cfm_param)) {

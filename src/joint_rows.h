@@ -33,6 +33,11 @@ static inline void ssRowWrite(const ssRowWriter* writer, dJointID joint, double 
   writer->set(joint, writer->cfm_number, cfm);
 }
 
+/* ODE's getter for a joint type's parameters, taking the numbers of the type's ssRowWriter; NULL for plane-2D, whose
+ * parameters ODE 0.16 cannot read back, and for types without soft parameters. */
+typedef dReal (*ssParamGetter)(dJointID joint, int parameter);
+ssParamGetter ssRowGetterOfType(int joint_type);
+
 /* Reads the row's softness as ODE holds it (MOTOR rows: erp 0 and the motor's cfm). NAN for plane-2D, which ODE 0.16
  * cannot read back. */
 void ssJointReadSoftness(dJointID joint, ssJointParam param, int axis, double* erp, double* cfm);

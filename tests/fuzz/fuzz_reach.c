@@ -296,6 +296,27 @@ static void repair(Program* p) {
     else ++s;
 }
 
+/* A bob left hanging from nothing a space holds is unknowable (stepper.h: what nothing reaches, it cannot see), so
+ * the program takes it down with what it hung from, as a game removes a whole entity: through the stepper, which
+ * knew it. */
+static void removeOrphans(Program* p) {
+  int reached[MAX_BODIES] = {0};
+  for (int i = 0; i < p->body_count; ++i) reached[i] = p->bodies[i].geom != 0 || p->bodies[i].watched;
+  for (int changed = 1; changed;) {
+    changed = 0;
+    for (int j = 0; j < p->joint_count; ++j) {
+      dBodyID a = dJointGetBody(p->joints[j], 0), b = dJointGetBody(p->joints[j], 1);
+      for (int k = 0; k < p->body_count; ++k)
+        for (int l = 0; l < p->body_count; ++l)
+          if (reached[k] && !reached[l] && ((p->bodies[k].body == a && p->bodies[l].body == b) ||
+                                            (p->bodies[k].body == b && p->bodies[l].body == a)))
+            reached[l] = changed = 1;
+    }
+  }
+  for (int i = p->body_count - 1; i >= 0; --i)
+    if (!reached[i]) destroyThroughStepper(p, i);
+}
+
 /* ---- operations ---- */
 
 static const double kFrames[] = {0, 1.0 / 144, 1.0 / 60, 1.0 / 59, 1.0 / 30, 0.05, 1.0 / 15};
@@ -388,6 +409,7 @@ static void operate(Program* p, int code, FuzzInput* in, int inside) {
       break;
     default: break;
   }
+  if (code == 2 || code == 3 || code == 4 || code == 11) removeOrphans(p);
 }
 
 /* The program's collision: contacts softened for the step; one the stepper refuses (not finite) is dropped. */
