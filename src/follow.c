@@ -22,12 +22,6 @@ typedef struct FollowedRow {
   ssRowLaw law;
 } FollowedRow;
 
-/* The step the program's values are taken as tuned for: adoption's, or (springs bound by hand, no adoption) the
- * step the registry last wrote them for. 0: none yet, nothing to compare with. */
-static double meantFor(const ssRegistry* registry) {
-  if (registry->tuned_step_s > 0) return registry->tuned_step_s;
-  return isfinite(registry->applied_step_s) ? registry->applied_step_s : 0;
-}
 
 /* What the binding holds in ODE as the registry wrote it (NAN: nothing written since it was bound). */
 static ssSoftness writtenOf(const ssRegistry* registry, const JointBinding* binding) {
@@ -47,6 +41,7 @@ static ssStatus followRows(ssRegistry* registry, double step_s, FollowedRow** ou
   int capacity = 0;
   for (int i = 0; i < registry->joint_count; ++i) {
     const JointBinding* binding = &registry->joints[i];
+    if (binding->law.tuned_step_s == 0) continue; /* a spring the program bound itself: it binds another the same way */
     /* the row's getter, with the numbers its writer resolved at binding: no lookup of the joint's type */
     ssParamGetter get = binding->writer.set != NULL ? ssRowGetterOfType(binding->joint_type) : NULL;
     if (get == NULL) continue; /* plane-2D: ODE cannot read it back */
@@ -99,14 +94,14 @@ static int bodyAsWritten(const ssRegistry* registry, const ssBodyBinding* bindin
 
 ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
   if (followed != NULL) *followed = 0;
-  double step_s = meantFor(registry);
+  double step_s = registry->tuned_step_s; /* what adopted numbers mean; nothing adopted, nothing to follow */
   if (step_s == 0) return SS_OK;
   dWorldID world = registry->world;
   /* the world's rows */
   int world_followed = 0;
   ssRowLaw world_law;
   ssSoftness world_held = {dWorldGetERP(world), dWorldGetCFM(world)};
-  if (registry->world_bound && !isnan(registry->world_written.cfm) &&
+  if (registry->world_bound && registry->world_law.tuned_step_s > 0 && !isnan(registry->world_written.cfm) &&
       (!ssSameInOde(world_held.erp, registry->world_written.erp) ||
        !ssSameInOde(world_held.cfm, registry->world_written.cfm))) {
     ssStatus status = lawOfWritten("world ERP/CFM, as the program wrote them,", world_held, step_s, &world_law);
@@ -123,7 +118,8 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
   int body_count = 0;
   for (int i = 0; i < registry->body_count && status == SS_OK; ++i) {
     const ssBodyBinding* binding = &registry->bodies[i];
-    if (isnan(binding->written_step_s) || bodyAsWritten(registry, binding)) continue;
+    int adopted = binding->tuned.damping_step_s > 0 || binding->tuned.auto_disable_step_s > 0;
+    if (!adopted || isnan(binding->written_step_s) || bodyAsWritten(registry, binding)) continue;
     ssBodyBinding* larger_bodies = realloc(bodies, (size_t)(body_count + 1) * sizeof *bodies);
     int* larger_at = realloc(body_at, (size_t)(body_count + 1) * sizeof *body_at);
     if (larger_bodies != NULL) bodies = larger_bodies;

@@ -44,11 +44,11 @@ typedef struct ssBodyWritten {
 } ssBodyWritten;
 void ssBodyWrittenFor(const ssBodyBinding* binding, double step_s, ssBodyWritten* out);
 
-/* The program stays in charge (follow.c): every value the registry writes for each step (the world's ERP/CFM, each
- * bound joint row, each body's damping and auto-disable) that ODE holds otherwise than the registry last wrote it
- * was written by the program since, and is taken as newly tuned at the registry's tuned step (or, without adoption,
- * at the step it was last written for): bound again as what it stands for, so that every step length writes what
- * the program's value means. *followed (may be NULL) counts the values taken. Nothing is changed on an error.
+/* The program stays in charge (follow.c): every adopted value the registry writes for each step (the world's
+ * ERP/CFM, each joint row, each body's damping and auto-disable, as adoption read them or as followed since) that ODE
+ * holds otherwise than the registry last wrote it was written by the program since, and is taken as newly tuned at
+ * the registry's tuned step: bound again as what it stands for, so that every step length writes what the program's
+ * value means. A spring the program bound itself (ssRegistry_BindJoint, ...) it changes by binding again: not read. *followed (may be NULL) counts the values taken. Nothing is changed on an error.
  * Errors, naming the value: those of adoption for a value no spring stands for (erp outside [0, 1], cfm < 0, a
  * damping scale outside [0, 1), ...), SS_ERROR_NO_FINITE_MAPPING. */
 ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed);

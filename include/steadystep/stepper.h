@@ -71,9 +71,10 @@
  *
  * The program's own writes. A program may go on setting what it tuned (world ERP/CFM, a joint's parameters, a body's
  * damping or auto-disable) after adoption, from its settings or its entities. Before each frame, and before each
- * step that follows a callback, the stepper compares every value it rewrites for each step with what it last wrote:
- * one that differs was the program's, and is taken as newly tuned at the tuned step (as adoption took the first),
- * so that every step length gets what the program's value means. report->program_writes counts them. A value no
+ * step that follows a callback, the stepper compares every adopted value it rewrites for each step with what it last
+ * wrote: one that differs was the program's, and is taken as newly tuned at the tuned step (as adoption took the
+ * first), so that every step length gets what the program's value means. (A spring bound by hand with the registry
+ * is changed by binding it again: its rows are not read.) report->program_writes counts them. A value no
  * spring stands for (an erp outside [0, 1], a cfm below 0, a damping scale of 1) refuses the frame by name, with
  * nothing stepped, until the program sets another.
  *
