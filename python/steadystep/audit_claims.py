@@ -62,7 +62,15 @@ class Tables:
     def deviation(self, variant: str) -> tuple[float, str | None]:
         return largest(self.result.deviation["window"], variant, self.deciding)
 
+    def exact_zero(self, variant: str, quantity: str | None) -> bool:
+        """Whether the variant's spread in quantity is an exact 0: every run identical to the first at every
+        compared time, in a program that repeats itself exactly (no noise to it: any positive value is beyond)."""
+        runs = self.result.spread_runs[variant].get(quantity) if quantity else None
+        return bool(runs) and all(x == 0 for x in runs) and self.repeat[quantity] == 0
+
     def spread_noise(self, a: str, qa: str | None, b: str, qb: str | None) -> float:
+        if self.exact_zero(a, qa) or self.exact_zero(b, qb):
+            return 0.0
         error = self.result.spread_error
         return measure_.noise(error[a][qa] if qa else 0.0, error[b][qb] if qb else 0.0,
                               max(self.repeat[q] for q in (qa, qb) if q) if (qa or qb) else 0.0)

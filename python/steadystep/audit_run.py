@@ -243,15 +243,15 @@ def _flags(variant: str, profile: str, seed: int, duration_s: float) -> list[str
 
 
 def supports(program, variant: str) -> bool:
-    """Whether the program takes a diagnosis variant's flag: a run of one frame with it, refused with exit 2 (an
-    unknown flag) or not. A Python program always does."""
+    """Whether the program takes a diagnosis variant's flag: a run of one frame with it ends with exit 0 or 1 (a
+    refusal, exit 2, or anything else, says it does not). A Python program always does."""
     if isinstance(program, PythonProgram) or variant not in DIAGNOSIS_FLAGS:
         return True
     command = program.command_line(variant, "fixed:60", 1, 1.0 / 60)
     with tempfile.TemporaryDirectory(prefix="steadystep-audit-") as scratch:
         env = _frames_env(Path(scratch), "fixed:60", 1, 1.0 / 60)
         status, *_ = run_process(command, env, program.time_limit_s, OUTPUT_BYTES_SLACK, shlex.join(command))
-    return not (os.WIFEXITED(status) and os.WEXITSTATUS(status) == 2)
+    return os.WIFEXITED(status) and os.WEXITSTATUS(status) in (0, 1)
 
 
 @dataclass

@@ -72,7 +72,14 @@ class Reader:
         repeat = max((self.repeat[q] for q in quantities), default=0.0)
         return self.sigmas * math.hypot(ea, eb) + 2 * repeat + extra
 
+    def exact_zero(self, v, q) -> bool:
+        """docs/audit.md: every run identical to the first (all per-run values 0) in a program that repeats itself."""
+        runs = self.m["spread_runs"][v].get(q) if q else None
+        return bool(runs) and all(x == 0 for x in runs) and self.repeat[q] == 0
+
     def spread_noise(self, a, qa, b, qb):
+        if self.exact_zero(a, qa) or self.exact_zero(b, qb):
+            return 0.0
         return self._noise(self.m["spread_error"], a, qa, b, qb)
 
     def deviation_noise(self, a, qa, b, qb):
