@@ -1,7 +1,8 @@
 # The audit's test programs (tests/audit_programs/*.c), linked to the core alone: STEADYSTEP_AUDIT_PROGRAMS_CORE
 # (default the project's steadystep target; tests/audit_programs/CMakeLists.txt sets the installed one). Each is
 # built as steadystep_audit_<name>; ctest checks each one's protocol header and t = 0 row, and that it refuses a
-# bad flag with exit 2.
+# bad flag with exit 2. protocol_cxx.cpp uses the header from C++: the frames it reads from STEADYSTEP_AUDIT_FRAMES
+# (frames.txt: 0.25 and 0.5 s, repeated) and from fixed:FPS, and a random profile refused by name without them.
 if(NOT DEFINED STEADYSTEP_AUDIT_PROGRAMS_CORE)
   set(STEADYSTEP_AUDIT_PROGRAMS_CORE steadystep)
 endif()
@@ -20,3 +21,20 @@ foreach(name box_stack ragdoll maze hopper)
                          "${name}: --policy sideways: [^\n]*\nexit 2\n")
   endif()
 endforeach()
+
+add_executable(steadystep_audit_protocol_cxx ${STEADYSTEP_AUDIT_PROGRAMS_DIR}/protocol_cxx.cpp)
+target_link_libraries(steadystep_audit_protocol_cxx PRIVATE ${STEADYSTEP_AUDIT_PROGRAMS_CORE} m)
+if(BUILD_TESTING OR STEADYSTEP_TESTS)
+  add_test(NAME audit_protocol_frames_file
+           COMMAND ${CMAKE_COMMAND} -E env STEADYSTEP_AUDIT_FRAMES=${STEADYSTEP_AUDIT_PROGRAMS_DIR}/frames.txt
+                   $<TARGET_FILE:steadystep_audit_protocol_cxx> --profile uniform:15:45 --seed 3 --duration 1.2
+                   --policy fixed)
+  set_tests_properties(audit_protocol_frames_file PROPERTIES PASS_REGULAR_EXPRESSION
+                       "^t_s,frame_s\n0,0\n0\.25,0\.25\n0\.75,0\.5\n1,0\.25\n1\.2,0\.19[0-9]*\n$")
+  add_test(NAME audit_protocol_fixed COMMAND steadystep_audit_protocol_cxx --profile fixed:4 --duration 0.5)
+  set_tests_properties(audit_protocol_fixed PROPERTIES PASS_REGULAR_EXPRESSION "^t_s,frame_s\n0,0\n0\.25,0\.25\n0\.5,0\.25\n$")
+  add_test(NAME audit_protocol_random_refused
+           COMMAND sh -c "\"$1\" --profile uniform:15:45 2>&1; echo exit $?" sh $<TARGET_FILE:steadystep_audit_protocol_cxx>)
+  set_tests_properties(audit_protocol_random_refused PROPERTIES PASS_REGULAR_EXPRESSION
+                       "protocol_cxx: --profile uniform:15:45: without the lab[^\n]*STEADYSTEP_AUDIT_FRAMES[^\n]*\nexit 2\n")
+endif()
