@@ -320,7 +320,7 @@ REPORT_FILES = ("report.html", "index.html", "metrics.json", "metrics.csv")
 
 def _compare(args, argv) -> int:
     _require_report_extra("compare")
-    from steadystep import report
+    from steadystep import report, report_progress
     from steadystep.figures import article_figure
 
     grid = {axis: values for axis, values in (("stiffness", args.stiffness), ("damping", args.damping),
@@ -335,8 +335,10 @@ def _compare(args, argv) -> int:
         args.out.mkdir(parents=True, exist_ok=True)
         result = report.compare(args.scenes, args.profiles, args.policies, args.duration, args.seed,
                                 figure_dir=args.out, executor=executor, grid=grid)
-    article_paths = article_figure(args.out, args.duration, args.seed)
-    path = report.write(result, args.out, _command_line(argv), article_paths)
+    with report_progress.step("steadystep compare [article's figure]"):
+        article_paths = article_figure(args.out, args.duration, args.seed)
+    with report_progress.step("steadystep compare [page]"):
+        path = report.write(result, args.out, _command_line(argv), article_paths)
     _say(str(path))
     return 0
 

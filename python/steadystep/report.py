@@ -28,12 +28,13 @@ __all__ = ["CSV_COLUMNS", "GRID_AXES", "NOT_PROBED", "REPORT_PARAMS", "Report", 
 
 
 def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: float = 5.0, seed: int = 1,
-            params: dict | None = None, progress: bool | None = None, figure_dir: Path | None = None,
+            params: dict | None = None, progress: bool | str | None = None, figure_dir: Path | None = None,
             executor=None, grid: dict | None = None) -> Report:
     """Runs every scene under every profile and policy, plus each scene's reference, and measures them.
 
-    params: per scene changes to its parameters (default REPORT_PARAMS). progress: tqdm bars on stderr naming the
-    phase (None: only on a terminal). figure_dir: where to write the figures (None: none drawn). executor: where
+    params: per scene changes to its parameters (default REPORT_PARAMS). progress: on stderr, naming the phase:
+    None, tqdm bars on a terminal and lines off one (a line at least every 10 s with an estimate: report_progress);
+    "lines", lines anyway; True, tqdm bars; False, nothing. figure_dir: where to write the figures (None: none drawn). executor: where
     the independent runs, probes, the animation and the figures go, any concurrent.futures.Executor or a name for
     study.make_executor ("local", "dask", ...); None: in this process. The numbers do not depend on it, only the
     wall times do; the cost benchmark always runs here, alone, after them (report_tasks). grid: values per axis of

@@ -11,6 +11,8 @@ benchmark, a scene's figures), run wherever the executor puts it. The phases, ea
    returns the files' bytes; they are written here, on this machine, whatever executor drew them);
 3. cost: the benchmark times its plans in this process once every unit is done, so that its timings are taken
    while nothing else of the study runs; the aggregation and the page do not wait for anything else.
+
+Off a terminal every phase writes its progress as lines (report_progress): at least one every 10 s, with an estimate.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from steadystep import animation, cost, probe, runs, study
+from steadystep import animation, cost, probe, report_progress, runs, study
 from steadystep.files import write_output_bytes
 from steadystep.profiles import frame_times
 from steadystep.report_aggregate import deviation, exact_curve
@@ -154,7 +156,7 @@ def run_phases(report, units: dict[tuple, dict], executor, progress: bool | None
     waiting = {scene: _figures_needed(report, scene) for scene in report.scenes} if figure_dir is not None else {}
     total = len(units) + sum(_figure_count(scene) for scene in waiting)
     done: dict[tuple, object] = {}
-    with study.progress_bar(total, progress, "steadystep compare [runs]", "unit") as bar:
+    with report_progress.bar(total, progress, "steadystep compare [runs]", "unit") as bar:
         def finished(key, task, result):
             done[key] = result
             bar.set_postfix_str(label(task), refresh=False)
@@ -208,8 +210,9 @@ def run_phases(report, units: dict[tuple, dict], executor, progress: bool | None
                     if not runs_s and len(done) == len(units):
                         runs_s = time.perf_counter() - started
                     running = {"runs" if what == "unit" else "figures" for what, _ in in_flight.values()}
-                    bar.set_description_str(f"steadystep compare [{', '.join(sorted(running, reverse=True))}]",
-                                            refresh=False)
+                    if running:  # (none once the last unit is back: the bar keeps the phase it ended in)
+                        bar.set_description_str(f"steadystep compare [{', '.join(sorted(running, reverse=True))}]",
+                                                refresh=False)
             finally:  # a failure or Ctrl-C: nothing more is started
                 for future in in_flight:
                     future.cancel()
@@ -224,7 +227,7 @@ def costs(report, done: dict, progress: bool | None) -> None:
     runs."""
     pairs = [(scene, policy) for scene in report.scenes for policy in report.policies[scene]]
     started = time.perf_counter()
-    with study.progress_bar(len(pairs), progress, "steadystep compare [cost against plain ODE]", "run") as bar:
+    with report_progress.bar(len(pairs), progress, "steadystep compare [cost against plain ODE]", "run") as bar:
         for scene, policy in pairs:
             report.costs.append(cost.time_plan(done["cost", scene, policy]))
             bar.set_postfix_str(f"{scene} {policy}", refresh=False)
