@@ -704,6 +704,21 @@ static ssStatus refuseStep(ssStepper* stepper, ssStatus status, int index) {
   return latch(stepper, status);
 }
 
+static int softenedContacts(const ssFrameReport* report) {
+  const ssServedCounts* c = &report->contacts;
+  return c->by_mapping + c->handed_to_matched + c->handed_to_implicit_euler;
+}
+
+/* Whether a contact joint is attached to a known body (ODE puts a new joint at the head of its body's list): asked
+ * only of a step whose collision softened nothing, to tell a program that forgot ssStepper_SoftenContact. */
+static int knownBodyTouches(const ssStepper* stepper) {
+  for (int k = 0; k < stepper->known.count; ++k) {
+    dJointID first = dBodyGetJoint(stepper->known.ids[k], 0);
+    if (first != 0 && dJointGetType(first) == dJointTypeContact) return 1;
+  }
+  return 0;
+}
+
 /* ODE's step, with its generator set to the stepping's seed for it and put back after it (stepping.step_seed). */
 static int odeStep(ssStepper* stepper, double step_s) {
   const ssStepping* stepping = &stepper->def.stepping;
@@ -759,7 +774,13 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
         ((status = refreshKnown(stepper)) != SS_OK ||
          (status = checkKnown(stepper, 0, "before the collision of", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
-    if (!stepper->destroy_requested && def->collide) def->collide(def->collide_context, stepper);
+    if (!stepper->destroy_requested && def->collide) {
+      int softened_before = softenedContacts(report);
+      def->collide(def->collide_context, stepper);
+      if (def->space != 0 && def->contact_group != 0 && softenedContacts(report) == softened_before &&
+          knownBodyTouches(stepper))
+        report->unsoftened_contact_steps += 1;
+    }
     if (stepper->destroy_requested) { /* the frame stops here: this step is not taken */
       if (def->contact_group) dJointGroupEmpty(def->contact_group);
       return SS_OK;

@@ -176,6 +176,9 @@ typedef struct ssFrameReport {
   ssServedCounts contacts;    /* contacts softened with ssStepper_SoftenContact, by who served them */
   int row_writes;             /* parameter sets written into ODE, summed over the frame's Applies (implicit Euler
                                * applies once a frame of equal substeps, and writes only what changed) */
+  int unsoftened_contact_steps; /* steps whose collision made contacts on known bodies but softened none with
+                                 * ssStepper_SoftenContact (a near callback that forgot it: those contacts keep the
+                                 * softness tuned for one step length); counted with def.space and def.contact_group */
   int program_writes;         /* values the program wrote into ODE since the stepper last looked (the world's
                                * ERP/CFM, a bound joint row, a body's damping or auto-disable), each taken as newly
                                * tuned at the tuned step (see "The program's own writes" at the top) */

@@ -497,6 +497,38 @@ TEST_F(PromiseTest, ABodyUnwatchedAndDestroyedInACallbackIsForgottenByThePoseHis
   EXPECT_EQ(ssStepper_InterpolatedPose(stepper, bob, position, quaternion), SS_ERROR_NOT_FOUND);
 }
 
+// A near callback that makes contacts but forgets ssStepper_SoftenContact is told, step by step, in the frame's
+// report: its contacts keep the softness tuned for one step length.
+TEST_F(PromiseTest, ContactsMadeButNotSoftenedAreCountedInTheReport) {
+  dWorldSetGravity(world, 0, 0, -9.81);
+  dCreatePlane(space, 0, 0, 1, 0);
+  Box(0, 0, 0.04);  // resting on the ground: contacts at every step
+  ssStepperDef def = Def();
+  def.collide = [](void* context, ssStepper*) {
+    auto* test = static_cast<PromiseTest*>(context);
+    dSpaceCollide(test->space, test, [](void* data, dGeomID a, dGeomID b) {  // the program's, without the line
+      auto* t = static_cast<PromiseTest*>(data);
+      dContact contact[4];
+      std::memset(contact, 0, sizeof contact);
+      int n = dCollide(a, b, 4, &contact[0].geom, sizeof contact[0]);
+      dBodyID b1 = dGeomGetBody(a), b2 = dGeomGetBody(b);
+      for (int i = 0; i < n; ++i)
+        dJointAttach(dJointCreateContact(dBodyGetWorld(b1 ? b1 : b2), t->contacts, &contact[i]), b1, b2);
+    });
+  };
+  ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+  ssFrameReport report;
+  ASSERT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_OK) << ssLastError();
+  EXPECT_EQ(report.steps, 3);
+  EXPECT_EQ(report.unsoftened_contact_steps, 3);
+  ssStepper_Destroy(stepper);
+  stepper = nullptr;
+  ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();  // the same world, its contacts softened
+  ASSERT_EQ(ssStepper_Step(stepper, 0.05, &report), SS_OK) << ssLastError();
+  EXPECT_GT(report.contacts.by_mapping, 0);
+  EXPECT_EQ(report.unsoftened_contact_steps, 0);
+}
+
 TEST_F(PromiseTest, SteppingAgainFromItsOwnCallbackIsRefusedByName) {
   Box(0, 0, 1);
   struct Reentry {
