@@ -16,7 +16,43 @@ from steadystep._native_ffi import ffi
 # The lab library: the core and the lab in one shared object (the core alone, libsteadystep, is for C programs).
 LIBRARY_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_native", "libsteadystep_lab.so")
 
-lib = ffi.dlopen(LIBRARY_PATH)
+
+
+class MissingLibrary(ImportError):
+    """A shared library the binding needs cannot be loaded: the message is one line naming it and the package
+    that provides it (Debian's libode8 for libode.so.8)."""
+
+
+def _missing_library_line(error: OSError) -> str:
+    text = " ".join(str(error).split())
+    reason = text.split("': ", 1)[-1]  # cffi: "cannot load library 'PATH': " and the loader's own words
+    if "libode.so" in text:
+        return ("steadystep: cannot load libode.so.8 (ODE 0.16, double precision), which the steadystep library "
+                f"links ({reason}): install Debian's libode8 (sudo apt-get install libode8; libode-dev to build)")
+    return (f"steadystep: cannot load the package's library {LIBRARY_PATH} ({reason}): reinstall the package "
+            "(pip install --force-reinstall steadystep, or scripts/deps.sh in the repository)")
+
+
+def _is_the_command() -> bool:
+    """Whether this process is the `steadystep` command (its console script, or python -m steadystep.cli, whose
+    argv[0] is "-m" while the package is imported)."""
+    import sys
+
+    return os.path.basename(sys.argv[0] if sys.argv else "") in ("steadystep", "cli.py", "-m")
+
+
+try:
+    lib = ffi.dlopen(LIBRARY_PATH)
+except OSError as _error:
+    _line = _missing_library_line(_error)
+    if _is_the_command():
+        # The command dies here, on importing the package, before its main() could catch anything: one line on
+        # stderr and exit 2 (a refusal), as every other thing the command cannot have.
+        import sys
+
+        print(_line, file=sys.stderr)
+        raise SystemExit(2) from None
+    raise MissingLibrary(_line) from None
 # The library reads and writes ODE's dReal: a libode of the other precision loaded in its place would step every
 # world wrongly without a word (ssCheckOdePrecision names both precisions).
 if lib.ssCheckOdePrecision() != 0:

@@ -279,14 +279,21 @@ def _first_non_finite(data, name: str = ""):
     return None
 
 
-REPORT_EXTRA = ("matplotlib", "tqdm")  # what figure and compare need beyond the core (pyproject's report extra)
+# What figure and compare need beyond the core: pyproject's report extra (jinja2 writes the page).
+REPORT_EXTRA = ("matplotlib", "tqdm", "jinja2")
 
 
-def _require_report_extra(command: str) -> None:
-    """Refuses the command in one line when the report extra is not installed."""
-    import importlib.util
+def _require_report_extra(command: str, modules: tuple[str, ...] = REPORT_EXTRA) -> None:
+    """Refuses the command in one line (exit 2) when a module of the report extra it needs cannot be imported,
+    naming it and the pip extra that provides it."""
+    import importlib
 
-    missing = [name for name in REPORT_EXTRA if importlib.util.find_spec(name) is None]
+    missing = []
+    for name in modules:
+        try:
+            importlib.import_module(name)
+        except ImportError:  # absent, or present and broken: either way the extra is what to install again
+            missing.append(name)
     if missing:
         raise _UsageError(f"steadystep {command}: needs the report extra, {' and '.join(missing)} not installed: "
                           "pip install 'steadystep[report]'")
@@ -305,7 +312,7 @@ def _executor(command: str, spec: str):
 
 
 def _figure(args, argv) -> int:
-    _require_report_extra("figure")
+    _require_report_extra("figure", ("matplotlib",))
     from steadystep.figures import article_figure
 
     args.out.mkdir(parents=True, exist_ok=True)

@@ -26,7 +26,8 @@ from steadystep import report
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 needs_chromium = pytest.mark.skipif(CHROMIUM is None and not os.environ.get("CI"),
-                                    reason="chromium not installed (scripts/deps.sh installs it; required in CI)")
+                                    reason="chromium not found on PATH: install Debian's chromium (sudo apt-get install "
+                                           "chromium; scripts/deps.sh does it; required in CI)")
 
 
 @pytest.fixture(scope="module")
@@ -40,7 +41,8 @@ def written(tmp_path_factory):
 
 
 def _chromium(*args: str, tmp_path) -> subprocess.CompletedProcess:
-    assert CHROMIUM is not None, "CI needs chromium (scripts/deps.sh installs it)"
+    assert CHROMIUM is not None, ("chromium not found on PATH: install Debian's chromium (sudo apt-get install "
+                                  "chromium; scripts/deps.sh does it)")
     command = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
                f"--user-data-dir={tmp_path / 'profile'}", *args]
     return subprocess.run(command, capture_output=True, text=True, timeout=180)
