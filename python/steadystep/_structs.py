@@ -33,7 +33,7 @@ class StructView:
     C_TYPE = ""
     FIELDS: tuple[str, ...] = ()
 
-    def __init_subclass__(cls, c_type: str = "", convert: dict | None = None, **kwargs):
+    def __init_subclass__(cls, c_type: str = "", convert: dict | None = None, docs: dict | None = None, **kwargs):
         super().__init_subclass__(**kwargs)
         if not c_type:
             return
@@ -41,7 +41,12 @@ class StructView:
         fields = ffi.typeof(c_type).fields
         cls.FIELDS = tuple(name for name, _ in fields)
         for name, field in fields:
-            setattr(cls, name, _field_property(name, field.type, (convert or {}).get(name)))
+            made = _field_property(name, field.type, (convert or {}).get(name))
+            # help(view) shows each field's meaning and unit (docs: as the header says it), not the getter's own
+            # docstring; a field the C struct gained and docs do not name still says where it is documented.
+            doc = (docs or {}).get(name, f"see {c_type} in the library's headers")
+            kind = "read-only" if name in (convert or {}) else f"{field.type.cname}, read-only"
+            setattr(cls, name, property(made.fget, doc=f"{name} ({kind}): {doc}"))
         _VIEWS[ffi.typeof(c_type).cname] = cls
 
     def __init__(self, *values, **named):
@@ -73,6 +78,7 @@ class StructView:
         return ffi.new(f"{cls.C_TYPE}*")
 
     def as_dict(self) -> dict:
+        """The fields as plain data by name, in the C order (nested views as dicts)."""
         return {name: _plain(getattr(self, name)) for name in self.FIELDS}
 
     def __eq__(self, other):

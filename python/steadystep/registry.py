@@ -22,7 +22,12 @@ from steadystep.convert import Spring
 from steadystep.enums import JointParam, Mapping, Status
 
 
-class ServedCounts(StructView, c_type="ssServedCounts"):
+class ServedCounts(StructView, c_type="ssServedCounts", docs={
+        "by_mapping": "served by the stepping's own mapping (every one under implicit Euler)",
+        "handed_to_matched": "exact only: served by matched (this step length gave exact no finite softness)",
+        "handed_to_implicit_euler": "matched/exact only: served by implicit Euler (above the step's Nyquist "
+                                    "frequency, undamped, no effective mass, a static load, no finite softness; "
+                                    "every contact)"}):
     """Who served the rows or contacts of a step, or of a frame summed over its steps (ssServedCounts), read-only;
     each row or contact is counted once, in one of: by_mapping (the stepping's own mapping: every one under implicit
     Euler), handed_to_matched (exact only: no finite exact softness at this step length), handed_to_implicit_euler
@@ -32,14 +37,25 @@ class ServedCounts(StructView, c_type="ssServedCounts"):
     __slots__ = ()
 
 
-class ApplyReport(StructView, c_type="ssApplyReport"):
+class ApplyReport(StructView, c_type="ssApplyReport", docs={
+        "rows": "ServedCounts of every bound row, the world's included, once",
+        "row_writes": "parameter sets actually written into ODE (unchanged values are skipped)"}):
     """What one Apply did (ssApplyReport), read-only: rows (ServedCounts: every bound row, the world's included,
     once), row_writes (parameter sets actually written into ODE; unchanged values are skipped)."""
 
     __slots__ = ()
 
 
-class AdoptReport(StructView, c_type="ssAdoptReport"):
+class AdoptReport(StructView, c_type="ssAdoptReport", docs={
+        "world": "1 when the world's ERP/CFM were adopted, else 0",
+        "joints": "joints adopted (at least one row bound, or nothing soft but known)",
+        "joint_rows": "JointParam.JOINT sets (ball, fixed, double ball, double hinge, transmission)",
+        "stop_rows": "JointParam.STOP sets, one per axis",
+        "motor_rows": "JointParam.MOTOR sets, one per axis",
+        "suspension_rows": "JointParam.SUSPENSION sets",
+        "hard_rows": "of all rows above (the world's included), those tuned with cfm = 0, kept hard",
+        "bodies": "bodies adopted: known to the stepper, damping and auto-disable bound in seconds",
+        "skipped_joints": "contact, null and plane-2D joints, not adopted"}):
     """What one adoption call bound, by kind (ssAdoptReport, adopt.h), read-only: world (1 when the world's ERP/CFM
     were adopted), joints, their rows by kind (joint_rows, stop_rows, motor_rows, suspension_rows), hard_rows (of
     those, tuned with cfm = 0, kept hard), bodies (known to the stepper), skipped_joints (contact, null, plane-2D),

@@ -52,7 +52,15 @@ from steadystep.registry import AdoptReport, Registry  # also declares ServedCou
 from steadystep.stepping import Stepping, stepping_from
 
 
-class StepInfo(StructView, c_type="ssStepInfo", convert={"mapping": Mapping}):
+class StepInfo(StructView, c_type="ssStepInfo", convert={"mapping": Mapping}, docs={
+        "mapping": "the Mapping this step's softness is written with",
+        "step_s": "the length of the physics step about to be taken (s)",
+        "softness_step_s": "the step length the softness is for (s): step_s, or stepping.frozen_step_s",
+        "previous_step_s": "the step before, for Mapping.EXACT (s); 0 when there is no usable history",
+        "index": "0-based index of this step within the frame",
+        "count": "steps this frame takes",
+        "time_s": "the simulated time at this step's start (s), every step since the stepper was made added in "
+                  "order; under the fixed cut the same bits for the n-th step at every frame rate"}):
     """The physics step about to be taken (ssStepInfo), as current_step() gives it inside the callbacks: mapping
     (the Mapping this step's softness is written with), step_s (the length of the step about to be taken, s),
     softness_step_s (the step length the softness is for, s: step_s, or stepping.frozen_step_s), previous_step_s
@@ -64,18 +72,42 @@ class StepInfo(StructView, c_type="ssStepInfo", convert={"mapping": Mapping}):
     __slots__ = ()
 
 
-class FrameReport(StructView, c_type="ssFrameReport", convert={"failed_body": address_of}):
+class FrameReport(StructView, c_type="ssFrameReport", convert={"failed_body": address_of}, docs={
+        "steps": "physics steps taken",
+        "step_s": "length of the last step taken (s); 0 when none",
+        "simulated_s": "time simulated this frame (s)",
+        "time_s": "the stepper's simulated time after this frame (s): the time to label the frame's state with "
+                  "(the same bits after the same number of steps under the fixed cut at every frame rate)",
+        "carried_s": "time not simulated yet, carried to the next frame (s): the fixed cut's accumulator, or a "
+                     "frame too short to step",
+        "dropped_s": "time dropped by stepping.max_steps_per_frame (s), never simulated",
+        "interpolation": "the fixed cut's blend factor, accumulator / fixed_step_s in [0, 1): blend the last two "
+                         "states with it to render",
+        "rows": "ServedCounts of row-steps: every bound row (the world's included) once per physics step, by who "
+                "served it",
+        "contacts": "ServedCounts of the contacts softened with soften_contact (or a ContactRule), by who served them",
+        "row_writes": "parameter sets written into ODE, summed over the frame's applies",
+        "unsoftened_contact_steps": "steps whose collision made contacts on known bodies but softened none (a near "
+                                    "callback that forgot soften_contact: those contacts keep the softness tuned "
+                                    "for one step length)",
+        "program_writes": "values the program wrote into ODE since the stepper last looked (the world's ERP/CFM, a "
+                          "bound joint row, a body's damping or auto-disable), each taken as tuned at the tuned step",
+        "failed_body": "the address of the body that blew up or ran too fast, else 0 (compare with "
+                       "ctypes.cast(body, c_void_p).value)"}):
     """What one frame did (ssFrameReport), with the fields and meanings stepper.h gives them, read-only and read
     from the C report when asked for (FIELDS lists them; as_dict() copies them): steps, step_s (s), simulated_s (s),
     time_s (the stepper's simulated time after the frame, s: the time to label the frame's state with, the same
     bits after the same number of steps under the fixed cut at every frame rate), carried_s, dropped_s (s),
     interpolation (the fixed cut's blend factor, in [0, 1)), ... failed_body is the address of the body that failed,
-    else 0 (compare with ctypes.cast(body, c_void_p).value)."""
+    else 0 (compare with ctypes.cast(body, c_void_p).value). help(FrameReport) shows every field with its unit."""
 
     __slots__ = ()
 
 
-class ContactRuleReport(StructView, c_type="ssContactRuleReport"):
+class ContactRuleReport(StructView, c_type="ssContactRuleReport", docs={
+        "pairs": "pairs of geoms dCollide was asked about (pairs of two static geoms are skipped)",
+        "contacts": "contact joints made, each softened (counted in the frame report's contacts)",
+        "dropped": "contacts whose position, normal or depth was not finite, dropped without a joint"}):
     """What one collision by a ContactRule made (ssContactRuleReport), read-only: pairs (pairs of geoms dCollide
     was asked about), contacts (contact joints made, each softened and counted in the frame report), dropped
     (contacts whose position, normal or depth was not finite, dropped without a joint)."""

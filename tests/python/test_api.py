@@ -148,12 +148,13 @@ def test_conversions_work_elementwise_on_numpy_arrays():
         ss.implicit_euler_softness((np.ones(2), np.ones(3)), 0.1)
 
 
-@pytest.mark.parametrize("command", [["figure", "--out", "unused"], ["compare", "--out", "unused"]])
-def test_drawing_commands_say_the_extra_is_missing_in_one_line(command, monkeypatch, capsys, tmp_path):
-    real = importlib.util.find_spec
-    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "tqdm" else real(name, *a))
+@pytest.mark.parametrize("command, missing", [(["figure", "--out", "unused"], "matplotlib"),
+                                              (["compare", "--out", "unused"], "tqdm"),
+                                              (["compare", "--out", "unused"], "jinja2")])
+def test_drawing_commands_say_the_extra_is_missing_in_one_line(command, missing, monkeypatch, capsys, tmp_path):
+    monkeypatch.setitem(sys.modules, missing, None)  # its import fails, as when it is not installed
     monkeypatch.chdir(tmp_path)
     assert cli.main(command) == cli.EXIT_BAD_INPUT
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "tqdm not installed" in err and "steadystep[report]" in err
+    assert err.count("\n") == 1 and f"{missing} not installed" in err and "steadystep[report]" in err
     assert not (tmp_path / "unused").exists()
