@@ -269,8 +269,8 @@ def draw_deviation_figure(scene: str, quantity: str, deviations: dict, statuses:
     """Grouped bars: the deviation per profile (groups) and policy (colour and hatch), on a log scale.
 
     deviations: {(profile, policy): value}; statuses: {(profile, policy): status}. A failed run (inf, or a status
-    other than "ok") is drawn as a bar to the top, crossed out and labelled with its status; the legend mentions
-    failures only when there are some."""
+    other than "ok") has no deviation to draw: no bar, but a red ✕ and its status at the foot of its place (a bar
+    at some height would read as a value); the title mentions failures only when there are some."""
     statuses = statuses or {}
     profiles = list(dict.fromkeys(profile for profile, _ in deviations))
     policies = list(dict.fromkeys(policy for _, policy in deviations))
@@ -290,22 +290,21 @@ def draw_deviation_figure(scene: str, quantity: str, deviations: dict, statuses:
                 continue
             bad = not np.isfinite(value) or statuses.get((profile, policy), "ok") != "ok"
             positions.append(i + (j - (len(policies) - 1) / 2) * width)
-            heights.append(top if bad else max(value, bottom))
-            failed.append(statuses.get((profile, policy), "blew up") if bad else None)
+            heights.append(bottom if bad else max(value, bottom))  # the axis' foot: nothing shows of a failed run
+            failed.append(statuses.get((profile, policy), "blew up") if bad and value is not None else None)
         bars = ax.bar(positions, heights, width, color=policy_color(policy), hatch=HATCHES[j % len(HATCHES)],
                       edgecolor="white", linewidth=0.4, label=policy)
         for bar, status in zip(bars, failed):
             if status:
                 any_failed = True
-                bar.set_alpha(0.35)
-                ax.text(bar.get_x() + bar.get_width() / 2, top, "✕", ha="center", va="bottom", fontsize=9,
-                        color="#b00000")
+                ax.text(bar.get_x() + bar.get_width() / 2, bottom * 1.15, f"✕ {status}", ha="center", va="bottom",
+                        rotation=90, fontsize=7, color="#b00000")
     ax.set_yscale("log")
     ax.set_ylim(bottom, top * 2.0)
     ax.set_xticks(range(len(profiles)), [_label(profile) for profile in profiles])
     ax.set_ylabel("RMS deviation / amplitude")
     ax.set_title(f"{scene}: deviation of {quantity} from the reference run, by profile and policy"
-                 + (" (✕, faded to the top: the run failed)" if any_failed else ""), loc="left", fontsize=10)
+                 + (" (✕: the run failed, no deviation)" if any_failed else ""), loc="left", fontsize=10)
     figure.legend(*ax.get_legend_handles_labels(), ncol=min(7, len(policies)), loc="outside lower center",
                   fontsize=8)
     return figure

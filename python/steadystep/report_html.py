@@ -5,7 +5,6 @@ in). The templates are in report_templates.py."""
 from __future__ import annotations
 
 import base64
-import json
 import math
 import platform
 import time
@@ -19,6 +18,30 @@ from steadystep.report_model import Report
 from steadystep.report_tasks import NOT_PROBED
 from steadystep.report_templates import ENVIRONMENT
 from steadystep.report_validate import GRID_AXES
+
+
+# Enum-valued settings by field name, shown by their names (the C integers meant nothing on a page).
+_SETTING_ENUMS = {"cut": "FrameCut", "mapping": "Mapping", "solver": "Solver"}
+
+
+def readable_settings(settings: dict | None) -> str:
+    """Settings as a person reads them: "name = value" by field, enums by name in lower case with dashes
+    (cut = substeps, solver = quick), seconds with their unit, nested dicts in parentheses; "-" for none."""
+    from steadystep import enums
+
+    def shown(name: str, value) -> str:
+        if isinstance(value, dict):
+            return f"{name} ({readable_settings(value)})"
+        if name in _SETTING_ENUMS and isinstance(value, int):
+            try:
+                value = getattr(enums, _SETTING_ENUMS[name])(value).name.lower().replace("_", "-")
+            except ValueError:
+                pass
+        elif isinstance(value, float):
+            value = f"{value:g} s" if name.endswith("_s") else f"{value:g}"
+        return f"{name} = {value}"
+
+    return ", ".join(shown(name, value) for name, value in (settings or {}).items()) or "-"
 
 
 def number(value, digits: int = 3) -> str:
@@ -221,7 +244,8 @@ def as_html(report: Report, command: str, article_paths: list[Path]) -> str:
         not_probed=[(scene, NOT_PROBED.get(scene, "")) for scene in report.not_probed],
         article=embed(pngs[0]) if pngs else None,
         scenes=[scene_section(report, s) for s in report.scenes],
-        parameters=[[s, Markup("<code>{}</code>").format(json.dumps(p))] for s, p in report.params.items()],
-        stepping_defaults=json.dumps(runs.default_stepping()), reference_stepping=json.dumps(runs.reference_stepping()),
+        parameters=[[s, readable_settings(p)] for s, p in report.params.items()],
+        stepping_defaults=readable_settings(runs.default_stepping()),
+        reference_stepping=readable_settings(runs.reference_stepping()),
         reference_profile=runs.REFERENCE_PROFILE, node=platform.node(), machine=platform.machine(),
         made_at=time.strftime("%Y-%m-%d %H:%M:%S %Z"), phases=report.phases_s)

@@ -142,8 +142,8 @@ rows...), summed over the run's steps; - for policies that use implicit Euler th
 </section>
 <h2>Parameters</h2>
 <p>duration {{ "%g"|format(report.duration_s) }} s simulated per run, profile seed {{ report.seed }}, profiles
-{{ report.profiles|join(", ") }}; stepping defaults <code>{{ stepping_defaults }}</code> (policy set per run);
-reference <code>{{ reference_stepping }}</code> under {{ reference_profile }}.</p>
+{{ report.profiles|join(", ") }}; stepping defaults: {{ stepping_defaults }} (policy set per run);
+reference: {{ reference_stepping }}, under {{ reference_profile }}.</p>
 {{ table({"header": ["scene", "parameters"], "rows": parameters}) }}
 <h2>Regenerate</h2>
 <pre>{{ command }}</pre>

@@ -285,6 +285,21 @@ def test_a_run_that_leaves_the_axes_is_marked_and_the_legend_says_only_what_is_d
                                                               ("fixed:30", "implicit-euler"): 0.01},
                                            {("fixed:30", "naive"): "blow-up", ("fixed:30", "implicit-euler"): "ok"})
     assert "the run failed" in failed.axes[0].get_title(loc="left")
+    # A failed run has no deviation: no bar at some height (it read as a value), but its status at the axis' foot.
+    foot = failed.axes[0].get_ylim()[0]
+    assert max(bar.get_y() + bar.get_height() for bar in failed.axes[0].patches[:1]) <= foot * 1.0001
+    assert [text.get_text() for text in failed.axes[0].texts] == ["✕ blow-up"]
+    assert all(bar.get_alpha() in (None, 1) for bar in failed.axes[0].patches)  # nothing faded
+
+
+def test_parameters_read_as_names_not_json_with_enum_integers():
+    from steadystep import runs
+    from steadystep.report_html import readable_settings
+
+    text = readable_settings(runs.reference_stepping())
+    assert "cut = substeps" in text and "solver = quick" in text and "mapping = implicit-euler" in text
+    assert "max_step_s = 0.001 s" in text and "{" not in text and '"' not in text
+    assert readable_settings({"body_count": 150}) == "body_count = 150" and readable_settings(None) == "-"
 
 
 def test_the_stable_step_line_says_where_the_best_is_beaten():
