@@ -46,6 +46,7 @@ def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: f
     seed, duration_s, profiles = seed_value(seed), float(duration_s), list(profiles)
     params = REPORT_PARAMS if params is None else params
     report = Report(scenes, profiles, {s: policies_for(s, policies) for s in scenes}, duration_s, seed)
+    report.machine["load_at_start"] = report_tasks.machine_state()["load"]
     report.repeat_profiles = report_tasks.repeat_profiles(profiles, seed)
     report.not_probed = [s for s in scenes if s in NOT_PROBED]
     springs, steps = grid_points(grid)

@@ -52,7 +52,7 @@ def as_json(report: Report, command: str) -> dict:
     return {
         "command": command, "duration_s": report.duration_s, "seed": report.seed, "profiles": report.profiles,
         "policies": report.policies, "params": report.params, "elapsed_s": report.elapsed_s,
-        "phases_s": report.phases_s,
+        "phases_s": report.phases_s, "machine": report.machine,
         "rows": [{"scene": r.scene, "profile": r.profile, "policy": r.policy, "status": r.status,
                   "deviation": dict(r.deviations),
                   "steps_per_frame": r.steps_per_frame, "steps_per_second": r.steps_per_second,

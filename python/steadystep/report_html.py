@@ -24,6 +24,19 @@ from steadystep.report_validate import GRID_AXES
 _SETTING_ENUMS = {"cut": "FrameCut", "mapping": "Mapping", "solver": "Solver"}
 
 
+def machine_line(report) -> str:
+    """The cores and the load beside the timings: "2 cores (2 usable), load 3.1 at the start, 3.4 before the cost
+    benchmark, 2.9 after it (1-minute averages)"; what was not recorded is left out."""
+    machine = getattr(report, "machine", None) or {}
+    cores = f"{machine['cores']:.0f} cores ({machine.get('usable_cores', machine['cores']):.0f} usable)" \
+        if machine.get("cores") else "an unknown number of cores"
+    loads = [f"{machine[key]:.1f} {when}" for key, when in (("load_at_start", "at the start"),
+                                                            ("load_before_cost", "before the cost benchmark"),
+                                                            ("load_after_cost", "after it"))
+             if machine.get(key) is not None]
+    return cores + (f", load {', '.join(loads)} (1-minute averages)" if loads else ", load not recorded")
+
+
 def readable_settings(settings: dict | None) -> str:
     """Settings as a person reads them: "name = value" by field, enums by name in lower case with dashes
     (cut = substeps, solver = quick), seconds with their unit, nested dicts in parentheses; "-" for none."""
@@ -248,4 +261,4 @@ def as_html(report: Report, command: str, article_paths: list[Path]) -> str:
         stepping_defaults=readable_settings(runs.default_stepping()),
         reference_stepping=readable_settings(runs.reference_stepping()),
         reference_profile=runs.REFERENCE_PROFILE, node=platform.node(), machine=platform.machine(),
-        made_at=time.strftime("%Y-%m-%d %H:%M:%S %Z"), phases=report.phases_s)
+        made_at=time.strftime("%Y-%m-%d %H:%M:%S %Z"), phases=report.phases_s, machine_line=machine_line(report))

@@ -64,3 +64,6 @@ class Report:
     served: dict[str, dict[str, dict[str, dict[str, int]]]] = field(default_factory=dict)
     not_probed: list[str] = field(default_factory=list)       # scenes the report does not probe (why: NOT_PROBED)
     phases_s: dict[str, float] = field(default_factory=dict)  # wall time of each phase of compare (s)
+    # What the timings ran on (report_tasks.machine_state): cores, the cores this process may use, and the 1-minute
+    # load average when compare started and before and after the cost benchmark.
+    machine: dict[str, float | None] = field(default_factory=dict)

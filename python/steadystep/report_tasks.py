@@ -221,11 +221,30 @@ def run_phases(report, units: dict[tuple, dict], executor, progress: bool | None
     return done
 
 
+def machine_state() -> dict[str, float | None]:
+    """What a timing ran on: cores (os.cpu_count), usable_cores (this process' affinity), load (the 1-minute load
+    average now; None where the system has none). Recorded beside every timing: a ratio timed under a load of 15 on
+    2 cores is not one timed alone."""
+    import os
+
+    try:
+        usable = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        usable = os.cpu_count() or 0
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):
+        load = None
+    return {"cores": os.cpu_count() or 0, "usable_cores": usable, "load": load}
+
+
 def costs(report, done: dict, progress: bool | None) -> None:
     """Phase 3: the cost benchmark of every scene and policy timed in this process (cost.time_plan of its plan,
     made in phase 1), once every unit is done, so that its timings are taken while nothing else of the study
     runs."""
     pairs = [(scene, policy) for scene in report.scenes for policy in report.policies[scene]]
+    state = machine_state()
+    report.machine.update(cores=state["cores"], usable_cores=state["usable_cores"], load_before_cost=state["load"])
     started = time.perf_counter()
     with report_progress.bar(len(pairs), progress, "steadystep compare [cost against plain ODE]", "run") as bar:
         for scene, policy in pairs:
@@ -233,3 +252,4 @@ def costs(report, done: dict, progress: bool | None) -> None:
             bar.set_postfix_str(f"{scene} {policy}", refresh=False)
             bar.update()
     report.cost_wall_s = report.phases_s["cost"] = time.perf_counter() - started
+    report.machine["load_after_cost"] = machine_state()["load"]

@@ -105,8 +105,8 @@ bound and no contact softened through the stepper are left out.</p>
 {% if cost %}
 <h2>Cost against plain ODE</h2>
 {{ table(cost, "cost") }}
-<p class=small>One benchmark run of {{ "%.1f"|format(report.cost_wall_s) }} s, alone on the machine's share of this
-study (after every run and figure): each policy and two plain ODE copies of the same scene take the same
+<p class=small>One benchmark run of {{ "%.1f"|format(report.cost_wall_s) }} s, after every run and figure of this
+study, on {{ machine_line }}: each policy and two plain ODE copies of the same scene take the same
 {{ cost_profile }} frames in {{ cost_repeats }} blocks, the order of the three rotating; each ratio is taken per
 block, its median and range shown (the blocks column: 3 where the first rotation's blocks already agreed within
 {{ cost_tight }} in both ratios). The program's own: collide, one dWorldQuickStep of each whole frame, softness as
@@ -148,7 +148,7 @@ reference: {{ reference_stepping }}, under {{ reference_profile }}.</p>
 <h2>Regenerate</h2>
 <pre>{{ command }}</pre>
 <p class=small>Made in {{ "%.1f"|format(report.elapsed_s) }} s ({% for phase, seconds in phases.items() %}{{ phase }}
-{{ "%.1f"|format(seconds) }} s{% if not loop.last %}, {% endif %}{% endfor %}) on {{ node }} ({{ machine }}),
+{{ "%.1f"|format(seconds) }} s{% if not loop.last %}, {% endif %}{% endfor %}) on {{ node }} ({{ machine }}; {{ machine_line }}),
 {{ made_at }}.</p>
 </body></html>
 """

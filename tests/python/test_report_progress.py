@@ -69,3 +69,21 @@ def test_scripts_report_draws_the_article_figure_once_and_ticks_through_the_buil
     text = (REPO / "scripts" / "report").read_text()
     assert "steadystep\" figure" not in text  # compare draws it; drawing it first too was twice
     assert "still working" in text and "STEADYSTEP_PROGRESS_S" in text
+
+
+def test_cores_and_load_are_recorded_beside_the_timings(tmp_path):
+    """The cost benchmark's paragraph and the page's foot say on how many cores and under what load they were
+    timed; metrics.json carries the numbers (docs/metrics.md, machine)."""
+    import json
+
+    out = tmp_path / "out"
+    done = subprocess.run([str(STEADYSTEP), "compare", "--out", str(out), "--scenes", "oscillator", "--profiles",
+                           "fixed:30", "--duration", "0.2", "--executor", "serial"], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    machine = json.loads((out / "metrics.json").read_text())["machine"]
+    assert machine["cores"] == os.cpu_count() and 1 <= machine["usable_cores"] <= machine["cores"]
+    assert all(machine[key] >= 0 for key in ("load_at_start", "load_before_cost", "load_after_cost"))
+    page = (out / "report.html").read_text()
+    assert page.count(f"{machine['cores']} cores ({machine['usable_cores']} usable), load ") == 2  # cost, foot
+    assert "alone on the machine" not in page
