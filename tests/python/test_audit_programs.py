@@ -55,9 +55,12 @@ def programs(tmp_path_factory) -> dict:
     return made
 
 
-def audit(out: Path, program: Path, *args) -> dict:
-    done = subprocess.run([*COMMAND, "audit", str(program), "--own", str(program), "--out", str(out), *AUDITED,
-                           *map(str, args)], capture_output=True, text=True, timeout=600)
+def audit(out: Path, program: Path, *args, own: Path | None = None) -> dict:
+    """The audit of program (an executable with its own stepping in own, default itself; or a Python file)."""
+    which = (["--python", str(program)] if program.suffix == ".py" else
+             [str(program), "--own", str(own or program)])
+    done = subprocess.run([*COMMAND, "audit", *which, "--out", str(out), *AUDITED, *map(str, args)],
+                          capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     metrics = json.loads((out / "metrics.json").read_text())
     audit_claims_check.check(metrics)
@@ -72,10 +75,13 @@ def audit(out: Path, program: Path, *args) -> dict:
     return metrics
 
 
-def run_csv(program: Path, variant: str, profile: str, seed: int, duration: float) -> dict:
+def run_csv(program, variant: str, profile: str, seed: int, duration: float) -> dict:
+    """One run's columns: program is an audit_run.Executable or PythonProgram, or a path (its own stepping itself)."""
     from steadystep.audit_run import Executable, run
 
-    made = run(Executable((str(program),), (str(program),)), variant, profile, seed, duration)
+    if isinstance(program, Path):
+        program = Executable((str(program),), (str(program),))
+    made = run(program, variant, profile, seed, duration)
     assert made.ok, made.status
     return made.columns
 
@@ -101,7 +107,7 @@ def difference(run: dict, base: dict, q: str) -> float:
     return float(np.sqrt(np.mean((a - b) ** 2)))
 
 
-def separately(program: Path, metrics: dict) -> dict:
+def separately(program, metrics: dict) -> dict:
     """Each policy's (and own stepping's) spread per quantity, with its standard error, from SEPARATE runs."""
     out = {}
     for variant in ("own", *SEPARATE_POLICIES, metrics_recommended(metrics)):
@@ -121,7 +127,7 @@ def metrics_recommended(metrics: dict) -> str:
     return next(c for c in metrics["claims"] if c["kind"] == "recommend")["variant"]
 
 
-def check_by_separate_runs(program: Path, metrics: dict) -> tuple[str, dict]:
+def check_by_separate_runs(program, metrics: dict) -> tuple[str, dict]:
     """The recommendation against separate runs: its largest spread (over the deciding quantities) within the noise
     of the smallest policy's, and no worse than own stepping beyond the noise in any quantity unless the page's
     recommendation says so."""
@@ -201,15 +207,35 @@ def test_hopper_names_an_unphysical_reference(programs, tmp_path):
     check_by_separate_runs(programs["hopper"], metrics)
 
 
-@pytest.mark.parametrize("example", ["wrecking_arm", "substepping_program"])
+EXAMPLES = {  # the project's programs: (the program, its own stepping: None for the same, or a Python file)
+    "wrecking_arm": ("steadystep_example_wrecking_arm", None),
+    "substepping_program": ("steadystep_test_substepping_program", None),
+    "audit_pendulum": ("steadystep_example_audit_pendulum", None),
+    "chain": ("steadystep_example_chain_steadystep", "steadystep_example_chain_ode"),
+    "audit_slider.py": (ROOT / "examples" / "audit_slider.py", None),
+}
+
+
+@pytest.mark.parametrize("example", EXAMPLES)
 def test_project_examples(example, tmp_path):
-    """The project's game-like example and its program that substeps itself (three dWorldStep a frame, naive its own
-    stepping bit for bit)."""
-    program = BUILD / (f"steadystep_example_{example}" if example == "wrecking_arm" else
-                       f"steadystep_test_{example}")
-    if not program.exists():
-        pytest.skip(f"{program} not built")
-    metrics = audit(tmp_path, program, "--cost", "none", "--no-diagnosis")
-    check_by_separate_runs(program, metrics)
+    """The project's game-like example, its program that substeps itself (three dWorldStep a frame, naive its own
+    stepping bit for bit), the chaotic pendulum, the chain against its plain-ODE twin, and the Python slider with its
+    own_frame."""
+    from steadystep.audit_run import Executable, PythonProgram
+
+    name, own = EXAMPLES[example]
+    if isinstance(name, Path):
+        program, separate = name, PythonProgram(str(name))
+    else:
+        program, own = BUILD / name, (BUILD / own if own else BUILD / name)
+        if not program.exists() or not own.exists():
+            pytest.skip(f"{program} not built")
+        separate = Executable((str(program),), (str(own),))
+    # A Python run is a slower process: half the time, the policies the separate runs hold it against.
+    shorter = ["--duration", "1.5", "--policies", *SEPARATE_POLICIES] if isinstance(name, Path) else []
+    metrics = audit(tmp_path, program, "--cost", "none", "--no-diagnosis", *shorter,
+                    own=None if isinstance(name, Path) else own)
+    assert metrics["variants"][0] == "own"
+    check_by_separate_runs(separate, metrics)
     if example == "substepping_program":
         assert metrics["spread"]["naive"] == metrics["spread"]["own"]
