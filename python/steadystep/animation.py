@@ -33,9 +33,12 @@ PLAYBACK_HZ = 60.0
 
 def _record(policy: str, frames: list[float], stepping: dict | None, params: dict | None,
             every_s: float = 0.0) -> dict:
-    """Plays frames through a Scene; returns {"policy", "t": [...], "points": [[[x, z], ...], ...], "status"}."""
+    """Plays frames through a Scene; returns {"policy", "t": [...], "points": [[[x, z], ...], ...], "status",
+    "broken_s"}: status "broken" from the first frame after which the scene left its sanity bounds (broken_s, the
+    scene's time then; the drawing goes on, physically wrong, and the panel says so), or a blow-up status."""
     scene = runs.Scene(SCENE, policy, params=params, stepping=stepping)
     times, points, status = [0.0], [scene.points(interpolated=True)[:, [0, 2]].round(4).tolist()], "ok"
+    broken_s = None
     next_record_s = every_s
     try:
         for frame_s in frames:
@@ -45,6 +48,8 @@ def _record(policy: str, frames: list[float], stepping: dict | None, params: dic
                 status = error.status
                 break
             now = scene.time_s
+            if broken_s is None and scene.broken is not None:
+                status, broken_s = runs.BROKEN, round(now, 6)
             if every_s and now + 1e-12 < next_record_s:
                 continue
             next_record_s += every_s
@@ -52,7 +57,7 @@ def _record(policy: str, frames: list[float], stepping: dict | None, params: dic
             points.append(scene.points(interpolated=True)[:, [0, 2]].round(4).tolist())
     finally:
         scene.close()
-    return {"policy": policy, "t": times, "points": points, "status": status}
+    return {"policy": policy, "t": times, "points": points, "status": status, "broken_s": broken_s}
 
 
 def record(duration_s: float = 5.0, seed: int = 1, params: dict | None = None) -> dict:
@@ -71,6 +76,16 @@ def record(duration_s: float = 5.0, seed: int = 1, params: dict | None = None) -
             "bounds": [float(low[0]), float(low[1]), float(high[0]), float(high[1])]}
 
 
+def _status_label(panel: dict) -> str:
+    """What a panel's title adds when its run did not stay physical: ", broken at 1.23 s" (it left the scene's
+    sanity bounds then: what follows is drawn, and wrong) or the blow-up status; nothing for a run that stayed ok."""
+    if panel["status"] == "ok":
+        return ""
+    if panel.get("broken_s") is not None:
+        return f", broken at {panel['broken_s']:.2f} s"
+    return f" ({panel['status']})"
+
+
 def section(data: dict) -> Markup:
     """The HTML of the animation: an SVG with one panel per run and the script that plays them
     (report_templates: animation.html)."""
@@ -79,7 +94,7 @@ def section(data: dict) -> Markup:
     width, height, pad = 300, 300, 14
     low_x, low_z, high_x, high_z = data["bounds"]
     span = max(high_x - low_x, high_z - low_z, 1e-3)
-    panels = [{"title": panel["policy"] + ("" if panel["status"] == "ok" else f" ({panel['status']})")}
+    panels = [{"title": panel["policy"] + _status_label(panel), "failed": panel["status"] != "ok"}
               for panel in data["panels"]]
     return Markup(ENVIRONMENT.get_template("animation.html").render(
         panels=panels, width=width, height=height, total_width=len(panels) * (width + 10), data=data,

@@ -157,7 +157,7 @@ _ANIMATION = """<figure id='animation-player' data-frame='0' data-time-s='0'>
 <svg id='animation-svg' width='{{ total_width }}' height='{{ height + 26 }}' viewBox='0 0 {{ total_width }} {{ height + 26 }}'
  role='img' aria-label='the chain swinging'>
 {% for panel in panels %}<g transform='translate({{ loop.index0 * (width + 10) }},0)'><rect width='{{ width }}'
- height='{{ height + 24 }}' fill='#fafafa' stroke='#ccc'/><text x='8' y='{{ height + 17 }}' font-size='13'>{{ panel.title }}</text>
+ height='{{ height + 24 }}' fill='#fafafa' stroke='#ccc'/><text x='8' y='{{ height + 17 }}' font-size='13'{% if panel.failed %} fill='#b00000' font-weight='bold'{% endif %}>{{ panel.title }}</text>
 {% if not loop.first %}<polyline class='ghost' data-panel='{{ loop.index0 }}' fill='none' stroke='#bbb' stroke-width='4'
  stroke-linejoin='round' points=''/>{% endif %}<polyline class='chain' data-panel='{{ loop.index0 }}' fill='none'
  stroke='#333' stroke-width='4' stroke-linejoin='round' points=''/><circle class='tip' data-panel='{{ loop.index0 }}'

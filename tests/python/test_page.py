@@ -318,3 +318,16 @@ def test_the_stable_step_line_says_where_the_best_is_beaten():
     assert text.startswith("matched:")
     assert "naive is shorter on buggy 80 ms against 103 ms" in text
     assert "on chain, naive 27.1 ms against 26.5 ms" in text
+
+
+def test_a_broken_run_in_the_animation_says_so_in_its_panel():
+    """The naive chain leaves its sanity bounds at 15-45 fps: its panel is labelled broken, with the time, in red
+    (it was animated with no label before)."""
+    from steadystep import animation
+
+    data = animation.record(duration_s=1.0, seed=1)
+    naive = next(panel for panel in data["panels"] if panel["policy"] == "naive")
+    assert naive["status"] == "broken" and 0 < naive["broken_s"] <= 1.0
+    html = str(animation.section(data))
+    assert re.search(r"fill='#b00000' font-weight='bold'>naive, broken at \d\.\d\d s</text>", html)
+    assert ">fixed</text>" in html and ">implicit-euler</text>" in html  # the runs that stayed ok: plain titles
