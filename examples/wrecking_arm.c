@@ -14,6 +14,7 @@
  * Followed: the chain's free end (x, z, m) and the top box's x (m). */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include <ode/ode.h>
 
@@ -43,6 +44,7 @@ static void nearCallback(void* data, dGeomID g1, dGeomID g2) {
   dBodyID b1 = dGeomGetBody(g1), b2 = dGeomGetBody(g2);
   if (b1 != 0 && b2 != 0 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
   dContact contact[MAX_CONTACTS];
+  memset(contact, 0, sizeof contact); /* every surface field the program does not set is 0, not stack garbage */
   int count = dCollide(g1, g2, MAX_CONTACTS, &contact[0].geom, sizeof(dContact));
   for (int i = 0; i < count; ++i) {
     contact[i].surface.mode = dContactSoftCFM | dContactApprox1;

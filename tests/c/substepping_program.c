@@ -7,6 +7,7 @@
  * Followed: the ball's x and y (m). */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include <ode/ode.h>
 
@@ -25,6 +26,7 @@ static dBodyID ball;
 static void nearCallback(void* data, dGeomID g1, dGeomID g2) {
   dBodyID b1 = dGeomGetBody(g1), b2 = dGeomGetBody(g2);
   dContact contact[MAX_CONTACTS];
+  memset(contact, 0, sizeof contact); /* bounce_vel and the rest: no stack garbage in the surface */
   int count = dCollide(g1, g2, MAX_CONTACTS, &contact[0].geom, sizeof(dContact));
   for (int i = 0; i < count; ++i) {
     contact[i].surface.mode = dContactBounce | dContactSoftERP | dContactSoftCFM;
