@@ -366,12 +366,16 @@ static void operate(Program* p, int code, FuzzInput* in, int inside) {
                * hinges under dWorldStep), so the callbacks write springs only. */
       double erp = 0.05 + 0.9 * (fuzz_byte(in) / 255.0), cfm = 1e-8 * pow(10, fuzz_byte(in) % 6);
       if (!inside && b % 4 == 0) {
-        erp = fuzzDouble(in);
-        cfm = fuzzDouble(in);
-        /* cfm 0 is a hard row, which a program may tune: with two hinges on one pair of bodies, plain dWorldStep
-         * then factors a singular matrix and aborts, the program's own doing; the refusals are what is fuzzed */
-        if (cfm == 0) cfm = -1;
+        /* a value no spring stands for, which the stepper must refuse by name. (Values a spring does stand for but
+         * plain ODE cannot step, a cfm of 0 or 1e-249 with constraints that repeat one another under dWorldStep, are
+         * the program's own doing, aborting its own loop as well: not fuzzed.) */
+        static const double bad_erp[] = {-0.5, 1.5, 1e300, NAN, INFINITY, 0.3, 0.3};
+        static const double bad_cfm[] = {1e-5, 1e-5, 1e-5, 1e-5, -1, NAN, -INFINITY};
+        erp = bad_erp[fuzz_byte(in) % 7];
+        cfm = bad_cfm[fuzz_byte(in) % 7];
+        if (erp == 0.3 && cfm == 1e-5) cfm = -1;
       }
+      if (verbose) fprintf(stderr, "  rewrite %d: erp %g cfm %g\n", a % 3, erp, cfm);
       switch (a % 3) {
         case 0:
           if (isfinite(erp) && isfinite(cfm)) dWorldSetERP(p->world, erp), dWorldSetCFM(p->world, cfm);
@@ -379,7 +383,7 @@ static void operate(Program* p, int code, FuzzInput* in, int inside) {
         case 1:
           if (p->joint_count > 0) setStops(p->joints[b % p->joint_count], erp, cfm);
           break;
-        default:
+        default: /* a damping scale: in [0, 1) a program's, else (1.5, NaN, ...) one the stepper refuses */
           if (p->body_count > 0 && isfinite(erp)) dBodySetLinearDamping(p->bodies[b % p->body_count].body, erp);
       }
       break;
@@ -449,6 +453,7 @@ static void beforeStep(void* context, ssStepper* stepper) {
 static ssStatus stepFrame(Program* p, double frame_s) {
   ssFrameReport report;
   ssStatus status = ssStepper_Step(p->stepper, frame_s, &report);
+  if (verbose) fprintf(stderr, "  frame %g: %s %s\n", frame_s, ssStatusName(status), status ? ssLastError() : "");
   checkStatus(status, "ssStepper_Step");
   return status;
 }
