@@ -203,7 +203,7 @@ def draw_scene_figure(scene: str, quantity: str, unit: str, reference, results, 
             ax.plot(*exact_curve, color=EXACT_COLOR, lw=3.0, alpha=0.35)
         ax.plot(reference.times, reference.quantities[quantity], color=REFERENCE_COLOR, lw=1.0, ls=(0, (2, 2)),
                 alpha=0.8)
-        failures = []
+        failures, drawn_profiles = {}, 0
         for j, profile in enumerate(profiles):
             result = results.get((profile, policy))
             if result is None or result.step_count == 0:
@@ -211,9 +211,10 @@ def draw_scene_figure(scene: str, quantity: str, unit: str, reference, results, 
             drawn = _draw_run(ax, result.times, result.quantities[quantity], policy_color(policy), profile_style(j),
                               low, high, result.status != "ok")
             marks = {k: marks[k] or drawn[k] for k in marks}
+            drawn_profiles += 1
             if result.status != "ok":
-                failures.append(f"{_label(profile)}: {result.status}")
-        ax.set_title(policy + ("\n" + "; ".join(failures) if failures else ""), loc="left", fontsize=10,
+                failures.setdefault(result.status, []).append(_label(profile))
+        ax.set_title(policy + failure_note(failures, drawn_profiles), loc="left", fontsize=10,
                      color=policy_color(policy) if not failures else "#b00000")
         ax.set_ylim(low, high)
         if index % columns == 0:
@@ -262,6 +263,20 @@ def deviation_figure(scene: str, quantity: str, deviations: dict, out_dir: Path,
                      statuses: dict | None = None) -> list[Path]:
     """draw_deviation_figure saved as out_dir/deviation_<scene>.png and .svg."""
     return save(draw_deviation_figure(scene, quantity, deviations, statuses), out_dir, f"deviation_{scene}")
+
+
+def failure_note(failures: dict[str, list[str]], drawn: int, width: int = 44) -> str:
+    """What a panel's title adds for its failed runs, kept within the panel (a list of every profile ran into the
+    next panel's title): "\nbroken under every profile", or by status, "\nbroken: fixed:30, hitch:60:30:0.1",
+    wrapped at width characters; "" when none failed."""
+    import textwrap
+
+    if not failures:
+        return ""
+    if len(failures) == 1 and len(next(iter(failures.values()))) == drawn > 1:
+        return f"\n{next(iter(failures))} under every profile"
+    text = "; ".join(f"{status}: {', '.join(labels)}" for status, labels in failures.items())
+    return "\n" + textwrap.fill(text, width)
 
 
 @_styled

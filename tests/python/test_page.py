@@ -331,3 +331,28 @@ def test_a_broken_run_in_the_animation_says_so_in_its_panel():
     html = str(animation.section(data))
     assert re.search(r"fill='#b00000' font-weight='bold'>naive, broken at \d\.\d\d s</text>", html)
     assert ">fixed</text>" in html and ">implicit-euler</text>" in html  # the runs that stayed ok: plain titles
+
+
+def test_the_failures_in_a_panels_title_stay_within_the_panel():
+    """Every profile's failure was listed on one line and ran into the next panel's title (the chain's naive
+    panel): now one status for all reads "broken under every profile", and any list is wrapped to the panel."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from steadystep import figures, runs
+
+    profiles = ["fixed:30", "uniform:15:45", "jitter:30:3", "hitch:60:30:0.1", "vsync:60:30"]
+    reference = runs.reference_run("chain", 3.0)
+    results = {(profile, policy): runs.run("chain", profile, policy, 3.0)
+               for profile in profiles for policy in ("naive", "implicit-euler", "fixed")}
+    assert all(results[profile, "naive"].status == "broken" for profile in profiles)
+    figure = figures.draw_scene_figure("chain", "end z", "m", reference, results)
+    FigureCanvasAgg(figure).draw()
+    renderer = figure.canvas.get_renderer()
+    titles = [ax._left_title for ax in figure.axes if ax.get_visible()]  # set_title(loc="left")
+    boxes = [title.get_window_extent(renderer) for title in titles if title.get_text()]
+    assert titles[0].get_text() == "naive\nbroken under every profile"
+    for one, other in zip(boxes, boxes[1:]):
+        assert not one.overlaps(other), (one, other)
+    assert figures.failure_note({"broken": ["fixed:30"], "blow-up": ["hitch:60:30:0.1"]}, 5) == \
+        "\nbroken: fixed:30; blow-up: hitch:60:30:0.1"
+    assert all(len(line) <= 44 for line in figures.failure_note({"broken": profiles * 3}, 20).splitlines())
