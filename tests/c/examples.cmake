@@ -48,43 +48,36 @@ echo \"$rows rows, byte-identical\""
            COMMAND steadystep_example_${program}_steadystep --profile fixed:30 --duration 0.1)
 endforeach()
 
-# The audit's double pendulum (examples/audit_pendulum.c) is one binary for both halves: without --policy it steps on
-# its own. Its followed quantities (the first three columns; the others count what served the rows, -1 when it steps
-# on its own) are the same bytes under naive. Chaotic: a difference of one rounding would show within seconds.
-foreach(profile fixed:60 fixed:30 uniform:15:45 fixed:120)
-  string(REPLACE ":" "_" profile_name ${profile})
-  # The game-like program (examples/wrecking_arm.c) likewise: its logic once a frame on its own, before every step
-  # adopted, and its wind added once a frame either way.
-  add_test(NAME example_wrecking_arm_naive_is_own_stepping_${profile_name}
-           COMMAND sh -c "\"$1\" --profile $3 --duration 10 --seed 3 | cut -d, -f1-4 > \"$2.ode.csv\" && \
-\"$1\" --policy naive --profile $3 --duration 10 --seed 3 | cut -d, -f1-4 > \"$2.naive.csv\" && \
+# A program that is both halves in one binary (without --policy it steps on its own) prints the same bytes adopted
+# under naive, in its followed columns (the first `columns`; those after count what served the rows, -1 on its own),
+# at each of the profiles: 10 s, every row present.
+function(steadystep_naive_is_own_stepping name target columns)
+  foreach(profile ${ARGN})
+    string(REPLACE ":" "_" profile_name ${profile})
+    add_test(NAME ${name}_naive_is_own_stepping_${profile_name}
+             COMMAND sh -c "\"$1\" --profile $3 --duration 10 --seed 3 | cut -d, -f1-$4 > \"$2.ode.csv\" && \
+\"$1\" --policy naive --profile $3 --duration 10 --seed 3 | cut -d, -f1-$4 > \"$2.naive.csv\" && \
 rows=$(wc -l < \"$2.ode.csv\") && test \"$rows\" -gt 100 && cmp \"$2.ode.csv\" \"$2.naive.csv\" && \
 echo \"$rows rows, byte-identical\""
-                   sh $<TARGET_FILE:steadystep_example_wrecking_arm>
-                   ${CMAKE_CURRENT_BINARY_DIR}/example_wrecking_arm_naive_${profile_name} ${profile})
-  add_test(NAME example_audit_pendulum_naive_is_own_stepping_${profile_name}
-           COMMAND sh -c "\"$1\" --profile $3 --duration 10 --seed 3 | cut -d, -f1-3 > \"$2.ode.csv\" && \
-\"$1\" --policy naive --profile $3 --duration 10 --seed 3 | cut -d, -f1-3 > \"$2.naive.csv\" && \
-rows=$(wc -l < \"$2.ode.csv\") && test \"$rows\" -gt 100 && cmp \"$2.ode.csv\" \"$2.naive.csv\" && \
-echo \"$rows rows, byte-identical\""
-                   sh $<TARGET_FILE:steadystep_example_audit_pendulum>
-                   ${CMAKE_CURRENT_BINARY_DIR}/example_audit_pendulum_naive_${profile_name} ${profile})
-endforeach()
+             sh $<TARGET_FILE:${target}> ${CMAKE_CURRENT_BINARY_DIR}/${name}_naive_${profile_name} ${profile}
+             ${columns})
+  endforeach()
+endfunction()
 
+# The audit's double pendulum (examples/audit_pendulum.c). Chaotic: a difference of one rounding would show within
+# seconds.
+steadystep_naive_is_own_stepping(example_audit_pendulum steadystep_example_audit_pendulum 3
+                                 fixed:60 fixed:30 uniform:15:45 fixed:120)
+# The game-like program (examples/wrecking_arm.c): its logic once a frame on its own, before every step adopted, and
+# its wind added once a frame either way.
+steadystep_naive_is_own_stepping(example_wrecking_arm steadystep_example_wrecking_arm 4
+                                 fixed:60 fixed:30 uniform:15:45 fixed:120)
 # A program that substeps itself (three dWorldStep substeps a frame, tests/c/substepping_program.c), adopted with one
-# ssStepper_Step per substep: under naive its own stepping bit for bit.
+# ssStepper_Step per substep.
 add_executable(steadystep_test_substepping_program tests/c/substepping_program.c)
 target_link_libraries(steadystep_test_substepping_program PRIVATE steadystep_lab m)
-foreach(profile fixed:60 fixed:30 fixed:144 uniform:15:45)
-  string(REPLACE ":" "_" profile_name ${profile})
-  add_test(NAME substepping_program_naive_is_own_stepping_${profile_name}
-           COMMAND sh -c "\"$1\" --profile $3 --duration 10 --seed 3 | cut -d, -f1-3 > \"$2.ode.csv\" && \
-\"$1\" --policy naive --profile $3 --duration 10 --seed 3 | cut -d, -f1-3 > \"$2.naive.csv\" && \
-rows=$(wc -l < \"$2.ode.csv\") && test \"$rows\" -gt 100 && cmp \"$2.ode.csv\" \"$2.naive.csv\" && \
-echo \"$rows rows, byte-identical\""
-           sh $<TARGET_FILE:steadystep_test_substepping_program>
-           ${CMAKE_CURRENT_BINARY_DIR}/substepping_program_naive_${profile_name} ${profile})
-endforeach()
+steadystep_naive_is_own_stepping(substepping_program steadystep_test_substepping_program 3
+                                 fixed:60 fixed:30 fixed:144 uniform:15:45)
 
 # The game-like program steps 10 s of 15-45 fps frames under every policy, and on its own.
 foreach(policy ${STEADYSTEP_EXAMPLE_POLICIES})
