@@ -10,6 +10,8 @@ import platform
 import time
 from pathlib import Path
 
+import numpy as np
+
 from markupsafe import Markup
 
 from steadystep import animation, cost, figures, page, runs, snippets
@@ -234,12 +236,39 @@ def code_to_write(report: Report) -> dict | None:
             "snippets": snippets.for_policy(policy)}
 
 
+def answer(report: Report) -> dict | None:
+    """The page's first sentence and picture: for these scenes, what changes with the frame rate under each policy
+    (the policies whose motion is the same at every frame rate, or the most alike), the recommended policy (the one
+    the code is written for) and its cost in one number: the median over the scenes of its wall time against the
+    program's plain loop (one step a frame); the picture, the first scene's deviation per profile and policy."""
+    chosen = page.code_policy(report)
+    if chosen is None:
+        return None
+    policy = chosen[0]
+    same = page.same_everywhere(report)
+    if same:
+        what = (f"only {', '.join(same)} gave the same motion at every frame rate; under every other policy the "
+                "motion changed with the frame rate")
+    else:
+        what = "under every policy the motion changed with the frame rate"
+    ratios = [c.ratio_median for c in report.costs if c.policy == policy and c.status == "ok" and c.ratio_median > 0]
+    machine = report.machine
+    load = f", load {machine['load_before_cost']:.1f}" if machine.get("load_before_cost") is not None else ""
+    cores = f"; {machine['cores']:.0f} cores{load}" if machine.get("cores") else ""
+    costs = (f"; it costs about {float(np.median(ratios)):.1f} times the program's plain loop (one step a frame: "
+             f"median over {len(ratios)} scene{'s' if len(ratios) != 1 else ''}{cores})") if ratios else ""
+    figure = next((path for scene in report.scenes for path in report.figures.get(scene, [])
+                   if path.name.startswith("deviation_") and path.suffix == ".png"), None)
+    return {"sentence": f"For these scenes ({', '.join(report.scenes)}), {what}. Use {policy}{costs}.",
+            "figure": embed(figure, "answer-figure") if figure else None}
+
+
 def as_html(report: Report, command: str, article_paths: list[Path]) -> str:
     """The whole page."""
     pngs = [p for p in article_paths if p.suffix == ".png"]
     return ENVIRONMENT.get_template("report.html").render(
         report=report, command=command,
-        recommendation=page.recommendation(report), code=code_to_write(report),
+        recommendation=page.recommendation(report), code=code_to_write(report), answer=answer(report),
         per_scene=[{**entry, "consistency": page.verdict(entry["consistency"]),
                     "deviation": page.verdict(entry["deviation"]), "cost": page.verdict(entry["cost"])}
                    for entry in page.per_scene(report)],

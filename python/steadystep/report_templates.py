@@ -32,6 +32,9 @@ pre { background: #f6f6f6; padding: 0.6em; } pre.code { overflow-x: auto; } .sma
 figure { margin: 0.5em 0 1.5em; }
 </style></head><body>
 <h1>steadystep: which constraint-softness policy, under variable frame times</h1>
+{% if answer %}<p id='answer'><b>{{ answer.sentence }}</b></p>
+{% if answer.figure %}<figure id='answer-picture'>{{ answer.figure }}</figure>{% endif %}
+{% endif %}
 <p>Every run is real ODE 0.16 (libode from Debian) stepped by libsteadystep: each scene under each frame-time profile
 ({{ report.profiles|join(", ") }}) and each policy, for {{ "%g"|format(report.duration_s) }} s, against a reference
 run (the same scene at a fixed 1/1000 s step, the article's mapping).</p>
@@ -68,6 +71,8 @@ whose steps follow the frames)</th><th>closest to the reference</th><th>cheapest
 <h2 id='animation'>Watch: the chain at 15-45 fps</h2>
 {{ animation }}
 {% endif %}
+<details id='measured'><summary><b>Everything measured</b>: consistency, deviation, the control ladder, where the
+mappings serve, cost, largest stable step, the article's figure, every scene and run</summary>
 <h2>Frame-rate consistency</h2>
 {{ table(consistency, "consistency") }}
 <p class=small>Consistency: each run's followed quantity minus the mean over the profiles of the same policy, RMS over
@@ -140,11 +145,13 @@ rows...), summed over the run's steps; - for policies that use implicit Euler th
 {% endfor %}
 {% endfor %}
 </section>
-<h2>Parameters</h2>
+</details>
+<details id='parameters'><summary><b>Parameters</b></summary>
 <p>duration {{ "%g"|format(report.duration_s) }} s simulated per run, profile seed {{ report.seed }}, profiles
 {{ report.profiles|join(", ") }}; stepping defaults: {{ stepping_defaults }} (policy set per run);
 reference: {{ reference_stepping }}, under {{ reference_profile }}.</p>
 {{ table({"header": ["scene", "parameters"], "rows": parameters}) }}
+</details>
 <h2>Regenerate</h2>
 <pre>{{ command }}</pre>
 <p class=small>Made in {{ "%.1f"|format(report.elapsed_s) }} s ({% for phase, seconds in phases.items() %}{{ phase }}

@@ -237,10 +237,10 @@ def test_the_animation_renders_and_moves(written, tmp_path):
     shots = []
     for budget in (300, 1500):
         shot = tmp_path / f"shot_{budget}.png"
-        _chromium(f"--virtual-time-budget={budget}", f"--screenshot={shot}", "--window-size=1400,2200", url,
+        _chromium(f"--virtual-time-budget={budget}", f"--screenshot={shot}", "--window-size=1400,3600", url,
                   tmp_path=tmp_path)
         shots.append(matplotlib.image.imread(shot))
-    assert shots[0].shape == shots[1].shape
+    assert shots[0].shape == shots[1].shape  # the whole page: the answer's picture comes before the animation
     changed = np.any(np.abs(shots[0] - shots[1]) > 0.05, axis=-1)
     rows = np.nonzero(changed.any(axis=1))[0]
     assert changed.sum() > 200, changed.sum()
@@ -356,3 +356,38 @@ def test_the_failures_in_a_panels_title_stay_within_the_panel():
     assert figures.failure_note({"broken": ["fixed:30"], "blow-up": ["hitch:60:30:0.1"]}, 5) == \
         "\nbroken: fixed:30; blow-up: hitch:60:30:0.1"
     assert all(len(line) <= 44 for line in figures.failure_note({"broken": profiles * 3}, 20).splitlines())
+
+
+def _measured(page: Path, tmp_path) -> dict:
+    """The page laid out by Chromium at 1400 px wide: its height, and where the answer and its picture end
+    (a copy of the page with a script that writes them into the DOM once it has loaded)."""
+    copy = page.with_name("measured.html")
+    copy.write_text(page.read_text().replace("</body>", """<script>
+window.addEventListener('load', function () {
+  const bottom = (id) => { const e = document.getElementById(id); return e ? e.getBoundingClientRect().bottom : -1; };
+  document.body.setAttribute('data-height', document.documentElement.scrollHeight);
+  document.body.setAttribute('data-answer-bottom', bottom('answer'));
+  document.body.setAttribute('data-figure-bottom', bottom('answer-figure'));
+});
+</script></body>"""))
+    dom = _chromium("--virtual-time-budget=1000", "--window-size=1400,900", "--dump-dom", copy.resolve().as_uri(),
+                    tmp_path=tmp_path).stdout
+    found = re.search(r'<body data-height="([\d.]+)" data-answer-bottom="([-\d.]+)" data-figure-bottom="([-\d.]+)"',
+                      dom)
+    assert found, dom[:500]
+    return {"height": float(found.group(1)), "answer": float(found.group(2)), "figure": float(found.group(3))}
+
+
+@needs_chromium
+def test_the_first_screen_answers_in_one_sentence_and_a_picture(written, tmp_path):
+    """Issue 28: at 1400 px wide the first 900 pixels hold the recommendation sentence and a figure, the details
+    are collapsed below, and the page is under 15,000 pixels tall."""
+    page = written[0].read_text()
+    sentence = re.search(r"<p id='answer'><b>(.*?)</b></p>", page, re.S)
+    text = html.unescape(sentence.group(1)) if sentence else ""
+    assert "For these scenes (chain, stack)" in text and " Use " in text, text
+    assert re.search(r"it costs about [\d.]+ times the program's plain loop .*2 cores, load [\d.]+\)\.$", text), text
+    measured = _measured(written[0], tmp_path)
+    assert 0 < measured["answer"] <= 900 and 0 < measured["figure"] <= 900, measured
+    assert measured["height"] < 15000, measured
+    assert "<details id='measured'>" in page and "<details id='parameters'>" in page
