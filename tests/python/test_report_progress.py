@@ -87,3 +87,24 @@ def test_cores_and_load_are_recorded_beside_the_timings(tmp_path):
     page = (out / "report.html").read_text()
     assert page.count(f"{machine['cores']} cores ({machine['usable_cores']} usable), load ") == 2  # cost, foot
     assert "alone on the machine" not in page
+
+
+def test_scripts_report_says_where_the_environment_and_build_are(tmp_path):
+    """scripts/report in a copy of the tree whose deps.sh takes a while and whose steadystep only records its
+    arguments: off a terminal it writes the environment phase's start, a line every STEADYSTEP_PROGRESS_S while
+    deps.sh works, its end, then runs compare once (the article's figure with it) into its own report/."""
+    (tmp_path / "scripts").mkdir()
+    (tmp_path / "scripts" / "report").write_text((REPO / "scripts" / "report").read_text())
+    (tmp_path / "scripts" / "deps.sh").write_text("sleep 1.2\n")
+    (tmp_path / ".venv" / "bin").mkdir(parents=True)
+    fake = tmp_path / ".venv" / "bin" / "steadystep"
+    fake.write_text(f"#!/bin/sh\necho \"$@\" >> {tmp_path / 'calls'}\n")
+    fake.chmod(0o755)
+    done = subprocess.run(["bash", str(tmp_path / "scripts" / "report"), "--scenes", "chain"], capture_output=True,
+                          text=True, timeout=60, env={**os.environ, "STEADYSTEP_PROGRESS_S": "0.3"})
+    assert done.returncode == 0, done.stderr
+    lines = done.stderr.splitlines()
+    assert lines[0].startswith("steadystep report [environment, build] started")
+    assert sum("[environment, build] still working" in line for line in lines) >= 2, lines
+    assert lines[-1].startswith("steadystep report [environment, build] done in")
+    assert (tmp_path / "calls").read_text().splitlines() == [f"compare --force --out {tmp_path / 'report'} --scenes chain"]
