@@ -199,6 +199,13 @@ static ssStatus followProgram(ssStepper* stepper, ssFrameReport* report);
 static void restoreTuned(ssStepper* stepper) {
   ssRegistry* registry = stepper->def.registry;
   if (stepper->def.space == 0 || registry == NULL || forgetDestroyed(stepper, 1) != SS_OK) return;
+  /* and whatever the joints' signatures told: only joints attached to a body on the known list are written (the
+   * list as it is, not built again: building it reads every bound joint) */
+  ssPointerSet alive = {NULL, 0, 0};
+  ssStatus listed = ssKnownCollectJoints(&stepper->known, &alive);
+  if (listed == SS_OK) ssRegistryUnbindJointsNotIn(registry, &alive);
+  ssPointerSetFree(&alive);
+  if (listed != SS_OK) return;
   ssFrameReport unused = {0};
   if (followProgram(stepper, &unused) != SS_OK) return; /* a value no spring stands for: left as the program set it */
   ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, stepper->tuned_step_s, 0, NULL);
