@@ -260,7 +260,12 @@ static void replaceStepper(Program* p) {
   def.registry = w->registry;
   def.contact_group = w->contacts;
   def.stepping = w->stepping;
+  /* the world may have been adopted since the first stepper was made: one made now freezes at the tuned step, since
+   * any other frozen step is refused (stepping.h) */
+  if (def.stepping.frozen_step_s > 0 && ssRegistry_TunedStep(def.registry) > 0)
+    def.stepping.frozen_step_s = SS_FROZEN_AT_TUNED_STEP;
   FUZZ_REQUIRE(ssStepper_Create(&def, &w->stepper) == SS_OK, "a stepper like the destroyed one: %s", ssLastError());
+  w->stepping = ssStepper_Stepping(w->stepper);
   for (int k = 0; k < ISLAND_COUNT; ++k)
     for (int i = 0; i < w->islands[k].body_count; ++i)
       FUZZ_REQUIRE(ssStepper_WatchBody(w->stepper, w->islands[k].bodies[i]) == SS_OK, "watch: %s", ssLastError());
