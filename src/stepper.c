@@ -236,14 +236,33 @@ void ssStepper_Destroy(ssStepper* stepper) {
   return ssFail(SS_ERROR_REENTERED, "%s: called from a callback of the same stepper, inside its frame (%s)", \
                 what, "call it between frames")
 
+/* Whether the program watches body. */
+static int watched(const ssStepper* stepper, dBodyID body) {
+  for (int i = 0; i < stepper->watched_count; ++i)
+    if (stepper->watched[i] == body) return 1;
+  return 0;
+}
+
+/* A body the program destroyed with ODE's own calls (or that lost its geom in the adopted spaces, or that
+ * the program destroys through the stepper): forgotten by the
+ * known list, the watch list, the registry and the pose history, by its address alone. */
+static void forgetBody(ssStepper* stepper, dBodyID body) {
+  for (int i = 0; i < stepper->watched_count; ++i)
+    if (stepper->watched[i] == body) stepper->watched[i--] = stepper->watched[--stepper->watched_count];
+  ssRegistry* registry = stepper->def.registry;
+  if (registry != NULL && ssRegistryHasBody(registry, body)) ssRegistry_UnbindBody(registry, body);
+  ssKnownForget(&stepper->known, body);
+  ssPoseHistoryForgetBody(stepper->poses, body);
+  stepper->watched_generation += 1;
+}
+
 ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body) {
   REQUIRE_STEPPER(stepper);
   if (body == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "body = NULL: a body is required");
   if (dBodyGetWorld(body) != stepper->def.world)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "body %p: of another world (%p), not the stepper's (%p)", (void*)body,
                   (void*)dBodyGetWorld(body), (void*)stepper->def.world);
-  for (int i = 0; i < stepper->watched_count; ++i)
-    if (stepper->watched[i] == body) return SS_OK;
+  if (watched(stepper, body)) return SS_OK;
   if (!ssReserveOne((void**)&stepper->watched, stepper->watched_count, &stepper->watched_capacity, sizeof body))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory watching a body");
   stepper->watched[stepper->watched_count++] = body;
@@ -280,22 +299,16 @@ ssStatus ssStepper_UnwatchBody(ssStepper* stepper, dBodyID body) {
 ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body) {
   REQUIRE_STEPPER(stepper);
   if (body == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "body = NULL: a body is required");
-  for (int i = 0; i < stepper->watched_count; ++i)
-    if (stepper->watched[i] == body) stepper->watched[i--] = stepper->watched[--stepper->watched_count];
   ssRegistry* registry = stepper->def.registry;
-  if (registry != NULL) {
-    if (ssRegistryHasBody(registry, body)) ssRegistry_UnbindBody(registry, body);
-    /* ODE leaves the body's joints detached on one side, where some of its getters assert: they are unbound */
-    for (int i = dBodyGetNumJoints(body) - 1; i >= 0; --i) {
-      dJointID joint = dBodyGetJoint(body, i);
-      if (ssRegistryHasJoint(registry, joint)) ssRegistry_UnbindJoint(registry, joint);
-    }
+  /* ODE leaves the body's joints detached on one side, where some of its getters assert: they are unbound */
+  for (int i = registry != NULL ? dBodyGetNumJoints(body) - 1 : -1; i >= 0; --i) {
+    dJointID joint = dBodyGetJoint(body, i);
+    if (ssRegistryHasJoint(registry, joint)) ssRegistry_UnbindJoint(registry, joint);
   }
-  ssKnownForget(&stepper->known, body); /* at once: inside a frame, the next check must not read it */
+  forgetBody(stepper, body); /* at once: inside a frame, the next check must not read it */
   /* a box spawned in its place leaves a space's count as it was, and may take its geom's or its own address: the
    * spaces are walked again before the next step */
   if (stepper->space_count > 0) stepper->spaces[0].geoms = -1;
-  ssPoseHistoryForgetBody(stepper->poses, body);
   dBodyDestroy(body);
   return SS_OK;
 }
@@ -435,12 +448,6 @@ static ssStatus adoptBody(ssStepper* stepper, dBodyID body) {
   return status;
 }
 
-static int watched(const ssStepper* stepper, dBodyID body) {
-  for (int i = 0; i < stepper->watched_count; ++i)
-    if (stepper->watched[i] == body) return 1;
-  return 0;
-}
-
 /* With def.space: adopts every known body that the registry has not (one reached through a joint made since), with
  * its joints, so that no body joined to the adopted ones steps with the softness the program tuned for one step.
  * Watched bodies are the program's to adopt or not (ssRegistry_AdoptBody): unwatched, they are known no more. */
@@ -522,18 +529,6 @@ static ssStatus listSpaces(ssStepper* stepper, ssPointerSet* live) {
   return SS_OK;
 }
 
-/* A body the program destroyed with ODE's own calls (or that lost its geom in the adopted spaces): forgotten by the
- * known list, the watch list, the registry and the pose history, by its address alone. */
-static void forgetBody(ssStepper* stepper, dBodyID body) {
-  for (int i = 0; i < stepper->watched_count; ++i)
-    if (stepper->watched[i] == body) stepper->watched[i--] = stepper->watched[--stepper->watched_count];
-  ssRegistry* registry = stepper->def.registry;
-  if (registry != NULL && ssRegistryHasBody(registry, body)) ssRegistry_UnbindBody(registry, body);
-  ssKnownForget(&stepper->known, body);
-  ssPoseHistoryForgetBody(stepper->poses, body);
-  stepper->watched_generation += 1;
-}
-
 /* What the program destroyed with ODE's own calls since the last look, found by reading only what is alive:
  *  - from the adopted spaces (alive while def.space is), when they changed: bodies that had a geom there and have
  *    none now were destroyed with their geoms (or lost them), and are forgotten; the bodies there now are kept for
@@ -587,7 +582,6 @@ static ssStatus adoptAnchored(ssStepper* stepper) {
  * spaces, and with look_at_joints the joints attached to known bodies (and the bodies beyond them). */
 static ssStatus findNew(ssStepper* stepper, int look_at_joints) {
   ssStatus status = forgetDestroyed(stepper, look_at_joints);
-  if (status == SS_OK) status = refreshKnown(stepper);
   if (status == SS_OK && stepper->adopt_anchored_due) status = adoptAnchored(stepper);
   if (status == SS_OK) status = refreshKnown(stepper);
   if (status == SS_OK && stepper->adopt_known_due) status = adoptKnown(stepper);
