@@ -451,35 +451,28 @@ def _become_subreaper() -> None:
         ctypes.CDLL(None, use_errno=True).prctl(36, 1, 0, 0, 0)
 
 
-def _children() -> set[int]:
-    """This process's children (from /proc)."""
-    me, found = os.getpid(), set()
+def _process_stats():
+    """Every live process as (pid, the fields of /proc/PID/stat after its name: state, ppid, pgrp, ...)."""
     for entry in os.scandir("/proc"):
         if not entry.name.isdigit():
             continue
         try:
-            fields = Path(entry.path, "stat").read_text().rsplit(")", 1)[1].split()
+            yield int(entry.name), Path(entry.path, "stat").read_text().rsplit(")", 1)[1].split()
         except (OSError, IndexError):
             continue
-        if int(fields[1]) == me:
-            found.add(int(entry.name))
-    return found
+
+
+def _children() -> set[int]:
+    """This process's children (from /proc)."""
+    me = os.getpid()
+    return {pid for pid, fields in _process_stats() if int(fields[1]) == me}
 
 
 def _group_cpu_s(group: int) -> float | None:
     """CPU time (s) of every live process of a process group, from /proc."""
-    total, ticks, seen = 0.0, os.sysconf("SC_CLK_TCK"), False
-    for entry in os.scandir("/proc"):
-        if not entry.name.isdigit():
-            continue
-        try:
-            fields = Path(entry.path, "stat").read_text().rsplit(")", 1)[1].split()
-        except (OSError, IndexError):
-            continue
-        if int(fields[2]) == group:
-            seen = True
-            total += (int(fields[11]) + int(fields[12])) / ticks
-    return total if seen else None
+    ticks = os.sysconf("SC_CLK_TCK")
+    times = [(int(fields[11]) + int(fields[12])) / ticks for _, fields in _process_stats() if int(fields[2]) == group]
+    return sum(times) if times else None
 
 
 def _kill_leftovers(before: set[int], group: int) -> None:
