@@ -1,5 +1,6 @@
 # Sourced by scripts/test and scripts/report: installs what the project needs on a fresh Debian machine.
-# As root it installs missing Debian packages with apt-get; otherwise it prints the exact command and stops.
+# As root it installs missing Debian packages with apt-get; otherwise it prints one line naming them and the exact
+# command, and exits 2 (tests/python/test_deps_script.py).
 # Then it makes the Python virtual environment .venv under the repository and installs the package into it.
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -29,9 +30,10 @@ if [ ${#missing[@]} -gt 0 ]; then
     apt-get update -qq
     apt-get install -y -qq "${missing[@]}" >/dev/null
   else
-    echo "steadystep: missing Debian packages. Run this, then run me again:" >&2
-    echo "  sudo apt-get install -y ${missing[*]}" >&2
-    exit 1
+    # One line, naming the packages and the command; exit 2, as every error that names its fix (issue 28).
+    echo "steadystep: missing Debian packages ${missing[*]}: run 'sudo apt-get install -y ${missing[*]}' (as root)," \
+         "then run me again" >&2
+    exit 2
   fi
 fi
 
