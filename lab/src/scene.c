@@ -161,6 +161,12 @@ static void sceneStepDone(void* context, double step_s) {
   if (scene->observer != NULL) scene->observer(scene->observer_context, scene, step_s);
 }
 
+/* The stepper's before_step: the scene's per-step input for the step about to be taken. */
+static void sceneBeforeStep(void* context, ssStepper* stepper) {
+  ssScene* scene = context;
+  scene->desc->drive(scene->state, ssStepper_CurrentStep(stepper).step_s);
+}
+
 static void freeWorld(ssSceneWorld* parts) {
   ssStepper_Destroy(parts->stepper);
   ssRegistry_Destroy(parts->registry);
@@ -180,8 +186,8 @@ static ssStatus makeStepper(ssScene* scene, const ssStepping* stepping) {
     def.stepping.frozen_step_s = SS_FROZEN_AT_TUNED_STEP;
   def.stepping.max_speed = fmin(stepping->max_speed > 0 ? stepping->max_speed : SS_MAX_SAFE_SPEED,
                                 SS_SCENE_MAX_SPEED_M_PER_S);
-  def.before_step = scene->desc->before_step;
-  def.before_step_context = scene->state;
+  def.before_step = scene->desc->drive != NULL ? sceneBeforeStep : NULL;
+  def.before_step_context = scene;
   def.collide = scene->desc->collide;
   def.collide_context = scene->state;
   def.step_done = sceneStepDone;
@@ -308,16 +314,55 @@ void ssScenePointOnBody(const ssStepper* drawn_by, dBodyID body, const double re
   for (int k = 0; k < 3; ++k) out[k] = position[k] + r[k][0] * rel[0] + r[k][1] * rel[1] + r[k][2] * rel[2];
 }
 
-static double nowSeconds(void) {
+/* The enabled bodies of space's geoms (and of its nested spaces'), each counted once: a body with several geoms is
+ * counted at its first geom in the walk (seen[], of at most capacity bodies; past it a body may count twice). */
+static int awakeIn(dSpaceID space, dBodyID* seen, int* seen_count, int capacity) {
+  int awake = 0;
+  int geoms = dSpaceGetNumGeoms(space);
+  for (int i = 0; i < geoms; ++i) {
+    dGeomID geom = dSpaceGetGeom(space, i);
+    if (dGeomIsSpace(geom)) {
+      awake += awakeIn((dSpaceID)geom, seen, seen_count, capacity);
+      continue;
+    }
+    dBodyID body = dGeomGetBody(geom);
+    if (body == 0) continue;
+    int known = 0;
+    for (int j = 0; j < *seen_count && !known; ++j) known = seen[j] == body;
+    if (known) continue;
+    if (*seen_count < capacity) seen[(*seen_count)++] = body;
+    awake += dBodyIsEnabled(body) != 0;
+  }
+  return awake;
+}
+
+int ssScene_AwakeBodies(const ssScene* scene) {
+  if (scene == NULL) {
+    ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to count the awake bodies of");
+    return -1;
+  }
+  enum { SEEN_CAPACITY = 4096 };
+  dBodyID* seen = malloc(SEEN_CAPACITY * sizeof *seen);
+  int seen_count = 0;
+  int awake = awakeIn(scene->parts.space, seen, &seen_count, seen != NULL ? SEEN_CAPACITY : 0);
+  free(seen);
+  return awake;
+}
+
+/* The calling thread's CPU time (s): what the timed frames cost this thread, not what other work on a shared machine
+ * took from it meanwhile (wall time would count that too). */
+static double threadCpuSeconds(void) {
   struct timespec now;
-  clock_gettime(CLOCK_MONOTONIC, &now);
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
   return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
 }
 
-/* What a program without the library does each frame: collide, one step of the whole frame, empty the contacts.
- * Softness stays as the stepper last wrote it; the contacts are softened as for the stepper's last step. */
+/* What a program without the library does each frame: its per-step input (the stack's push, the piston's motor)
+ * for the frame's one step, collide, one step of the whole frame, empty the contacts. Softness stays as the stepper
+ * last wrote it; the contacts are softened as for the stepper's last step. */
 static ssStatus plainFrame(ssScene* scene, double frame_s) {
   const ssSceneWorld* parts = &scene->parts;
+  if (scene->desc->drive != NULL) scene->desc->drive(scene->state, frame_s);
   if (scene->desc->collide != NULL) scene->desc->collide(scene->state, parts->stepper);
   if (ssStepper_Stepping(parts->stepper).solver == SS_SOLVER_STEP) {
     dWorldStep(parts->world, frame_s);
@@ -335,10 +380,10 @@ static ssStatus plainFrame(ssScene* scene, double frame_s) {
   return SS_OK;
 }
 
-ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, int count, int plain, double* wall_s) {
-  if (scene == NULL || frames_s == NULL || wall_s == NULL)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_TimeFrames needs a scene, frames and wall_s",
-                  scene == NULL ? "scene" : frames_s == NULL ? "frames_s" : "wall_s");
+ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, int count, int plain, double* cpu_s) {
+  if (scene == NULL || frames_s == NULL || cpu_s == NULL)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_TimeFrames needs a scene, frames and cpu_s",
+                  scene == NULL ? "scene" : frames_s == NULL ? "frames_s" : "cpu_s");
   if (count < 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "count = %d: must not be negative", count);
   if (plain != 0 && plain != 1) return ssFail(SS_ERROR_OUT_OF_RANGE, "plain = %d: must be 0 or 1", plain);
   if (plain && scene->counters.frames == 0)
@@ -350,7 +395,7 @@ ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, int count, i
                     frames_s[i], SS_MIN_STEP_S, SS_MAX_STEP_S);
   ssEnsureOde();
   ssStatus status = SS_OK;
-  double start_s = nowSeconds();
+  double start_s = threadCpuSeconds();
   if (plain) {
     dRandSetSeed(scene->ode_random_seed);
     for (int i = 0; status == SS_OK && i < count; ++i) status = plainFrame(scene, frames_s[i]);
@@ -360,7 +405,7 @@ ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, int count, i
     for (int i = 0; status == SS_OK && i < count; ++i) status = ssScene_Frame(scene, frames_s[i], NULL);
     scene->timing = 0;
   }
-  *wall_s = nowSeconds() - start_s;
+  *cpu_s = threadCpuSeconds() - start_s;
   return status;
 }
 

@@ -35,9 +35,12 @@ typedef struct ssSceneDesc {
   ssStatus (*build)(const ssSceneWorld* world, const ssSceneParams* params, void** state);
   /* Registers with the stepper the bodies the registry does not watch already (free bodies). May be NULL. */
   ssStatus (*watch)(void* state, ssStepper* stepper);
-  /* The stepper's before_step callback: forces that follow the state or the time (a push, a motor's drive). May be
-   * NULL. */
-  ssStepCallback* before_step;
+  /* The program's per-step input: forces or targets that follow the state or the time (a push, a motor's drive),
+   * for a step of step_s seconds about to be taken; the scene keeps its own clock, moved on by step_s. Called before
+   * every physics step (through the stepper's before_step, with ssStepper_CurrentStep's step_s) and before every
+   * plain frame of ssScene_TimeFrames (with the frame's length: a program without the library gives its input
+   * before each of its steps too, so that the cost benchmark compares like with like). May be NULL. */
+  void (*drive)(void* state, double step_s);
   /* The stepper's collide callback: create contacts for the stepper's current step. May be NULL. */
   ssStepCallback* collide;
   /* The followed quantities after a step, info.quantity_count of them. */

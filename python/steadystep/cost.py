@@ -6,12 +6,17 @@ For each scene and policy three copies of the scene step the same frame times (a
 - as plain ODE at the stepper's own steps: one dWorldQuickStep per step the stepper takes, no library call in
   between (every softness as the stepper last wrote it). The ratio of the two is what the library itself costs;
 - as a program without the library: one dWorldQuickStep of each whole frame, every softness as the naive policy
-  wrote it at its first frame (tuned once for 30 fps). The ratio to it is what a frame costs the program,
-  substeps included.
+  wrote it at its first frame (tuned once for 30 fps), its per-step input given before each step as the stepper
+  gives it (the stack's push, the piston's motor: ssScene_TimeFrames), so that it moves, and falls asleep, as the
+  program does. The ratio to it is what a frame costs the program, substeps included.
 The copies take the frames in blocks, the order of the three rotating from block to block so that all see the same
 machine at the same moments; each ratio is taken per block, and the median and range over the blocks are reported
-(as bench/bench_stepper.c does in C). The timing loop runs in C (ssScene_TimeFrames), so that Python's call overhead
-is not measured.
+(as bench/bench_stepper.c does in C). A ratio counts only blocks that compare like with like: before and after the
+block both of its copies had as many bodies awake (ssScene_AwakeBodies). In a scene with auto-disable (stack, wall)
+a copy that fell asleep steps for almost nothing; against one that did not, its ratio would measure the sleep, not
+the stepping. A ratio with no such block is not given (nan, ratio_blocks 0). The timing loop runs in C (ssScene_TimeFrames), so that Python's call overhead
+is not measured, and times the thread's CPU (CLOCK_THREAD_CPUTIME_ID), so that other work on a shared machine does
+not count; the page records the cores and the load beside it (report_html.machine_line).
 
 What the copies step is fixed before any of them is timed, by plan(): the block's length (frames that take about
 BLOCK_TARGET_S plain), the frames, and the stepper's steps over them, counted on a fourth, untimed copy that steps
@@ -54,16 +59,19 @@ class Cost:
     profile: str
     frames_per_block: int
     repeats: int              # the blocks measured (fewer than asked for when the ranges were tight: TIGHT_RANGE)
-    ratio_median: float       # policy wall time / the program's plain frames, median over the blocks
+    ratio_median: float       # policy CPU time / the program's plain frames, median over the blocks
     ratio_low: float          # the smallest and largest of that ratio over the blocks
     ratio_high: float
-    us_per_frame: float       # the policy's median wall time per frame (µs)
-    plain_us_per_frame: float # the program's plain ODE, one step a frame: median wall time per frame (µs)
+    us_per_frame: float       # the policy's median CPU time per frame (µs, this thread's)
+    plain_us_per_frame: float # the program's plain ODE, one step a frame: median CPU time per frame (µs)
     steps_per_frame: float    # the policy's physics steps per frame in the benchmark
-    overhead_median: float = math.nan  # policy wall time / plain ODE at the stepper's own steps, median
+    overhead_median: float = math.nan  # policy CPU time / plain ODE at the stepper's own steps, median
     overhead_low: float = math.nan     # the smallest and largest of that ratio over the blocks
     overhead_high: float = math.nan
     status: str = "ok"        # "ok", or why the measurement stopped (a blow-up of a copy)
+    ratio_blocks: int = 0     # the blocks in ratio_*: those after which the policy's copy and the program's had as
+                              # many bodies awake as before them (like with like: neither alone fell asleep)
+    overhead_blocks: int = 0  # the blocks in overhead_*, by the same rule for the copy at the stepper's own steps
 
 
 def _steps_of(counter: runs.Scene, stepping: dict, frames: np.ndarray) -> np.ndarray:
@@ -144,6 +152,13 @@ def _tight(ratios: list[float], within: float) -> bool:
     return math.isfinite(middle) and max(ratios) - min(ratios) <= within * middle
 
 
+def _summary(ratios: list[float]) -> tuple[float, float, float]:
+    """(median, smallest, largest) of the blocks' ratios; nan for none."""
+    if not ratios:
+        return math.nan, math.nan, math.nan
+    return statistics.median(ratios), min(ratios), max(ratios)
+
+
 def time_plan(planned: Plan, tight_range: float = TIGHT_RANGE) -> Cost:
     """The benchmark of a plan (made here or elsewhere): the policy and two plain copies of its scene step its
     blocks, each timed, the order of the three rotating; it stops after the first MIN_REPEATS blocks (a rotation)
@@ -168,8 +183,9 @@ def time_plan(planned: Plan, tight_range: float = TIGHT_RANGE) -> Cost:
         same_steps.time_frames(planned.warmup_steps, plain=True)
         stepped.time_frames(planned.warmup_frames)
         steps_before = stepped.counters()["steps"]
-        walls = {"policy": [], "same": [], "program": []}
+        cpu = {"policy": [], "same": [], "program": []}
         ratios, overheads = [], []
+        awake = [copy.awake_bodies() for copy in copies]
         for r in range(repeats):
             chunk = planned.frames[r * block:(r + 1) * block]
             steps = planned.block_steps[r]
@@ -178,17 +194,21 @@ def time_plan(planned: Plan, tight_range: float = TIGHT_RANGE) -> Cost:
                      "program": lambda: program.time_frames(chunk, plain=True)}
             order = list(timed)[r % 3:] + list(timed)[:r % 3]
             for name in order:
-                walls[name].append(timed[name]())
-            ratios.append(walls["policy"][-1] / walls["program"][-1] if walls["program"][-1] > 0 else math.inf)
-            overheads.append(walls["policy"][-1] / walls["same"][-1] if walls["same"][-1] > 0 else math.inf)
+                cpu[name].append(timed[name]())
+            before, awake = awake, [copy.awake_bodies() for copy in copies]
+            if before[0] == before[2] and awake[0] == awake[2]:  # the policy's copy and the program's alike
+                ratios.append(cpu["policy"][-1] / cpu["program"][-1] if cpu["program"][-1] > 0 else math.inf)
+            if before[0] == before[1] and awake[0] == awake[1]:  # and the copy at the stepper's own steps
+                overheads.append(cpu["policy"][-1] / cpu["same"][-1] if cpu["same"][-1] > 0 else math.inf)
             measured = r + 1
-            if measured == MIN_REPEATS and _tight(ratios, tight_range) and _tight(overheads, tight_range):
+            if (measured == MIN_REPEATS and len(ratios) == len(overheads) == measured
+                    and _tight(ratios, tight_range) and _tight(overheads, tight_range)):
                 break  # checked once: more blocks only widen a range
         steps = stepped.counters()["steps"] - steps_before
-        return Cost(scene, policy, profile, block, measured, statistics.median(ratios), min(ratios), max(ratios),
-                    1e6 * statistics.median(walls["policy"]) / block,
-                    1e6 * statistics.median(walls["program"]) / block, steps / (block * measured),
-                    statistics.median(overheads), min(overheads), max(overheads))
+        ratio, overhead = _summary(ratios), _summary(overheads)
+        return Cost(scene, policy, profile, block, measured, *ratio, 1e6 * statistics.median(cpu["policy"]) / block,
+                    1e6 * statistics.median(cpu["program"]) / block, steps / (block * measured), *overhead,
+                    ratio_blocks=len(ratios), overhead_blocks=len(overheads))
     except SteadystepError as error:
         failed.status = f"{error.status}: {error.message}"
         return failed

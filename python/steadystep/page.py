@@ -11,7 +11,7 @@ and links to the table or figure that shows it. The needs it answers:
 - accuracy: closest to the exact solution (the oscillator at 15-45 fps) and to the fine-step reference (the
   deviation, RMS over profiles);
 - where the accurate mappings serve: the share of rows and contacts they served, and what fell back;
-- cost: wall time against plain ODE in one interleaved benchmark (cost.py);
+- cost: CPU time against plain ODE in one interleaved benchmark (cost.py);
 - the largest stable step (probe.py);
 and which policies failed (blew up or broke) on some run. The section ends with the lines of code to write for the
 policy its first line recommends (code_policy, steadystep.snippets): the one with the same motion under every

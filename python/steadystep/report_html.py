@@ -155,17 +155,32 @@ def _blocks(costs) -> str:
     return f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
 
 
+NOT_ALIKE = "not like with like"
+
+
+def _ratio_cells(ok: bool, median: float, low: float, high: float, blocks: int, measured: int,
+                 digits: int = 3) -> list:
+    """A ratio's median and range over the blocks it counts (cost.py: those whose two copies had as many bodies
+    awake before and after); "not like with like" where no block did, the count where only some did."""
+    if not ok:
+        return ["-", "-"]
+    if blocks == 0 or not math.isfinite(median):
+        return [Markup("<span title='{}'>{}</span>").format(
+            "one copy fell asleep (auto-disable) and the other did not, in every block", NOT_ALIKE), "-"]
+    spread = f"{number(low, digits)} – {number(high, digits)}"
+    return [f"×{number(median, digits)}", spread + (f" ({blocks} of {measured} blocks)" if blocks < measured else "")]
+
+
 def cost_table(report: Report) -> dict:
     rows = []
     for c in report.costs:
         ok = c.status == "ok"
         rows.append([c.scene, policy_cell(c.policy), str(c.repeats) if ok else "-", number(c.steps_per_frame),
-                     number(c.us_per_frame) if ok else bad(c.status),
-                     f"×{number(c.ratio_median)}" if ok else "-",
-                     f"{number(c.ratio_low)} – {number(c.ratio_high)}" if ok else "-",
-                     f"×{number(c.overhead_median, 4)}" if ok else "-",
-                     f"{number(c.overhead_low, 4)} – {number(c.overhead_high, 4)}" if ok else "-"])
-    return {"header": ["scene", "policy", "blocks", "steps / frame", "µs / frame",
+                     number(c.us_per_frame) if ok else bad(c.status)]
+                    + _ratio_cells(ok, c.ratio_median, c.ratio_low, c.ratio_high, c.ratio_blocks, c.repeats)
+                    + _ratio_cells(ok, c.overhead_median, c.overhead_low, c.overhead_high, c.overhead_blocks,
+                                   c.repeats, 4))
+    return {"header": ["scene", "policy", "blocks", "steps / frame", "CPU µs / frame",
                        "per frame / program's own (median)", "range over blocks",
                        "library: / plain ODE at the same steps (median)", "range over blocks"],
             "rows": rows}

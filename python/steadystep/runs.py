@@ -351,6 +351,11 @@ class Scene:
         parameter sets written (row_writes)."""
         return _as_dict(lib.ssScene_Counters(self._handle()))
 
+    def awake_bodies(self) -> int:
+        """The scene's bodies that are awake now (ssScene_AwakeBodies: dBodyIsEnabled, each body its space reaches
+        counted once); scenes with auto-disable (stack, wall) fall asleep at rest."""
+        return int(lib.ssScene_AwakeBodies(self._handle()))
+
     def points(self, interpolated: bool = False) -> np.ndarray:
         """The scene's drawing now (ssScene_Points): an (n, 3) array of polyline points in m; (0, 3) when the scene
         has none (only the chain has one). interpolated: on the poses the stepper gives to draw
@@ -362,14 +367,15 @@ class Scene:
         return np.frombuffer(ffi.buffer(xyz, 3 * count * ffi.sizeof("double")), dtype=np.float64).reshape(count, 3).copy()
 
     def time_frames(self, frames_s, plain: bool = False) -> float:
-        """Steps the frames (s each) and returns the wall-clock seconds they took (ssScene_TimeFrames): through the
+        """Steps the frames (s each) and returns the CPU seconds they took on this thread (ssScene_TimeFrames,
+        CLOCK_THREAD_CPUTIME_ID: other work on the machine does not count): through the
         stepper, or plain (one dWorldQuickStep a frame, softness as last written; needs one frame() first). Raises
         SteadystepError named by the library (a bad frame, a plain frame before any frame(), a blow-up)."""
         frames = np.ascontiguousarray(frames_s, dtype=np.float64)
-        wall = ffi.new("double*")
+        cpu = ffi.new("double*")
         check(lib.ssScene_TimeFrames(self._handle(), ffi.cast("const double*", ffi.from_buffer(frames)),
-                                     len(frames), int(bool(plain)), wall))
-        return wall[0]
+                                     len(frames), int(bool(plain)), cpu))
+        return cpu[0]
 
     def close(self) -> None:
         """Destroys the scene and its ODE world now rather than at garbage collection."""

@@ -42,3 +42,21 @@ def test_the_timing_stops_early_only_after_a_whole_rotation_whose_ranges_are_tig
 def test_measure_is_its_plan_timed():
     measured = cost.measure("buggy", "naive", repeats=3)
     assert measured.status == "ok" and measured.repeats == 3 and measured.steps_per_frame == 1.0
+
+
+def test_a_ratio_counts_only_the_blocks_whose_copies_sleep_alike():
+    """Issue 28: the stack's plain copy, not pushed, fell asleep while the library's did not ("library ×77"). Now the
+    plain copies are pushed as the stepper pushes, and a block counts only when both copies of a ratio have as many
+    bodies awake before and after it: under fixed 1/60 s steps the stack falls asleep after its push (3 s), the
+    program's whole 15-45 fps frames keep four of its boxes awake, so the later blocks of that ratio are left out;
+    the copy at the stepper's own steps sleeps with it, so every block of that ratio counts. The chain has nothing
+    to fall asleep: every block counts."""
+    stack = cost.time_plan(cost.plan("stack", "fixed", repeats=7), tight_range=0.0)
+    assert stack.status == "ok" and stack.repeats == 7
+    assert stack.ratio_blocks < 7 and stack.overhead_blocks == 7
+    if stack.ratio_blocks:  # how many of the first blocks the program's copy kept all six awake: the machine's speed
+        assert stack.ratio_low <= stack.ratio_median <= stack.ratio_high
+    else:
+        assert math.isnan(stack.ratio_median)  # no block like with like: no ratio, rather than a wrong one
+    chain = cost.time_plan(cost.plan("chain", "fixed", repeats=3), tight_range=0.0)
+    assert chain.ratio_blocks == chain.overhead_blocks == 3

@@ -47,22 +47,65 @@ def test_the_chain_is_drawn_as_links_of_its_length_hanging_from_the_pivot():
     oscillator.close()
 
 
-def test_plain_frames_are_naive_frames_without_the_stepper():
-    # naive writes the same softness (frozen at 1/30 s) before each whole-frame step: stepping the world plain after
-    # its first frame must give the same motion.
-    frames = frame_times("uniform:15:45", 40, 7)
-    stepped, plain = runs.Scene("oscillator", "naive"), runs.Scene("oscillator", "naive")
+@pytest.mark.parametrize("scene", ["oscillator", "stack", "piston"])
+def test_plain_frames_are_naive_frames_without_the_stepper(scene):
+    # naive writes the same softness (frozen at its tuned step) before each whole-frame step: stepping the world plain
+    # after its first frame must give the same motion, the per-step input included (issue 28: the stack's plain copy
+    # was not pushed, nor the piston's motor reversed, so the cost benchmark compared a pushed tower with one asleep).
+    frames = frame_times("uniform:15:45", 200, 7)  # 6 s: the stack's push (3 s), the piston's reversals
+    stepped, plain = runs.Scene(scene, "naive"), runs.Scene(scene, "naive")
     try:
         stepped.frame(frames[0])
         plain.frame(frames[0])
         stepped.time_frames(frames[1:])
         plain.time_frames(frames[1:], plain=True)
         assert stepped.time_s == pytest.approx(plain.time_s, rel=1e-12)
-        assert stepped.sample()["x"] == pytest.approx(plain.sample()["x"], rel=1e-9, abs=1e-12)
+        for name, value in stepped.sample().items():
+            assert plain.sample()[name] == pytest.approx(value, rel=1e-9, abs=1e-12), name
         assert plain.counters()["frames"] == 1 and stepped.counters()["frames"] == len(frames)
+        assert plain.awake_bodies() == stepped.awake_bodies()
     finally:
         stepped.close()
         plain.close()
+
+
+def test_awake_bodies_counts_what_auto_disable_put_to_sleep():
+    """The stack (auto-disable tuned at 1/60 s) falls asleep under fixed 1/60 s steps once its push stops at 3 s;
+    the buggy (no auto-disable: a chassis, four wheels, each with geoms) never does; every body counted once, those
+    without a geom not at all (the chain's links are reached by no geom)."""
+    frames = frame_times("fixed:30", 300, 1)  # 10 s
+    stack, chain = runs.Scene("stack", "fixed"), runs.Scene("buggy", "fixed")
+    try:
+        assert stack.awake_bodies() == 6 and chain.awake_bodies() == 5
+        unseen = runs.Scene("chain", "fixed")
+        assert unseen.awake_bodies() == 0
+        unseen.close()
+        for frame_s in frames[:60]:  # 2 s: pushed, awake
+            stack.frame(frame_s)
+        assert stack.awake_bodies() == 6
+        stack.time_frames(frames[60:])
+        chain.time_frames(frames)
+        assert stack.awake_bodies() == 0 and chain.awake_bodies() == 5
+    finally:
+        stack.close()
+        chain.close()
+
+
+def test_timed_frames_are_the_threads_cpu_time():
+    """ssScene_TimeFrames times the thread's CPU (issue 28: timings on a shared machine are CPU time): never more
+    than this thread's CPU time around the call, and most of it."""
+    import time
+
+    scene = runs.Scene("chain", "implicit-euler")
+    try:
+        scene.frame(1 / 30)
+        frames = frame_times("uniform:15:45", 400, 3)
+        before = time.thread_time()
+        measured = scene.time_frames(frames)
+        around = time.thread_time() - before
+        assert 0.5 * around <= measured <= around + 1e-4, (measured, around)
+    finally:
+        scene.close()
 
 
 def test_plain_frames_are_refused_before_the_first_frame_and_out_of_range():

@@ -101,11 +101,11 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
 }
 
 /* Before every step: the motor's direction for the time the step starts, then that time moves on by the step. */
-static void beforeStep(void* context, ssStepper* stepper) {
-  Piston* piston = context;
+static void drive(void* state, double step_s) {
+  Piston* piston = state;
   int forward = (int)floor(piston->time_s / PISTON_REVERSE_S) % 2 == 0;
   dJointSetSliderParam(piston->slider, dParamVel, forward ? PISTON_SPEED_M_PER_S : -PISTON_SPEED_M_PER_S);
-  piston->time_s += ssStepper_CurrentStep(stepper).step_s;
+  piston->time_s += step_s;
 }
 
 static void sample(const void* state, double* out) {
@@ -157,7 +157,7 @@ const ssSceneDesc ssPistonScene = {
                  .body_count = 0},
     .max_body_count = 0,
     .build = build,
-    .before_step = beforeStep,
+    .drive = drive,
     .sample = sample,
     .check = check,
     .destroy = destroy,

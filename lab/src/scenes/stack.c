@@ -123,12 +123,12 @@ static void collide(void* context, ssStepper* stepper) {
 }
 
 /* Before every step: the push on the top box at the time the step starts, then that time moves on by the step. */
-static void beforeStep(void* context, ssStepper* stepper) {
-  Stack* stack = context;
+static void drive(void* state, double step_s) {
+  Stack* stack = state;
   if (stack->time_s < STACK_PUSH_UNTIL_S)
     dBodyAddForce(stack->boxes[stack->count - 1],
                   stack->push_n * sin(2 * M_PI * stack->time_s / STACK_PUSH_PERIOD_S), 0, 0);
-  stack->time_s += ssStepper_CurrentStep(stepper).step_s;
+  stack->time_s += step_s;
 }
 
 /* How far above its centre a box reaches along world z (m): its half extents projected on z. */
@@ -190,7 +190,7 @@ const ssSceneDesc ssStackScene = {
                  .body_count = 6},
     .max_body_count = STACK_MAX_BOXES,
     .build = build,
-    .before_step = beforeStep,
+    .drive = drive,
     .collide = collide,
     .sample = sample,
     .check = check,

@@ -222,20 +222,27 @@ SS_LAB_API int ssScene_Points(const ssScene* scene, double* xyz, int capacity);
  *  interpolation factor, under the other cuts ODE's pose (the same points as ssScene_Points). Same errors. */
 SS_LAB_API int ssScene_InterpolatedPoints(const ssScene* scene, double* xyz, int capacity);
 
-/** Steps count frames of frames_s[i] seconds and writes the wall-clock seconds they took to *wall_s: through the
- *  scene's stepper (plain = 0, as ssScene_Frame), or (plain = 1) as a program without the library steps, for the
- *  cost benchmark: collide, one dWorldQuickStep (or dWorldStep, per the stepping's solver) of the whole frame and
- *  empty the contacts, with every softness left as the stepper last wrote it (contacts softened as for the
- *  stepper's last step; the stack's push and the piston's motor reversals, added before each step through the
- *  stepper, are not: the ram stays against the stop it last reached). A plain frame needs one ssScene_Frame first,
- *  so that every softness has been written.
+/** The bodies of the scene that are awake (dBodyIsEnabled): those its space's geoms reach (nested spaces
+ *  included), each counted once; a body without a geom (the chain's links, the oscillator's) is not counted. Scenes with auto-disable (stack, wall) fall asleep when they come to rest; the
+ *  cost benchmark compares two copies only where as many bodies are awake in both. -1 for scene = NULL, which
+ *  records why for ssLastError(). */
+SS_LAB_API int ssScene_AwakeBodies(const ssScene* scene);
+
+/** Steps count frames of frames_s[i] seconds and writes the calling thread's CPU seconds they took to *cpu_s
+ *  (CLOCK_THREAD_CPUTIME_ID: other work on a shared machine does not count): through the scene's stepper
+ *  (plain = 0, as ssScene_Frame), or (plain = 1) as a program without the library steps, for the cost benchmark:
+ *  the scene's per-step input for the frame's one step (the stack's push, the piston's motor, as the stepper gives
+ *  it before each of its steps), collide, one dWorldQuickStep (or dWorldStep, per the stepping's solver) of the
+ *  whole frame and empty the contacts, with every softness left as the stepper last wrote it (contacts softened as
+ *  for the stepper's last step). A plain frame needs one ssScene_Frame first, so that every softness has been
+ *  written.
  *  Frames through the stepper are timed without the lab's sanity bounds (ssScene_Broken, ssScene_BoundUse skip
  *  them), which a program does not pay; a plain frame checks only that the followed quantities stay finite, since
  *  ODE aborts on a step from a non-finite state.
- *  Errors: SS_ERROR_OUT_OF_RANGE (scene, frames_s or wall_s NULL, count < 0, plain not 0 or 1, a plain frame
+ *  Errors: SS_ERROR_OUT_OF_RANGE (scene, frames_s or cpu_s NULL, count < 0, plain not 0 or 1, a plain frame
  *  before any ssScene_Frame, a frame outside [SS_MIN_STEP_S, SS_MAX_STEP_S] when plain); SS_ERROR_BLOWUP when a
  *  plain frame leaves a followed quantity not finite (the frames after it are not stepped); those of ssScene_Frame. */
-SS_LAB_API ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, int count, int plain, double* wall_s);
+SS_LAB_API ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, int count, int plain, double* cpu_s);
 
 /** A run: a scene under a profile for duration_s, one record after every physics step. */
 typedef struct ssRunDef {
