@@ -91,6 +91,12 @@ def embed(path: Path, anchor: str | None = None) -> Markup:
         Markup(" id='{}'").format(anchor) if anchor else "", data, Path(path).name)
 
 
+def embed_png(data: bytes, anchor: str, alt: str) -> Markup:
+    """PNG bytes as an image in the page (a data URI), with its id and alternative text."""
+    return Markup('<img id="{}" src="data:image/png;base64,{}" alt="{}">').format(
+        anchor, base64.b64encode(data).decode(), alt)
+
+
 def _all_policies(report: Report) -> list[str]:
     return list(dict.fromkeys(p for s in report.scenes for p in report.policies[s]))
 
@@ -254,8 +260,10 @@ def code_to_write(report: Report) -> dict | None:
 def answer(report: Report) -> dict | None:
     """The page's first sentence and picture: for these scenes, what changes with the frame rate under each policy
     (the policies whose motion is the same at every frame rate, or the most alike), the recommended policy (the one
-    the code is written for) and its cost in one number: the median over the scenes of its wall time against the
-    program's plain loop (one step a frame); the picture, the first scene's deviation per profile and policy."""
+    the code is written for) and its cost in one number: the median over the scenes of its CPU time against the
+    program's plain loop (one step a frame), with the cores and the load it was measured under; the picture
+    (report_answer): per scene and policy, each profile's deviation from the fine-step reference and the
+    consistency, the recommended policy in bold."""
     chosen = page.code_policy(report)
     if chosen is None:
         return None
@@ -270,12 +278,16 @@ def answer(report: Report) -> dict | None:
     machine = report.machine
     load = f", load {machine['load_before_cost']:.1f}" if machine.get("load_before_cost") is not None else ""
     cores = f"; {machine['cores']:.0f} cores{load}" if machine.get("cores") else ""
-    costs = (f"; it costs about {float(np.median(ratios)):.1f} times the program's plain loop (one step a frame: "
-             f"median over {len(ratios)} scene{'s' if len(ratios) != 1 else ''}{cores})") if ratios else ""
-    figure = next((path for scene in report.scenes for path in report.figures.get(scene, [])
-                   if path.name.startswith("deviation_") and path.suffix == ".png"), None)
+    costs = (f"; it costs about {float(np.median(ratios)):.1f} times the program's plain loop (one step a frame, "
+             f"CPU time: median over {len(ratios)} scene{'s' if len(ratios) != 1 else ''}{cores})") if ratios else ""
+    figure = None
+    if report.rows:
+        from steadystep import report_answer
+
+        figure = embed_png(report_answer.png(report, policy, page.IDENTICAL), "answer-figure",
+                           "per scene and policy, each frame-time profile's deviation from the fine-step reference")
     return {"sentence": f"For these scenes ({', '.join(report.scenes)}), {what}. Use {policy}{costs}.",
-            "figure": embed(figure, "answer-figure") if figure else None}
+            "figure": figure}
 
 
 def as_html(report: Report, command: str, article_paths: list[Path]) -> str:

@@ -29,15 +29,22 @@ img { max-width: 100%; display: block; margin: 0.5em 0 1.5em; }
 #recommendation { background: #f4f8ff; border: 1px solid #c9d8f0; padding: 0.3em 1em 1em; }
 .answers li { margin: 0.35em 0; }
 pre { background: #f6f6f6; padding: 0.6em; } pre.code { overflow-x: auto; } .small { color: #666; font-size: 0.85em; margin-bottom: 1.5em; }
-figure { margin: 0.5em 0 1.5em; }
+figure { margin: 0.5em 0 1.5em; } figcaption { max-width: 75em; }
+details { margin: 0.6em 0; } summary { cursor: pointer; }
 </style></head><body>
 <h1>steadystep: which constraint-softness policy, under variable frame times</h1>
 {% if answer %}<p id='answer'><b>{{ answer.sentence }}</b></p>
-{% if answer.figure %}<figure id='answer-picture'>{{ answer.figure }}</figure>{% endif %}
+{% if answer.figure %}<figure id='answer-picture'>{{ answer.figure }}<figcaption class=small>Each dot is one
+frame-time profile's run: its deviation from the fine-step reference (RMS of the scene's first quantity over the
+motion's amplitude); the line joins one policy's profiles, so the longer it is, the more the motion changes with the
+frame rate. The number above a policy is its consistency across the profiles (0: the same motion at every frame
+rate); the recommended policy is bold.</figcaption></figure>{% endif %}
 {% endif %}
-<p>Every run is real ODE 0.16 (libode from Debian) stepped by libsteadystep: each scene under each frame-time profile
-({{ report.profiles|join(", ") }}) and each policy, for {{ "%g"|format(report.duration_s) }} s, against a reference
-run (the same scene at a fixed 1/1000 s step, the article's mapping).</p>
+<p class=small>Every run is real ODE 0.16 (libode from Debian) stepped by libsteadystep: each scene under each
+frame-time profile ({{ report.profiles|join(", ") }}) and each policy, for {{ "%g"|format(report.duration_s) }} s,
+against a reference run (the same scene at a fixed 1/1000 s step, the article's mapping).</p>
+<details id='why'><summary><b>Why{% if code %}, and the code to write for {{ code.policy }}{% endif %}</b>: which
+policy for which need, per scene, the policies defined</summary>
 <section id='recommendation'><h2>Which policy for which need</h2>
 <p class=small>Every line below is computed from this run's numbers, says for which scenes it holds, and links to the
 table that shows it. A winner is named only where its lead is larger than the measured spread of repeats
@@ -67,6 +74,7 @@ whose steps follow the frames)</th><th>closest to the reference</th><th>cheapest
 {% endfor %}
 {% endif %}
 </section>
+</details>
 {% if animation %}
 <h2 id='animation'>Watch: the chain at 15-45 fps</h2>
 {{ animation }}

@@ -137,7 +137,12 @@ def test_the_recommendation_names_the_best_by_the_numbers_on_the_page(written):
     assert f"<b>{min(deviation, key=deviation.get)}</b>" in _section(page, "Closest to the fine-step reference")
     ratios = {}
     for entry in metrics["cost"]["runs"]:
+        if entry["ratio_median"] is None:  # no block compared like with like (a copy asleep): no ratio, said so
+            assert entry["status"] != "ok" or entry["ratio_blocks"] == 0
+            continue
         ratios.setdefault(entry["policy"], []).append(entry["ratio_median"])
+    if any(e["status"] == "ok" and e["ratio_blocks"] == 0 for e in metrics["cost"]["runs"]):
+        assert "not like with like" in page[page.index("id='cost'"):]
     cheapest_text = _section(page, "Cheapest")
     for policy, values in ratios.items():
         assert html.escape(policy) + f" ×{statistics.median(values):.3g}" in cheapest_text
@@ -391,3 +396,41 @@ def test_the_first_screen_answers_in_one_sentence_and_a_picture(written, tmp_pat
     assert 0 < measured["answer"] <= 900 and 0 < measured["figure"] <= 900, measured
     assert measured["height"] < 15000, measured
     assert "<details id='measured'>" in page and "<details id='parameters'>" in page
+    # The picture is what changes with the frame rate under each policy (report_answer), not one scene's chart; the
+    # reasons and the code are collapsed below it, one line of summary.
+    assert 'id="answer-figure"' in page and "each frame-time profile&#39;s deviation" in page
+    assert page.index("<details id='why'>") < page.index("<section id='recommendation'>")
+
+
+def test_the_first_picture_shows_every_policys_runs_and_consistency():
+    """The answer's picture from the report's own numbers: one panel a scene, one tick a policy, one dot a profile's
+    run that did not fail, and the consistency above each policy, the recommended policy bold."""
+    from steadystep import page as page_module, report_answer
+
+    made = report.Report(scenes=["chain", "stack"], profiles=["fixed:30", "uniform:15:45"],
+                         policies={"chain": ["naive", "fixed"], "stack": ["naive", "fixed"]}, duration_s=1.0, seed=1)
+    deviation = {("chain", "fixed:30", "naive"): 0.2, ("chain", "uniform:15:45", "naive"): 0.5,
+                 ("chain", "fixed:30", "fixed"): 0.01, ("chain", "uniform:15:45", "fixed"): 0.01,
+                 ("stack", "fixed:30", "naive"): float("inf"), ("stack", "uniform:15:45", "naive"): 0.3,
+                 ("stack", "fixed:30", "fixed"): 0.02, ("stack", "uniform:15:45", "fixed"): 0.02}
+    for (scene, profile, policy), value in deviation.items():
+        quantity = "end x" if scene == "chain" else "top x"
+        made.rows.append(report.Row(scene, profile, policy, {quantity: value}, 1.0, 30.0, 1.0,
+                             "ok" if value != float("inf") else "blow-up"))
+    made.consistency = {"chain": {"naive": {"end x": 0.1}, "fixed": {"end x": 0.0}},
+                        "stack": {"naive": {"top x": float("inf")}, "fixed": {"top x": 1e-12}}}
+    figure = report_answer.draw(made, "fixed", page_module.IDENTICAL)
+    panels = [ax for ax in figure.axes if ax.get_visible()]
+    assert [ax.get_title(loc="left") for ax in panels] == ["chain: end x", "stack: top x"]
+    for ax in panels:
+        assert [t.get_text() for t in ax.get_xticklabels()] == ["naive", "fixed"]
+        bold = [t.get_text() for t in ax.get_xticklabels() if t.get_fontweight() == "bold"]
+        assert bold == ["fixed"]
+    dots = {ax.get_title(loc="left"): sorted(round(float(line.get_ydata()[0]), 6) for line in ax.get_lines()
+                                              if line.get_marker() not in (None, "None", ""))
+            for ax in panels}
+    assert dots == {"chain: end x": [0.01, 0.01, 0.2, 0.5], "stack: top x": [0.02, 0.02, 0.3]}
+    texts = {ax.get_title(loc="left"): [t.get_text() for t in ax.texts] for ax in panels}
+    assert texts["chain: end x"] == ["0.1", "0"]
+    assert texts["stack: top x"] == ["✕ 1 failed", "failed", "0"]  # the blown-up run, and 1e-12 is the same motion
+    assert report_answer.png(made, "fixed", page_module.IDENTICAL).startswith(b"\x89PNG")
