@@ -177,6 +177,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   dInitODE2(0);
+  benchPrintMachine("bench_bind", "before");
   static double bind[kSizes][kMaxRepeats], adopt[kSizes][kMaxRepeats], step[kSizes][kMaxRepeats];
   static double read[kSizes][kMaxRepeats], bind_faults[kSizes][kMaxRepeats], adopt_faults[kSizes][kMaxRepeats];
   double fault_s[kMaxRepeats];
@@ -194,7 +195,8 @@ int main(int argc, char** argv) {
     }
   }
   double fault_us = 1e6 * benchMedian(fault_s, repeats);
-  printf("bench_bind: hinge chains, a stop and a motor row a hinge; medians of %d repeats\n", repeats);
+  printf("bench_bind: hinge chains, a stop and a motor row a hinge; medians of %d repeats, this thread's CPU time\n",
+         repeats);
   printf("  %8s %12s %12s %12s %14s %14s %13s %15s\n", "rows", "bind us/row", "adopt us/row", "read us/row",
          "bind faults/k", "adopt faults/k", "QuickStep ms", "bind/QuickStep");
   double bind_us[kSizes], adopt_us[kSizes];
@@ -220,5 +222,6 @@ int main(int argc, char** argv) {
   printf("  less the page faults' time: bind %.3f / %.3f / %.3f us/row (%.2f), adopt %.3f / %.3f / %.3f (%.2f)\n",
          net_bind[0], net_bind[1], net_bind[2], spread(net_bind), net_adopt[0], net_adopt[1], net_adopt[2],
          spread(net_adopt));
+  benchPrintMachine("bench_bind", "after");
   return 0;
 }

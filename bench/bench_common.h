@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <steadystep/status.h>
 
@@ -14,6 +15,16 @@ static inline double benchCpuSeconds(void) {
   struct timespec t;
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Prints what the figures were measured on, one line: the load average over 1, 5 and 15 minutes (the threads that
+ * wanted a core: above the cores, this benchmark shared them with other work) and the cores online. when says at
+ * which point of the benchmark ("before", "after"). */
+static inline void benchPrintMachine(const char* bench, const char* when) {
+  double load[3] = {-1, -1, -1};
+  if (getloadavg(load, 3) != 3) load[0] = load[1] = load[2] = -1;
+  printf("%s: load average %.2f %.2f %.2f %s, %ld cores online\n", bench, load[0], load[1], load[2], when,
+         sysconf(_SC_NPROCESSORS_ONLN));
 }
 
 /* Ends the benchmark with the library's message when a call it needs failed. */

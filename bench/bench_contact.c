@@ -161,13 +161,15 @@ int main(int argc, char** argv) {
   }
   dInitODE2(0);
   frames = (frames + kBlock - 1) / kBlock * kBlock;
-  printf("bench_contact: box stacks, %d frames a repeat, %d repeats, QuickStep 40 iterations; target: adopted naive "
-         "<= 1.02 times the program's own loop\n",
+  benchPrintMachine("bench_contact", "before");
+  printf("bench_contact: box stacks, %d frames a repeat, %d repeats, QuickStep 40 iterations, this thread's CPU "
+         "time; target: adopted naive <= 1.02 times the program's own loop\n",
          frames, repeats);
   static const int kBoxes[2] = {8, 200};
   for (int b = 0; b < 2; ++b) {
     report(kBoxes[b], NULL, frames, repeats);
     report(kBoxes[b], "uniform:45:90", frames, repeats);
   }
+  benchPrintMachine("bench_contact", "after");
   return 0;
 }
