@@ -31,6 +31,7 @@ Prints Markdown tables. Exit 1 when a run fails (a program the audit refuses: it
 from __future__ import annotations
 
 import argparse
+import os
 import pathlib
 import shutil
 import statistics
@@ -42,6 +43,13 @@ POLICIES = ["implicit-euler", "matched", "exact", "fixed"]
 PROFILES = ["fixed:60", "fixed:30", "uniform:15:45"]
 SEEDS = [1, 2, 3]
 SECONDS = 10.0
+
+
+def machine() -> str:
+    """The load average (1, 5 and 15 minutes) and the cores this process may use: what the times were measured on."""
+    one, five, fifteen = os.getloadavg()
+    return (f"load average {one:.2f} {five:.2f} {fifteen:.2f}, {len(os.sched_getaffinity(0))} of {os.cpu_count()} "
+            "cores usable")
 
 
 def frame_rate_tables(build: pathlib.Path, executor: str) -> None:
@@ -171,6 +179,7 @@ def main() -> None:
     parser.add_argument("--executor", default="local", help="where the audit's runs go (study.py; default local)")
     args = parser.parse_args()
     build = pathlib.Path(args.build).resolve()
+    print(f"bench_examples: {machine()}")
     if not args.cost_only:
         from steadystep._native import SteadystepError
 
@@ -190,6 +199,7 @@ def main() -> None:
                           f"stack, {args.boxes} boxes")
         instruction_table(build, "vehicle", ["implicit-euler", "matched", "exact"], 60.0, [], "vehicle")
     diff_sizes(pathlib.Path(__file__).resolve().parent.parent)
+    print(f"\nafter: {machine()}")
 
 
 if __name__ == "__main__":
