@@ -108,6 +108,7 @@ class Audit:
     trajectories: dict = field(default_factory=dict)  # reference, check, and (variant, profile, seed) -> columns
     elapsed_s: float = 0.0
     reused_runs: int = 0
+    figures: dict = field(default_factory=dict)       # the page's figures drawn with the runs: file stem -> PNG
 
 
 def validate(program, profiles, seeds, policies, duration_s: float) -> None:
@@ -216,19 +217,32 @@ def cost_run(runs_per_variant: list[tuple[str, int]]) -> tuple[str, int]:
     return next(((p, s) for p, s in runs_per_variant if not p.startswith(DETERMINISTIC_KINDS)), runs_per_variant[0])
 
 
+def _longest_first(key: tuple) -> int:
+    """The order units are handed to a pool: it is done when its last unit is, so those that take longest go first
+    (counts under valgrind, then the check of the reference and the reference: 4000 and 1000 frames a second), and
+    the short runs fill in around them."""
+    return {"count": 0, "count-repeat": 0, "check": 1, "reference": 2}.get(key[0], 3)
+
+
 def audit(program, profiles=DEFAULT_PROFILES, seeds=DEFAULT_SEEDS, policies=None,
           duration_s: float = DEFAULT_DURATION_S, executor=None, progress: bool | None = None,
           reference_fps: int = REFERENCE_FPS, check_fps: int = CHECK_FPS, out_dir: Path | None = None,
-          cost: str = "auto", diagnosis: bool = True) -> Audit:
+          cost: str = "auto", diagnosis: bool = True, draw: bool = False) -> Audit:
     """Runs program (Executable or PythonProgram) as every variant under every profile run, plus the reference, its
     check, a repeat and the cost runs, through executor (any concurrent.futures.Executor, a name for
     study.make_executor, or None: here), and measures them. policies: default every policy the library names.
     out_dir: where finished runs are kept (OUT/runs) and found again; None keeps none. cost: "auto"
     (instructions under valgrind for an executable when valgrind is there, else CPU time over repeats),
-    "instructions", "time" or "none". diagnosis: run the diagnosis variants (when the program takes their flags)."""
+    "instructions", "time" or "none". diagnosis: run the diagnosis variants (when the program takes their flags).
+    draw: draw the page's figures too, after the runs, through the same executor (Audit.figures; write() draws
+    those it does not find there, in this process)."""
     from steadystep import study
     from steadystep.stepping import policy_names
 
+    if isinstance(executor, str):  # one pool for the runs and the figures
+        with study.make_executor(executor) as made:
+            return audit(program, profiles, seeds, policies, duration_s, made, progress, reference_fps, check_fps,
+                         out_dir, cost, diagnosis, draw)
     started = time.perf_counter()
     policies = list(policies) if policies else policy_names()
     profiles, seeds = list(profiles), [seed_value(s) for s in seeds]
@@ -268,6 +282,8 @@ def audit(program, profiles=DEFAULT_PROFILES, seeds=DEFAULT_SEEDS, policies=None
     done = {key: store.get(key) for key in tasks}
     reused = sum(run is not None for run in done.values())
     missing = [key for key in tasks if done[key] is None]
+    if executor is not None and not isinstance(executor, study.SerialExecutor):
+        missing.sort(key=_longest_first)  # in this process they run in the tasks' order, the reference first
     units = [dict(program=program, duration_s=float(duration_s), **tasks[key]) for key in missing]
     try:
         for index, made in study.as_completed(_unit, units, executor, progress, f"steadystep audit {program.name}",
@@ -280,8 +296,20 @@ def audit(program, profiles=DEFAULT_PROFILES, seeds=DEFAULT_SEEDS, policies=None
     result = measure(program, variants, runs_per_variant, float(duration_s), done, method, (cost_profile, cost_seed),
                      has_own, not_measured)
     result.reused_runs = reused
+    if draw:
+        result.figures = _draw_figures(result, executor, progress)
     result.elapsed_s = time.perf_counter() - started
     return result
+
+
+def _draw_figures(result: Audit, executor, progress: bool | None) -> dict:
+    """The page's figures (audit_page.figure_units), drawn through executor: file stem -> PNG bytes."""
+    from steadystep import audit_page, study
+
+    units = audit_page.figure_units(result)
+    drawn = dict(study.as_completed(audit_page.draw_png, units, executor, progress,
+                                    f"steadystep audit {result.program}", "figure", lambda unit: unit["stem"]))
+    return {unit["stem"]: drawn[i] for i, unit in enumerate(units)}
 
 
 # ---- the numbers ----------------------------------------------------------------------------------------------

@@ -95,7 +95,8 @@ def command(args, argv) -> int:
     try:
         with study.make_executor(args.executor) as executor:
             result = audit.audit(program, args.profiles, args.seeds, args.policies, args.duration, executor,
-                                 out_dir=args.out, cost=args.cost, diagnosis=not args.no_diagnosis)
+                                 out_dir=args.out, cost=args.cost, diagnosis=not args.no_diagnosis,
+                                 draw=True)  # the figures drawn in the executor's workers, after the runs
     except study.ExecutorUnavailable as error:
         raise SteadystepError(Status.OUT_OF_RANGE, f"steadystep audit: {error}") from None
     path = audit.write(result, args.out, shlex.join(["steadystep", *argv]), force=args.force)

@@ -1,21 +1,26 @@
 """The audit's page (audit.html): the recommendation first, each claim linked to its table, then what it is about,
 each chosen quantity under the program's own stepping and under the recommended policy across the audited frame
 rates (the article's figure, for the user's program), then the tables and figures the claims rest on. Figures drawn
-with figures.py's colours and style; every text escaped."""
+with figures.py's colours and style; every text escaped.
+
+The figures are units of work of their own (figure_units, draw_png: PNG bytes), so that the audit draws them in its
+executor's workers after the runs (audit.audit(draw=True): Audit.figures) and this process needs no matplotlib;
+whatever is not drawn there is drawn here, by the same function."""
 
 from __future__ import annotations
 
 import base64
+import dataclasses
 import html
+import io
 import math
 import platform
 import time
 from pathlib import Path
 
 import numpy as np
-from matplotlib.figure import Figure
 
-from steadystep import figures
+from steadystep import palette
 from steadystep.audit_run import OWN, SERVED_COLUMNS, TIME_COLUMN
 
 OWN_COLOR = "#000000"
@@ -24,7 +29,7 @@ FIGURE_QUANTITIES = 4  # the deciding quantities drawn across frame rates, at mo
 
 
 def _color(variant: str) -> str:
-    return OWN_COLOR if variant == OWN else figures.policy_color(variant)
+    return OWN_COLOR if variant == OWN else palette.policy_color(variant)
 
 
 def _number(value, digits: int = 3) -> str:
@@ -179,9 +184,11 @@ def _shown_pair(result) -> tuple[str, str]:
     return left, right
 
 
-def _draw_across(result, quantity: str) -> Figure:
+def _draw_across(result, quantity: str):
     """One quantity under the program's own stepping and under the recommended policy, each in every audited
     profile run, with the reference dashed: how much each depends on the frame rate."""
+    from matplotlib.figure import Figure
+
     left, right = _shown_pair(result)
     figure = Figure(figsize=(11, 3.4))
     axes = figure.subplots(1, 2, sharey=True)
@@ -191,7 +198,7 @@ def _draw_across(result, quantity: str) -> Figure:
             run = result.trajectories[(variant, profile, seed)]
             ax.plot(run[TIME_COLUMN], run[quantity], color=PROFILE_COLORS[i % len(PROFILE_COLORS)], lw=1.0,
                     label=f"{profile} seed {seed}")
-        ax.plot(reference[TIME_COLUMN], reference[quantity], color=figures.REFERENCE_COLOR, ls="--", lw=1.0,
+        ax.plot(reference[TIME_COLUMN], reference[quantity], color=palette.REFERENCE_COLOR, ls="--", lw=1.0,
                 label=f"reference ({result.reference['reference_fps']} fps)")
         _mark_parting(ax, result)
         spread = result.spread[variant][quantity]
@@ -204,7 +211,9 @@ def _draw_across(result, quantity: str) -> Figure:
     return figure
 
 
-def _draw_reference(result) -> Figure:
+def _draw_reference(result):
+    from matplotlib.figure import Figure
+
     figure = Figure(figsize=(11, 2.8))
     ax = figure.add_subplot()
     r = result.reference
@@ -228,16 +237,43 @@ def _mark_parting(ax, result) -> None:
         ax.axvspan(parted_at, result.duration_s, color="#f3d6d6", alpha=0.6, label="reference not held")
 
 
-def draw(result, out_dir: Path) -> list[Path]:
-    """The figures, as PNG beside the page: each deciding quantity across frame rates (at most FIGURE_QUANTITIES),
-    and the reference's check."""
+def figure_units(result) -> list[dict]:
+    """The page's figures as units of work for draw_png, in the page's order: each deciding quantity across frame
+    rates (at most FIGURE_QUANTITIES), then the reference's check. Each holds the result with only the trajectories
+    the figures draw (the two variants shown and the reference), plain data a worker can be sent."""
+    left, right = _shown_pair(result)
+    drawn = {key: columns for key, columns in result.trajectories.items()
+             if key == "reference" or (isinstance(key, tuple) and key[0] in (left, right))}
+    slim = dataclasses.replace(result, trajectories=drawn, runs=[], spread_runs={}, deviation_runs={}, figures={})
+    units = [dict(stem=f"audit_{i}_{q}", result=slim, quantity=q)
+             for i, q in enumerate(result.deciding[:FIGURE_QUANTITIES])]
+    return units + [dict(stem="audit_reference", result=slim, quantity=None)]
+
+
+def draw_png(stem: str, result, quantity: str | None) -> bytes:
+    """One figure of the page (a unit of figure_units) as the bytes of its PNG file: quantity across frame rates,
+    or the reference's check when quantity is None."""
     import matplotlib
 
-    paths = []
+    from steadystep import figures
+
     with matplotlib.rc_context(figures.STYLE):
-        for i, q in enumerate(result.deciding[:FIGURE_QUANTITIES]):
-            paths += figures.save(_draw_across(result, q), out_dir, f"audit_{i}_{q}", formats=("png",))
-        paths += figures.save(_draw_reference(result), out_dir, "audit_reference", formats=("png",))
+        figure = _draw_reference(result) if quantity is None else _draw_across(result, quantity)
+        buffer = io.BytesIO()
+        figure.savefig(buffer, format="png", dpi=150)  # as files.save_figure writes a figure
+    return buffer.getvalue()
+
+
+def draw(result, out_dir: Path) -> list[Path]:
+    """The figures, as PNG beside the page (figure_units): those the audit drew already (result.figures, by stem)
+    written as they are, the others drawn here."""
+    from steadystep.files import write_output_bytes
+
+    drawn = getattr(result, "figures", None) or {}
+    paths = []
+    for unit in figure_units(result):
+        data = drawn.get(unit["stem"])
+        paths.append(write_output_bytes(Path(out_dir) / f"{unit['stem']}.png", data if data else draw_png(**unit)))
     return paths
 
 

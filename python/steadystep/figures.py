@@ -25,16 +25,8 @@ from steadystep.limits import MIN_MEASURED_DURATION_S
 from steadystep.profiles import seed_value
 from steadystep.files import save_figure
 from steadystep.profiles import frame_times
-
-# One colour per policy, in the library's order of its policies (naive, substeps-frozen, implicit-euler, matched,
-# exact, fixed, fixed-matched, fixed-exact): orange, light orange (naive's softness, implicit-euler's cut), purple,
-# brown, cyan, grey, rose, green. A policy the library adds beyond these is drawn dark grey until it gets its own.
-_POLICY_PALETTE = ("#e6550d", "#fdae6b", "#756bb1", "#8c6d31", "#17becf", "#636363", "#d6616b", "#31a354")
-POLICY_COLORS = dict(zip(runs.policy_names(), _POLICY_PALETTE))
-REFERENCE_COLOR = "#000000"
-EXACT_COLOR = "#1f5fbf"      # the article's blue
-FIXED_30_COLOR = "#d62728"   # the article's red
-VARIABLE_COLOR = "#2ca02c"   # the article's green
+from steadystep.palette import (EXACT_COLOR, FIXED_30_COLOR, POLICY_COLORS, REFERENCE_COLOR,  # noqa: F401
+                                VARIABLE_COLOR, policy_color)
 
 STYLE = {
     "figure.dpi": 100, "axes.grid": True, "grid.alpha": 0.3, "axes.spines.top": False,
@@ -55,10 +47,6 @@ def _label(text: str) -> str:
     """User text (a profile spec, a trace file's name) as matplotlib draws it literally: no lone surrogates from
     bytes that were not UTF-8 (its fonts refuse them) and no $ that would start mathtext."""
     return printable(text).replace("$", r"\$")
-
-
-def policy_color(policy: str) -> str:
-    return POLICY_COLORS.get(policy, "#333333")
 
 
 def save(figure, out_dir: Path, stem: str, formats=("png", "svg")) -> list[Path]:

@@ -175,3 +175,25 @@ def test_python_program(tmp_path):
     # One step of at most 1/60 s per frame at 60 fps: the steps column the audit counted itself.
     steps = {(r["variant"], r["profile"]): r["steps_per_frame"] for r in metrics["runs"]}
     assert steps["exact", "fixed:60"] == 1.0 and steps["exact", "uniform:15:45"] > 1.0
+
+
+def test_figures_drawn_in_the_pool_are_the_page_figures(tmp_path):
+    """audit(draw=True) draws the page's figures in its executor's workers after the runs (so that the process that
+    runs the audit need not): they are the very figures this process draws from the same result, and write() puts
+    those it finds in the result beside the page instead of drawing them again."""
+    from steadystep import audit, audit_page
+
+    program = audit.Executable((str(BUILD / "steadystep_example_chain_steadystep"),),
+                               own=(str(BUILD / "steadystep_example_chain_ode"),))
+    result = audit.audit(program, ["fixed:60", "uniform:15:45"], [1], ["naive", "fixed"], 1.0, "local",
+                         progress=False, cost="none", diagnosis=False, draw=True)
+    units = audit_page.figure_units(result)
+    assert list(result.figures) == [unit["stem"] for unit in units] == \
+        [f"audit_{i}_{q}" for i, q in enumerate(result.deciding[:audit_page.FIGURE_QUANTITIES])] + ["audit_reference"]
+    for unit in units:
+        assert result.figures[unit["stem"]].startswith(b"\x89PNG")
+        assert result.figures[unit["stem"]] == audit_page.draw_png(**unit)
+    result.figures = {stem: b"drawn in the pool " + stem.encode() for stem in result.figures}
+    audit.write(result, tmp_path, "steadystep audit (test)")
+    for stem, data in result.figures.items():
+        assert (tmp_path / f"{stem}.png").read_bytes() == data
