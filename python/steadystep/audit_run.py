@@ -32,6 +32,7 @@ import json
 import os
 import re
 import resource
+import select
 import shlex
 import signal
 import subprocess
@@ -529,9 +530,14 @@ def run_process(command: list[str], env: dict | None, limit_s: float, output_byt
 def _wait(process: subprocess.Popen, limit_s: float, shown: str):
     """(wait status, resource usage) of the process. Its CPU time is bounded by RLIMIT_CPU; here, a process that
     sleeps is killed with its group once, after limit_s of wall time, it has used no CPU for IDLE_S (or after
-    WALL_FACTOR times limit_s in any case), and when this wait is interrupted."""
+    WALL_FACTOR times limit_s in any case), and when this wait is interrupted. Between looks it waits on a pidfd of
+    the process (Linux 5.3 on), which wakes it as the process ends, else sleeps."""
     started = time.monotonic()
     pause, watched = 0.0005, None  # watched: (time, group CPU) of the last look after the limit
+    try:
+        ended = os.pidfd_open(process.pid)  # readable once the process has ended
+    except (AttributeError, OSError):
+        ended = None
     try:
         while True:
             pid, status, usage = os.wait4(process.pid, os.WNOHANG)
@@ -551,7 +557,10 @@ def _wait(process: subprocess.Popen, limit_s: float, shown: str):
                 if now - started > WALL_FACTOR * limit_s:
                     raise _bad(f"{shown}: still running after {WALL_FACTOR * limit_s:g} s of wall time, "
                                f"{WALL_FACTOR:g} times the time limit (--time-limit): killed")
-            time.sleep(pause)
+            if ended is None:
+                time.sleep(pause)
+            else:
+                select.select([ended], [], [], pause)
             pause = min(2 * pause, 0.05)
     except BaseException:  # a hang, or Ctrl-C: the program and its children go
         with contextlib.suppress(ProcessLookupError):
@@ -560,6 +569,9 @@ def _wait(process: subprocess.Popen, limit_s: float, shown: str):
             os.wait4(process.pid, 0)
         process.returncode = -signal.SIGKILL
         raise
+    finally:
+        if ended is not None:
+            os.close(ended)
 
 
 # ---- the CSV -----------------------------------------------------------------------------------------------------
