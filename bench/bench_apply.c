@@ -133,8 +133,8 @@ int main(int argc, char** argv) {
   frames = (frames + kBlock - 1) / kBlock * kBlock;
   benchPrintMachine("bench_apply", "before");
   printf("bench_apply: %d bodies, %d rows, %d frames a repeat, medians of %d repeats; Apply with every cache on "
-         "(us a frame of this thread's CPU time, and its share of a QuickStep), and each configuration's Apply time over "
-         "that\n",
+         "(us a frame of this thread's CPU time, and its share of a QuickStep), and each configuration's Apply time "
+         "over that\n",
          kChains * kLinks, 2 * kChains * kLinks, frames, repeats);
   printf("  %-14s %-8s %-8s %8s %7s", "mapping", "frames", "masses", "Apply us", "of step");
   for (int c = 1; c < kConfigs; ++c) printf(" %10s", kConfigNames[c]);

@@ -100,14 +100,15 @@ def main() -> int:
                 times[executor].append(wall_s)
                 pair.setdefault(executor, []).append(wall_s)
                 print(f"  {executor:6s} {wall_s:7.2f} s   load average {os.getloadavg()[0]:.2f}", flush=True)
-            print(f"  repeat {repeat + 1}: serial / local {statistics.mean(pair['serial']) / statistics.mean(pair['local']):.2f}",
-                  flush=True)
+            ratio = statistics.mean(pair["serial"]) / statistics.mean(pair["local"])
+            print(f"  repeat {repeat + 1}: serial / local {ratio:.2f}", flush=True)
         if _page_content(Path(scratch) / "serial") != _page_content(Path(scratch) / "local"):
             print("bench_audit: the serial and local audits' pages differ beyond their times", file=sys.stderr)
             return 1
         for png in sorted((Path(scratch) / "serial").glob("*.png")):
             if png.read_bytes() != (Path(scratch) / "local" / png.name).read_bytes():
-                print(f"bench_audit: the figure {png.name} differs between the serial and local audits", file=sys.stderr)
+                print(f"bench_audit: the figure {png.name} differs between the serial and local audits",
+                      file=sys.stderr)
                 return 1
     serial, local = statistics.mean(times["serial"]), statistics.mean(times["local"])
     print(f"serial / local pool: {serial / local:.2f} (mean wall {serial:.2f} s / {local:.2f} s over "
