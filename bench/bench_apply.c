@@ -1,10 +1,12 @@
-/* What each of Apply's caches buys (apply.c states their invariants): 1000 bodies in hanging hinge chains with a soft
- * stop and a damper on every motor row (2000 rows, as bench_stepper's), one world per configuration (every cache on,
- * each one off alone, all off), stepped through the same frames. Only ssRegistry_Apply is timed, each frame right
- * after the world's dWorldQuickStep (which evicts the registry from the caches, as in a program). The worlds are
- * stepped in alternating blocks in a rotating order, and the measurement is repeated: the median of each world's
- * time over the all-on time is printed, with Apply's share of a QuickStep. A first block is stepped untimed: the
- * first Apply computes every row whatever the caches.
+/* What each of Apply's caches buys (apply.c lists them, apply_state.h states their invariants): 1000 bodies in
+ * hanging hinge chains with a soft stop and a damper on every motor row (2000 rows, as bench_stepper's), one world per
+ * configuration (every cache on, each one off alone, all off: Apply's plain path, and the tests' plain reference
+ * Apply, tests/c/apply_reference.c), stepped through the same frames. Only Apply is timed, each frame right after the
+ * world's dWorldQuickStep (which evicts the registry from the caches, as in a program). The worlds are stepped in
+ * alternating blocks in a rotating order, and the measurement is repeated: the median of each world's time over the
+ * all-on time is printed (above 1: the cache turned off pays there), with Apply's share of a QuickStep. A first
+ * block is stepped untimed: the first Apply computes every row whatever the caches. Built with the core's cache
+ * switches (SS_APPLY_SWITCHES), which the shipped library has not.
  *
  *   bench_apply [frames] [repeats]      (default 120 frames, 5 repeats) */
 #include <math.h>
@@ -12,24 +14,26 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "registry_internal.h"
+#include "apply_internal.h"
+#include "apply_reference.h"
 #include "steadystep/steadystep.h"
 
 #include "bench_common.h"
 
 enum { kChains = 50, kLinks = 20, kBlock = 10, kMaxRepeats = 32 };
-enum { kConfigs = 9 };
+enum { kConfigs = 10, kReference = kConfigs - 1 };
 static const unsigned kDisabled[kConfigs] = {0,
-                                             SS_CACHE_SAME_STEP,
-                                             SS_CACHE_BY_LAW,
-                                             SS_CACHE_BODIES,
-                                             SS_CACHE_SHARED,
-                                             SS_CACHE_REUSE,
-                                             SS_CACHE_SAME_AXIS,
-                                             SS_CACHE_SURE_FALLBACK,
-                                             SS_CACHE_ALL};
-static const char* const kConfigNames[kConfigs] = {"all on",  "-same step", "-by law",   "-bodies", "-shared",
-                                                   "-reuse",  "-same axis", "-fallback", "all off"};
+                                             SS_APPLY_SAME_STEP,
+                                             SS_APPLY_BY_LAW,
+                                             SS_APPLY_BODIES,
+                                             SS_APPLY_SHARED,
+                                             SS_APPLY_REUSE,
+                                             SS_APPLY_SAME_AXIS,
+                                             SS_APPLY_SURE_FALLBACK,
+                                             SS_APPLY_ALL,
+                                             SS_APPLY_ALL};
+static const char* const kConfigNames[kConfigs] = {"all on", "-same step", "-by law",   "-bodies",  "-shared",
+                                                   "-reuse", "-same axis", "-fallback", "all off", "reference"};
 static const ssSpring kLimit = {5.0, 0.05}, kFriction = {0.0, 0.01};
 static const double kFrame_s = 1.0 / 60.0;
 
@@ -41,10 +45,12 @@ typedef struct Scene {
   dWorldID world;
   ssRegistry* registry;
   double previous_s;
+  int reference;          /* stepped by the tests' reference Apply */
+  unsigned applied_stamp; /* the reference's */
 } Scene;
 
-static Scene build(int distinct, unsigned disabled) {
-  Scene scene = {dWorldCreate(), NULL, 0};
+static Scene build(int distinct, int config) {
+  Scene scene = {dWorldCreate(), NULL, 0, config == kReference, 0};
   dWorldSetGravity(scene.world, 0, 0, -9.81);
   dWorldSetQuickStepNumIterations(scene.world, 20);
   scene.registry = ssRegistry_Create(scene.world);
@@ -69,7 +75,7 @@ static Scene build(int distinct, unsigned disabled) {
       previous = body;
     }
   }
-  ssRegistryDisableCaches(scene.registry, disabled);
+  ssApplyDisableCaches(scene.registry, kDisabled[config]);
   return scene;
 }
 
@@ -78,7 +84,12 @@ static double stepBlock(Scene* scene, ssMapping mapping, const double* frames_s,
   double timed = 0;
   for (int i = 0; i < count; ++i) {
     double start = nowSeconds();
-    check(ssRegistry_Apply(scene->registry, mapping, frames_s[i], scene->previous_s, NULL), "apply");
+    if (scene->reference)
+      check(ssRegistryApplyReference(scene->registry, &scene->applied_stamp, mapping, frames_s[i], scene->previous_s,
+                                     NULL),
+            "reference apply");
+    else
+      check(ssRegistry_Apply(scene->registry, mapping, frames_s[i], scene->previous_s, NULL), "apply");
     timed += nowSeconds() - start;
     dWorldQuickStep(scene->world, frames_s[i]);
     scene->previous_s = frames_s[i];
@@ -91,7 +102,7 @@ static void report(ssMapping mapping, int varying, int distinct, int frames, int
   unsigned random = 12345;
   for (int r = 0; r < repeats; ++r) {
     Scene scenes[kConfigs];
-    for (int c = 0; c < kConfigs; ++c) scenes[c] = build(distinct, kDisabled[c]), seconds[c][r] = 0;
+    for (int c = 0; c < kConfigs; ++c) scenes[c] = build(distinct, c), seconds[c][r] = 0;
     double frames_s[kBlock];
     /* a first block untimed: the first Apply computes and writes every row and builds the caches once */
     for (int i = 0; i < kBlock; ++i) frames_s[i] = kFrame_s;

@@ -10,10 +10,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "apply_internal.h"
 #include "error.h"
 #include "joint_rows.h"
 #include "ode_bounds.h"
-#include "registry_layout.h"
+#include "registry_internal.h"
+#include "steadystep/adopt.h"
 
 /* A row the program wrote: its binding, what ODE holds now and the law that stands for it. */
 typedef struct FollowedRow {
@@ -22,12 +24,6 @@ typedef struct FollowedRow {
   ssRowLaw law;
 } FollowedRow;
 
-
-/* What the binding holds in ODE as the registry wrote it (NAN: nothing written since it was bound). */
-static ssSoftness writtenOf(const ssRegistry* registry, const JointBinding* binding) {
-  if (registry->written_by_law && binding->law_slot >= 0) return registry->law_written[binding->law_slot];
-  return binding->written;
-}
 
 /* The law a value the program wrote stands for, checked as adoption checks it; the message names the row. */
 static ssStatus lawOfWritten(const char* what, ssSoftness held, double step_s, ssRowLaw* law) {
@@ -39,17 +35,19 @@ static ssStatus followRows(ssRegistry* registry, double step_s, FollowedRow** ou
   *out = NULL;
   *count = 0;
   int capacity = 0;
-  for (int i = 0; i < registry->joint_count; ++i) {
-    const JointBinding* binding = &registry->joints[i];
+  int rows = ssRegistry_JointBindingCount(registry);
+  for (int i = 0; i < rows; ++i) {
+    const ssJointRowBinding* binding = ssRegistryJointRowAt(registry, i);
     if (binding->law.tuned_step_s == 0) continue; /* a spring the program bound itself: it binds another the same way */
-    /* the row's getter, with the numbers its writer resolved at binding: no lookup of the joint's type */
-    ssParamGetter get = binding->writer.set != NULL ? ssRowGetterOfType(binding->joint_type) : NULL;
+    ssRowWriter writer; /* the row's getter takes its writer's numbers: no lookup of the joint's type */
+    ssJointRowWriterOfType(binding->joint_type, binding->param, binding->axis, &writer);
+    ssParamGetter get = writer.set != NULL ? ssRowGetterOfType(binding->joint_type) : NULL;
     if (get == NULL) continue; /* plane-2D: ODE cannot read it back */
-    ssSoftness written = writtenOf(registry, binding);
+    ssSoftness written = ssApplyLastWritten(registry, i);
     if (isnan(written.cfm)) continue;
-    int has_erp = binding->writer.erp_number >= 0;
-    double cfm = get(binding->joint, binding->writer.cfm_number);
-    double erp = has_erp ? get(binding->joint, binding->writer.erp_number) : 0;
+    int has_erp = writer.erp_number >= 0;
+    double cfm = get(binding->joint, writer.cfm_number);
+    double erp = has_erp ? get(binding->joint, writer.erp_number) : 0;
     if (ssSameInOde(cfm, written.cfm) && (!has_erp || ssSameInOde(erp, written.erp))) continue;
     /* a motor row (no erp) stands for a damper: its law is read with erp 0, as adoption reads it */
     ssSoftness held = {has_erp ? erp : 0, cfm};
@@ -79,7 +77,7 @@ static int bodyAsWritten(const ssRegistry* registry, const ssBodyBinding* bindin
   ssBodyWritten written;
   ssBodyWrittenFor(binding, binding->written_step_s, &written);
   dBodyID body = binding->body;
-  dWorldID world = registry->world;
+  dWorldID world = ssRegistryWorld(registry);
   if (binding->has_damping &&
       (!ssSameInOde(written.linear_scale, body ? dBodyGetLinearDamping(body) : dWorldGetLinearDamping(world)) ||
        !ssSameInOde(written.angular_scale, body ? dBodyGetAngularDamping(body) : dWorldGetAngularDamping(world))))
@@ -94,16 +92,18 @@ static int bodyAsWritten(const ssRegistry* registry, const ssBodyBinding* bindin
 
 ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
   if (followed != NULL) *followed = 0;
-  double step_s = registry->tuned_step_s; /* what adopted numbers mean; nothing adopted, nothing to follow */
+  double step_s = ssRegistry_TunedStep(registry); /* what adopted numbers mean; nothing adopted, nothing to follow */
   if (step_s == 0) return SS_OK;
-  dWorldID world = registry->world;
+  dWorldID world = ssRegistryWorld(registry);
   /* the world's rows */
   int world_followed = 0;
   ssRowLaw world_law;
   ssSoftness world_held = {dWorldGetERP(world), dWorldGetCFM(world)};
-  if (registry->world_bound && registry->world_law.tuned_step_s > 0 && !isnan(registry->world_written.cfm) &&
-      (!ssSameInOde(world_held.erp, registry->world_written.erp) ||
-       !ssSameInOde(world_held.cfm, registry->world_written.cfm))) {
+  ssRowLaw bound_law;
+  int world_bound = ssRegistryWorldBound(registry, &bound_law) && bound_law.tuned_step_s > 0;
+  ssSoftness world_written = world_bound ? ssApplyLastWritten(registry, -1) : (ssSoftness){NAN, NAN};
+  if (world_bound && !isnan(world_written.cfm) &&
+      (!ssSameInOde(world_held.erp, world_written.erp) || !ssSameInOde(world_held.cfm, world_written.cfm))) {
     ssStatus status = lawOfWritten("world ERP/CFM, as the program wrote them,", world_held, step_s, &world_law);
     if (status != SS_OK) return status;
     world_followed = 1;
@@ -116,8 +116,8 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
   ssBodyBinding* bodies = NULL;
   int* body_at = NULL;
   int body_count = 0;
-  for (int i = 0; i < registry->body_count && status == SS_OK; ++i) {
-    const ssBodyBinding* binding = &registry->bodies[i];
+  for (int i = 0; i < ssRegistryBodyBindingCount(registry) && status == SS_OK; ++i) {
+    const ssBodyBinding* binding = ssRegistryBodyAt(registry, i);
     int adopted = binding->tuned.damping_step_s > 0 || binding->tuned.auto_disable_step_s > 0;
     if (!adopted || isnan(binding->written_step_s) || bodyAsWritten(registry, binding)) continue;
     ssBodyBinding* larger_bodies = realloc(bodies, (size_t)(body_count + 1) * sizeof *bodies);
@@ -140,24 +140,14 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
     return status;
   }
 
-  /* Nothing below can fail: every followed value is bound as what it stands for. */
-  if (row_count > 0) ssApplyMaterializeWritten(registry); /* the rows' own written, before they change */
-  for (int r = 0; r < row_count; ++r) {
-    JointBinding* binding = &registry->joints[rows[r].binding];
-    binding->law = rows[r].law;
-    binding->written = rows[r].held; /* what ODE holds: Apply writes the law's softness over it */
-    binding->computed_step_s = NAN;
-  }
-  if (world_followed) {
-    registry->world_law = world_law;
-    registry->world_written = world_held;
-    if (registry->tuned_step_s > 0) registry->tuned_world = world_law.tuned; /* contacts without soft modes */
-  }
-  for (int b = 0; b < body_count; ++b) {
-    registry->bodies[body_at[b]] = bodies[b]; /* its samples written: what ODE holds now */
-  }
+  /* Nothing below can fail: every followed value is bound as what it stands for, and what ODE holds now is what
+   * Apply compares its next softness with (it writes the law's over it where they differ). */
+  for (int r = 0; r < row_count; ++r) ssRegistryFollowJointLaw(registry, rows[r].binding, rows[r].law);
+  if (world_followed) ssRegistryFollowWorldLaw(registry, world_law);
+  for (int b = 0; b < body_count; ++b) ssRegistryFollowBody(registry, body_at[b], &bodies[b]);
+  for (int r = 0; r < row_count; ++r) ssApplyTakeHeld(registry, rows[r].binding, rows[r].held);
+  if (world_followed) ssApplyTakeHeld(registry, -1, world_held);
   int total = world_followed + row_count + body_count;
-  if (total > 0) registry->revision += 1; /* Apply computes and writes again, even at the same step */
   if (followed != NULL) *followed = total;
   free(rows);
   free(bodies);

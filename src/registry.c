@@ -5,12 +5,35 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "binding_index.h"
 #include "error.h"
+#include "joint_rows.h"
 #include "ode_bounds.h"
 #include "pointer_set.h"
-#include "registry_layout.h"
+#include "registry_internal.h"
 #include "steadystep/adopt.h"
 #include "steadystep/registry.h"
+
+/* What the program bound, and nothing derived from it: Apply keeps what it computes and writes in its own state
+ * (apply.c), which it rebuilds whenever revision changes. */
+struct ssRegistry {
+  dWorldID world;
+  int world_bound;
+  ssRowLaw world_law;
+  double world_mass;
+  double tuned_step_s;    /* adoption's tuned step; 0 before any */
+  ssSoftness tuned_world; /* the world's ERP/CFM as adopted (contacts without soft modes stand for these) */
+  ssJointRowBinding* joints;
+  int joint_count, joint_capacity;
+  ssBodyBinding* bodies;
+  int body_count, body_capacity;
+  ssBindingIndex joint_index; /* (joint, rowTag) -> position in joints */
+  ssBindingIndex body_index;  /* (body, 0) -> position in bodies */
+  unsigned generation; /* changes whenever the set of bound joints or bodies does */
+  unsigned revision;   /* changes whenever any binding does */
+  unsigned last_stamp; /* the last stamp given to a joint row's binding */
+  ssRegistryAttachment apply; /* Apply's state (apply.c) */
+};
 
 /* Refuses a body of another world than the registry's (0, the static world, is everyone's): the registry's writes
  * for it would be read by a world the registry never steps. */
@@ -19,9 +42,6 @@ static ssStatus requireRegistryWorld(const ssRegistry* registry, const char* wha
   return ssFail(SS_ERROR_OUT_OF_RANGE, "%s: body %p is of world %p, not of the registry's world %p", what,
                 (void*)body, (void*)dBodyGetWorld(body), (void*)registry->world);
 }
-
-/* The block from realloc that holds the joints array (see growJoints), or NULL. */
-static void* jointsBlock(JointBinding* joints) { return joints ? ((void**)joints)[-1] : NULL; }
 
 ssRegistry* ssRegistry_Create(dWorldID world) {
   if (world == 0) {
@@ -34,18 +54,14 @@ ssRegistry* ssRegistry_Create(dWorldID world) {
     return NULL;
   }
   registry->world = world;
-  registry->world_written = (ssSoftness){NAN, NAN};
-  registry->applied_step_s = NAN;
-  registry->body_cache_stale = 1;
   return registry;
 }
 
 void ssRegistry_Destroy(ssRegistry* registry) {
   if (registry == NULL) return;
-  free(jointsBlock(registry->joints));
-  free(registry->hot_rows);
+  if (registry->apply.free_state != NULL) registry->apply.free_state(registry->apply.state);
+  free(registry->joints);
   free(registry->bodies);
-  free(registry->body_cache);
   ssIndexFree(&registry->joint_index);
   ssIndexFree(&registry->body_index);
   free(registry);
@@ -69,56 +85,18 @@ ssStatus ssRegistry_BindWorld(ssRegistry* registry, ssSpring spring, double effe
   return SS_OK;
 }
 
-/* The joints array is aligned to cache lines (JointBinding's groups are lines) inside a block from realloc, whose own
- * address is kept in the word before the array. Growing it with realloc rather than a fresh aligned block and a copy
- * matters at scale: glibc grows a large (mmapped) block with mremap, which moves its pages instead of copying them,
- * so the bindings made so far are neither copied nor is a second copy of them first-touched (page faults) at every
- * doubling (binding 100,000 rows in a fresh process: 8,300 faults instead of 17,300, 0.3 us a row instead of 0.6).
- * The block's offset within a page is kept by mremap, so the array rarely has to slide to its alignment. */
-enum { kLine = 64 };
+static int reserve(void** items, int count, int more, int* capacity, size_t size);
 
-static JointBinding* alignedIn(void* block) {
-  uintptr_t first = ((uintptr_t)block + sizeof(void*) + kLine - 1) / kLine * kLine;
-  return (JointBinding*)first;
-}
-
-static int growJoints(ssRegistry* registry, int wanted) {
-  void* old_block = jointsBlock(registry->joints);
-  size_t old_offset = registry->joints ? (size_t)((char*)registry->joints - (char*)old_block) : 0;
-  void* block = realloc(old_block, (size_t)wanted * sizeof(JointBinding) + kLine + sizeof(void*));
-  if (block == NULL) return 0;
-  JointBinding* joints = alignedIn(block);
-  size_t offset = (size_t)((char*)joints - (char*)block);
-  if (offset != old_offset && registry->joint_count > 0)
-    memmove(joints, (char*)block + old_offset, (size_t)registry->joint_count * sizeof(JointBinding));
-  ((void**)joints)[-1] = block;
-  registry->joints = joints;
-  return 1;
-}
-
-/* Room for `more` joint bindings. The hot rows are not copied: they mirror the bindings only while the Apply cache
- * is valid, and it is marked stale here, so the next Apply rebuilds them (apply.c). */
 static int reserveJoints(ssRegistry* registry, int more) {
-  if (!ssIndexReserve(&registry->joint_index, (size_t)registry->joint_count + (size_t)more)) return 0;
-  if (registry->joint_count + more <= registry->joint_capacity) return 1;
-  int wanted = registry->joint_capacity ? 2 * registry->joint_capacity : 8;
-  if (wanted < registry->joint_count + more) wanted = registry->joint_count + more;
-  HotRow* hot = aligned_alloc(kLine, ((size_t)wanted * sizeof(HotRow) + kLine - 1) / kLine * kLine);
-  if (hot == NULL || !growJoints(registry, wanted)) {
-    free(hot);
-    return 0;
-  }
-  free(registry->hot_rows);
-  registry->hot_rows = hot;
-  registry->body_cache_stale = 1;
-  registry->joint_capacity = wanted;
-  return 1;
+  return ssIndexReserve(&registry->joint_index, (size_t)registry->joint_count + (size_t)more) &&
+         reserve((void**)&registry->joints, registry->joint_count, more, &registry->joint_capacity,
+                 sizeof(ssJointRowBinding));
 }
 
 /* A joint row's tag in the index: its parameter set and axis (1..3). */
 static int rowTag(ssJointParam param, int axis) { return 4 * (int)param + axis; }
 
-static JointBinding* findJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis) {
+static ssJointRowBinding* findJoint(ssRegistry* registry, dJointID joint, ssJointParam param, int axis) {
   int position = ssIndexFind(&registry->joint_index, joint, rowTag(param, axis));
   return position >= 0 ? &registry->joints[position] : NULL;
 }
@@ -134,7 +112,7 @@ int ssRegistryHasJoint(const ssRegistry* registry, dJointID joint) {
 static void reindexJoints(ssRegistry* registry) {
   ssIndexClear(&registry->joint_index);
   for (int i = 0; i < registry->joint_count; ++i) {
-    const JointBinding* binding = &registry->joints[i];
+    const ssJointRowBinding* binding = &registry->joints[i];
     ssIndexPut(&registry->joint_index, binding->joint, rowTag(binding->param, binding->axis), i);
   }
 }
@@ -143,48 +121,34 @@ int ssRegistryHasJointRow(ssRegistry* registry, dJointID joint, ssJointParam par
   return findJoint(registry, joint, param, axis) != NULL;
 }
 
-static int reserve(void** items, int count, int more, int* capacity, size_t size);
-
-/* A fresh binding of a joint row, nothing computed yet. */
-static JointBinding newBinding(dJointID joint, int joint_type, ssJointParam param, int axis, ssRowLaw law,
-                               double effective_mass) {
-  JointBinding binding = {.joint = joint,
-                          .pending = {0, 0},
-                          .written = {NAN, NAN},
-                          .param = param,
-                          .axis = axis,
-                          .law = law,
-                          .effective_mass = effective_mass,
-                          .mass = NAN,
-                          .computed_mapping = SS_MAPPING_IMPLICIT_EULER,
-                          .computed_fallback = {0, 0},
-                          .law_slot = -1,
-                          .computed_step_s = NAN,
-                          .computed_previous_s = NAN,
-                          .load = 0,
-                          .load_correction = 0,
-                          .body_slot = {-1, -1},
-                          .joint_type = (uint8_t)joint_type};
-  ssJointRowWriterOfType(joint_type, param, axis, &binding.writer);
-  return binding;
+/* A fresh binding of a joint row, with a stamp of its own. */
+static ssJointRowBinding newBinding(ssRegistry* registry, dJointID joint, int joint_type, ssJointParam param,
+                                    int axis, ssRowLaw law, double effective_mass) {
+  return (ssJointRowBinding){.joint = joint,
+                             .law = law,
+                             .effective_mass = effective_mass,
+                             .load = 0,
+                             .stamp = ++registry->last_stamp,
+                             .joint_type = joint_type,
+                             .param = param,
+                             .axis = axis};
 }
 
 /* Appends a row not bound yet, with room reserved. */
 static void appendJoint(ssRegistry* registry, dJointID joint, int joint_type, ssJointParam param, int axis,
                         ssRowLaw law, double effective_mass) {
   ssIndexPut(&registry->joint_index, joint, rowTag(param, axis), registry->joint_count);
-  registry->joints[registry->joint_count++] = newBinding(joint, joint_type, param, axis, law, effective_mass);
+  registry->joints[registry->joint_count++] = newBinding(registry, joint, joint_type, param, axis, law, effective_mass);
   registry->generation += 1;
 }
 
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass) {
-  ssApplyMaterializeWritten(registry); /* before the law slots or the rows move */
   registry->revision += 1;
   int joint_type = dJointGetType(joint);
-  JointBinding* existing = findJoint(registry, joint, param, axis);
+  ssJointRowBinding* existing = findJoint(registry, joint, param, axis);
   if (existing != NULL) {
-    *existing = newBinding(joint, joint_type, param, axis, law, effective_mass);
+    *existing = newBinding(registry, joint, joint_type, param, axis, law, effective_mass);
     return SS_OK;
   }
   if (!reserveJoints(registry, 1))
@@ -195,7 +159,6 @@ ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointPar
 
 void ssRegistryAppendJointLaw(ssRegistry* registry, dJointID joint, int joint_type, ssJointParam param, int axis,
                               ssRowLaw law) {
-  ssApplyMaterializeWritten(registry);
   registry->revision += 1;
   appendJoint(registry, joint, joint_type, param, axis, law, 0);
 }
@@ -226,21 +189,19 @@ ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointPa
     status = ssFail(SS_ERROR_OUT_OF_RANGE, "load = %g N or N·m: must be at most SS_MAX_FORCE_N = %g in size", load,
                     SS_MAX_FORCE_N);
   if (status != SS_OK) return status;
-  JointBinding* binding = findJoint(registry, joint, param, axis);
+  ssJointRowBinding* binding = findJoint(registry, joint, param, axis);
   if (binding == NULL)
     return ssFail(SS_ERROR_NOT_FOUND, "joint %p, param %d, axis %d: not bound", (void*)joint, (int)param, axis);
   if (!ssJointRowHasDirection(joint, param, axis))
     return ssFail(SS_ERROR_UNSUPPORTED, "a %s joint's %s rows have no single direction to carry a load",
                   ssJointTypeName(joint), ssJointParamName(param));
   binding->load = load;
-  binding->computed_step_s = NAN; /* a softness the old load sent to implicit Euler is not reused */
   registry->revision += 1;
   return SS_OK;
 }
 
 ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
   REQUIRE_REGISTRY(registry);
-  ssApplyMaterializeWritten(registry);
   int kept = 0;
   for (int i = 0; i < registry->joint_count; ++i)
     if (registry->joints[i].joint != joint) registry->joints[kept++] = registry->joints[i];
@@ -253,7 +214,6 @@ ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
 }
 
 int ssRegistryUnbindJointsNotIn(ssRegistry* registry, const ssPointerSet* alive) {
-  ssApplyMaterializeWritten(registry);
   int kept = 0;
   for (int i = 0; i < registry->joint_count; ++i)
     if (ssPointerSetHas(alive, registry->joints[i].joint)) registry->joints[kept++] = registry->joints[i];
@@ -459,19 +419,29 @@ int ssRegistryBodyBindingCount(const ssRegistry* registry) { return registry->bo
 
 unsigned ssRegistryGeneration(const ssRegistry* registry) { return registry->generation; }
 
-ssJointRowBinding ssRegistryJointRowAt(const ssRegistry* registry, int i) {
-  const JointBinding* binding = &registry->joints[i];
-  /* while the by-law pass stands for the rows' own written, the law's is what the row was given */
-  int by_law = registry->written_by_law && binding->law_slot >= 0;
-  ssSoftness written = by_law ? registry->law_written[binding->law_slot] : binding->written;
-  return (ssJointRowBinding){binding->joint,          binding->param, binding->axis, binding->law,
-                             binding->effective_mass, binding->load,  isnan(written.erp) && isnan(written.cfm)};
+const ssJointRowBinding* ssRegistryJointRowAt(const ssRegistry* registry, int i) { return &registry->joints[i]; }
+
+unsigned ssRegistryLastStamp(const ssRegistry* registry) { return registry->last_stamp; }
+
+unsigned ssRegistryRevision(const ssRegistry* registry) { return registry->revision; }
+
+void ssRegistryFollowJointLaw(ssRegistry* registry, int i, ssRowLaw law) {
+  registry->joints[i].law = law;
+  registry->revision += 1;
 }
 
-void ssRegistrySetRowWritten(ssRegistry* registry, int i, ssSoftness softness) {
-  ssApplyMaterializeWritten(registry);
-  registry->joints[i].written = softness;
+void ssRegistryFollowWorldLaw(ssRegistry* registry, ssRowLaw law) {
+  registry->world_law = law;
+  if (registry->tuned_step_s > 0) registry->tuned_world = law.tuned; /* contacts without soft modes */
+  registry->revision += 1;
 }
+
+void ssRegistryFollowBody(ssRegistry* registry, int i, const ssBodyBinding* binding) {
+  registry->bodies[i] = *binding;
+  registry->revision += 1;
+}
+
+ssRegistryAttachment* ssRegistryApplyAttachment(ssRegistry* registry) { return &registry->apply; }
 
 ssBodyBinding* ssRegistryBodyAt(ssRegistry* registry, int i) { return &registry->bodies[i]; }
 

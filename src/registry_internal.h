@@ -1,10 +1,14 @@
-/* Internal: what the stepper, soft contacts and adoption need from the registry beyond the public API. */
+/* Internal: what the stepper, Apply, soft contacts, adoption and following need from the registry beyond the public
+ * API. The registry's layout is registry.c's alone. */
 #ifndef STEADYSTEP_REGISTRY_INTERNAL_H
 #define STEADYSTEP_REGISTRY_INTERNAL_H
 
 #include "pointer_set.h"
 #include "row_law.h"
 #include "steadystep/registry.h"
+
+#define REQUIRE_REGISTRY(registry) \
+  if ((registry) == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "registry = NULL: a registry is required")
 
 /* What a program had set on a body (or as the world's defaults), read back by adoption: at the step they were tuned
  * for the registry writes these numbers as they were, since the rates and seconds that stand for them at every other
@@ -91,22 +95,39 @@ ssStatus ssRegistryReserve(ssRegistry* registry, int more_joints, int more_bodie
 void ssRegistrySetTuned(ssRegistry* registry, double tuned_step_s, ssSoftness tuned_world);
 ssSoftness ssRegistryTunedWorld(const ssRegistry* registry);
 
-/* One bound joint row as bound, for the reference Apply (apply_reference.h): no cache, no derived state. */
+/* One bound joint row as the program (or adoption) bound it: all the registry keeps of a row. What Apply derives
+ * from it (what it wrote, masses, softnesses, its caches) is Apply's own (apply.c). */
 typedef struct ssJointRowBinding {
   dJointID joint;
-  ssJointParam param;
-  int axis;
   ssRowLaw law;
   double effective_mass; /* 0: measured from the bodies */
   double load;           /* 0: none declared */
-  int unwritten;         /* nothing written since it was bound: the next Apply writes it whatever ODE holds */
+  /* changes whenever the row is bound (again): a row bound after an Apply is written at the next one whatever ODE
+   * holds; never 0, and larger than every stamp given before (ssRegistryLastStamp) */
+  unsigned stamp;
+  int joint_type; /* dJointGetType at bind time: a joint's type never changes */
+  ssJointParam param;
+  int axis;
 } ssJointRowBinding;
 
-/* The i-th bound joint row (0 <= i < ssRegistry_JointBindingCount), in the order Apply writes them. */
-ssJointRowBinding ssRegistryJointRowAt(const ssRegistry* registry, int i);
+/* The i-th bound joint row (0 <= i < ssRegistry_JointBindingCount), in the order Apply writes them. Binding keeps the
+ * order of the rows it does not touch: rows bound anew are appended, rebound in place, unbound ones removed. */
+const ssJointRowBinding* ssRegistryJointRowAt(const ssRegistry* registry, int i);
 
-/* Records that the i-th row was given softness (the reference Apply's part of the registry's state). */
-void ssRegistrySetRowWritten(ssRegistry* registry, int i, ssSoftness softness);
+/* The largest stamp given to a binding so far (0: none). */
+unsigned ssRegistryLastStamp(const ssRegistry* registry);
+
+/* A number that changes whenever any binding does (a row, its load, the world, a body, the tuned step): what Apply
+ * derives from the bindings is rebuilt on a change. */
+unsigned ssRegistryRevision(const ssRegistry* registry);
+
+/* The i-th row takes law as the program's newly tuned one (follow.c): not a new binding (what Apply last wrote stays
+ * what it compares with), but a change of the bindings. */
+void ssRegistryFollowJointLaw(ssRegistry* registry, int i, ssRowLaw law);
+/* The world's rows take law, the world's ERP/CFM as the program wrote them (contacts without soft modes too). */
+void ssRegistryFollowWorldLaw(ssRegistry* registry, ssRowLaw law);
+/* The i-th body binding becomes binding, as adoption read it from what the program set. */
+void ssRegistryFollowBody(ssRegistry* registry, int i, const ssBodyBinding* binding);
 
 /* The i-th body binding (0 <= i < ssRegistryBodyBindingCount). */
 ssBodyBinding* ssRegistryBodyAt(ssRegistry* registry, int i);
@@ -114,20 +135,16 @@ ssBodyBinding* ssRegistryBodyAt(ssRegistry* registry, int i);
 /* The effective mass the world's rows are bound with (kg; 1 when none was given). */
 double ssRegistryWorldMass(const ssRegistry* registry);
 
-/* Apply's caches (apply.c states each one's invariant), for measuring what each buys and testing Apply without it. */
-enum {
-  SS_CACHE_SAME_STEP = 1 << 0, /* implicit Euler at the last step with nothing rebound: nothing to write */
-  SS_CACHE_BY_LAW = 1 << 1,    /* implicit Euler: one softness per law of the table, rows written by law */
-  SS_CACHE_BODIES = 1 << 2,    /* each body's inverse mass and inertia computed once per Apply */
-  SS_CACHE_SHARED = 1 << 3,    /* within an Apply, rows with the same law and mass share one softness */
-  SS_CACHE_REUSE = 1 << 4,     /* accurate mappings: a row's softness kept while its inputs are the same */
-  SS_CACHE_SAME_AXIS = 1 << 5, /* a stop and a motor on one axis share the mass measured for the first */
-  SS_CACHE_SURE_FALLBACK = 1 << 6, /* accurate mappings: a row the rule surely hands on, without the arithmetic */
-  SS_CACHE_ALL = (1 << 7) - 1
-};
+/* Writes every body binding whose values were written for another step than step_s (Apply's last part). */
+void ssRegistryWriteBodies(ssRegistry* registry, double step_s);
 
-/* Turns off the caches in mask (and on the others). The values Apply writes are the same either way. */
-void ssRegistryDisableCaches(ssRegistry* registry, unsigned mask);
+/* What another room derives from the bindings and keeps with the registry (Apply's state, apply.c): the registry
+ * holds it, frees it with free_state when it is destroyed, and never reads it. */
+typedef struct ssRegistryAttachment {
+  void* state;
+  void (*free_state)(void* state);
+} ssRegistryAttachment;
+ssRegistryAttachment* ssRegistryApplyAttachment(ssRegistry* registry);
 
 /* The last contact's softness, for the contacts that follow with the same numbers. A program softens every contact
  * of a step with one or a few surfaces: a contact whose tuned erp/cfm, tuned step, mapping and step are the last

@@ -7,6 +7,7 @@
 
 #include <ode/ode.h>
 
+#include "apply_internal.h"
 #include "apply_reference.h"
 #include "joint_rows.h"
 #include "registry_internal.h"
@@ -20,6 +21,7 @@ typedef struct Twin {
   ssRegistry* registry;
   dBodyID bodies[kBodies];
   dJointID joints[kJoints];
+  unsigned applied_stamp; /* the reference's */
 } Twin;
 
 typedef struct Reader {
@@ -95,6 +97,7 @@ static void buildTwin(Twin* twin) {
   dWorldSetGravity(twin->world, 0, 0, -9.81);
   dWorldSetQuickStepNumIterations(twin->world, 10);
   twin->registry = ssRegistry_Create(twin->world);
+  twin->applied_stamp = 0;
   for (int i = 0; i < kBodies; ++i) {
     twin->bodies[i] = dBodyCreate(twin->world);
     dMass mass;
@@ -281,7 +284,7 @@ int ssApplyDifferential(const uint8_t* data, size_t size, char* message, size_t 
       ssApplyReport reports[2];
       memset(reports, 0, sizeof reports);
       ssStatus fast = ssRegistry_Apply(twins[0].registry, mapping, step_s, previous_s, &reports[0]);
-      ssStatus reference = ssRegistryApplyReference(twins[1].registry, mapping, step_s, previous_s, &reports[1]);
+      ssStatus reference = ssRegistryApplyReference(twins[1].registry, &twins[1].applied_stamp, mapping, step_s, previous_s, &reports[1]);
       check.counts->applies += 1;
       check.counts->applies_failed += fast != SS_OK;
       if (fast != reference) {
@@ -317,7 +320,7 @@ int ssApplyDifferential(const uint8_t* data, size_t size, char* message, size_t 
       continue;
     }
     if (op.kind == 11) { /* some of Apply's caches off, or all on again: the values written stay the same */
-      ssRegistryDisableCaches(twins[0].registry, op.a % 2 ? 0 : op.b & SS_CACHE_ALL);
+      ssApplyDisableCaches(twins[0].registry, op.a % 2 ? 0 : op.b & SS_APPLY_ALL);
       continue;
     }
     for (int t = 0; t < 2; ++t) {

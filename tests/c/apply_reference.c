@@ -1,4 +1,4 @@
-/* The reference Apply (apply_reference.h): compute every row, then write what changed. */
+/* The tests' reference Apply (apply_reference.h): compute every row, then write what changed. */
 #include "apply_reference.h"
 
 #include <math.h>
@@ -107,8 +107,8 @@ static void writeBody(const ssBodyBinding* binding, dWorldID world, double step_
   }
 }
 
-ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
-                                  ssApplyReport* report) {
+ssStatus ssRegistryApplyReference(ssRegistry* registry, unsigned* applied_stamp, ssMapping mapping, double step_s,
+                                  double previous_step_s, ssApplyReport* report) {
   if (registry == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "registry = NULL: a registry is required");
   ssStatus status = ssCheckStepLength("step_s", step_s);
   if (status == SS_OK && previous_step_s != 0) status = ssCheckStepLength("previous_step_s", previous_step_s);
@@ -131,8 +131,7 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
   Computed* computed = malloc((size_t)(rows > 0 ? rows : 1) * sizeof *computed);
   if (computed == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory in the reference Apply");
   for (int i = 0; i < rows && status == SS_OK; ++i) {
-    ssJointRowBinding row = ssRegistryJointRowAt(registry, i);
-    status = computeRow(&row, mapping, step_s, previous_s, &counts, &computed[i]);
+    status = computeRow(ssRegistryJointRowAt(registry, i), mapping, step_s, previous_s, &counts, &computed[i]);
   }
   if (status != SS_OK) {
     free(computed);
@@ -146,7 +145,7 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
     counts.row_writes += 1;
   }
   for (int i = 0; i < rows; ++i) {
-    ssJointRowBinding row = ssRegistryJointRowAt(registry, i);
+    const ssJointRowBinding row = *ssRegistryJointRowAt(registry, i);
     double erp, cfm;
     ssJointReadSoftness(row.joint, row.param, row.axis, &erp, &cfm);
     ssRowWriter writer;
@@ -154,19 +153,19 @@ ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, doubl
     /* a motor row has no erp: ODE holds only its cfm */
     int erp_differs = writer.erp_number >= 0 && !ssSameInOde(erp, computed[i].softness.erp);
     /* a row bound since the last Apply is written whatever ODE holds (registry.h: binding again rewrites it) */
-    if (row.unwritten || erp_differs || !ssSameInOde(cfm, computed[i].softness.cfm)) {
+    if (row.stamp > *applied_stamp || erp_differs || !ssSameInOde(cfm, computed[i].softness.cfm)) {
       ssRowWrite(&writer, row.joint, computed[i].softness.erp, computed[i].softness.cfm);
-      ssRegistrySetRowWritten(registry, i, computed[i].softness);
       counts.row_writes += 1;
     }
   }
   for (int i = 0; i < rows; ++i) {
-    ssJointRowBinding row = ssRegistryJointRowAt(registry, i);
-    if (computed[i].correction != 0) ssJointAddRowForce(row.joint, row.param, row.axis, computed[i].correction);
+    const ssJointRowBinding* row = ssRegistryJointRowAt(registry, i);
+    if (computed[i].correction != 0) ssJointAddRowForce(row->joint, row->param, row->axis, computed[i].correction);
   }
   free(computed);
   for (int i = 0; i < ssRegistryBodyBindingCount(registry); ++i)
     writeBody(ssRegistryBodyAt(registry, i), world_id, step_s);
+  *applied_stamp = ssRegistryLastStamp(registry);
   if (report != NULL) *report = counts;
   return SS_OK;
 }

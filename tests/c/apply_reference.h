@@ -1,4 +1,5 @@
-/* Internal, built for tests only: Apply as its documentation states it, with no cache. Every row's mass is measured
+/* The tests' reference Apply: Apply as its documentation states it, with no cache and no state of its own beyond the
+ * last binding stamp it wrote for. Every row's mass is measured
  * from its bodies (or given), every softness computed and checked, every load correction bounded; then each value
  * that differs from what ODE holds is written. The differential test and fuzz target (tests/c/apply_differential.c)
  * drive it beside ssRegistry_Apply on twin worlds and require the same values in ODE. */
@@ -12,10 +13,11 @@ extern "C" {
 #endif
 
 /* ssRegistry_Apply's contract, computed plainly; row_writes counts the parameter sets written: those whose value ODE
- * did not hold already, and those bound since the last Apply. Errors: those of ssRegistry_Apply, with nothing
+ * did not hold already, and those bound since the last Apply (a stamp above *applied_stamp, which starts at 0 and
+ * which each Apply that succeeds sets to the registry's last stamp). Errors: those of ssRegistry_Apply, with nothing
  * written. */
-ssStatus ssRegistryApplyReference(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,
-                                  ssApplyReport* report);
+ssStatus ssRegistryApplyReference(ssRegistry* registry, unsigned* applied_stamp, ssMapping mapping, double step_s,
+                                  double previous_step_s, ssApplyReport* report);
 
 #ifdef __cplusplus
 }

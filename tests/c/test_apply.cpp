@@ -1,4 +1,4 @@
-// Apply against its reference (src/apply_reference.h): random scenarios on twin worlds, through many laws, loads,
+// Apply against its reference (tests/c/apply_reference.h): random scenarios on twin worlds, through many laws, loads,
 // unbinding, rebinding, attachment and mass changes and every mapping, must write the same values into ODE.
 #include <gtest/gtest.h>
 
