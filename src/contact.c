@@ -105,8 +105,6 @@ ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID
     cache->has_softness = 1;
     cache->mapping = mapping;
     cache->step_s = step_s;
-    cache->previous_step_s = 0;
-    cache->mass = NAN;
     cache->softness = softness;
     cache->handed_on = fallback;
   }

@@ -148,14 +148,14 @@ ssRegistryAttachment* ssRegistryApplyAttachment(ssRegistry* registry);
 
 /* The last contact's softness, for the contacts that follow with the same numbers. A program softens every contact
  * of a step with one or a few surfaces: a contact whose tuned erp/cfm, tuned step, mapping and step are the last
- * one's reuses its law and its softness (which depends on the step
- * alone: every mapping serves a contact with implicit Euler, contact.c), with no conversion and no check repeated:
- * they were made, and passed, for the same inputs. previous_step_s and mass are kept empty (0, NAN). */
+ * one's reuses its law and its softness (which depends on the step alone: every mapping serves a contact with
+ * implicit Euler, contact.c), with no conversion and no check repeated: they were made, and passed, for the same
+ * inputs. */
 typedef struct ssContactCache {
   double tuned_erp, tuned_cfm, tuned_step_s; /* NAN: empty */
   ssRowLaw law;
   ssMapping mapping;
-  double step_s, previous_step_s, mass; /* mass: NAN where the softness does not read it */
+  double step_s;
   int has_softness;
   ssSoftness softness;
   ssRowFallback handed_on;
@@ -165,8 +165,9 @@ typedef struct ssContactCache {
 ssContactCache ssContactCacheEmpty(void);
 
 /* Softens contact as the law that tuned_erp and tuned_cfm stand for at tuned_step_s (ssRowLawFromTuned), for a step
- * of step_s under mapping, through the cache; *handed_on (may be NULL) says whether the accurate mapping handed the
- * contact on (to matched, or to implicit Euler). Errors, with contact unchanged: those of ssRowLawFromTuned and
+ * of step_s under mapping, through the cache; *handed_on (may be NULL) says whether an accurate mapping handed the
+ * contact on to implicit Euler (it always does: exact_to_matched is never set). body1, body2 and previous_step_s
+ * are not read (no contact's softness depends on them). Errors, with contact unchanged: those of ssRowLawFromTuned and
  * ssContactSoften. */
 ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID body1, dBodyID body2,
                                double tuned_erp, double tuned_cfm, double tuned_step_s, ssMapping mapping,
