@@ -34,7 +34,8 @@ import numpy as np
 from steadystep import audit_measure as measure_
 from steadystep._native import SteadystepError, printable
 from steadystep.audit_run import (DIAGNOSIS_FLAGS, HALF_STEP, MORE_ITERATIONS, OWN, SERVED_COLUMNS, STEP_COLUMN,
-                                  TIME_COLUMN, BadProgram, Executable, PythonProgram, PythonWorld, Run)
+                                  TIME_COLUMN, UNSOFTENED_COLUMN, BadProgram, Executable, PythonProgram, PythonWorld,
+                                  Run)
 from steadystep.audit_run import run as run_program
 from steadystep.audit_run import supports
 from steadystep.enums import Status
@@ -426,7 +427,10 @@ def _run_row(run: Run, reference: Run, runs_per_variant, first: Run) -> dict:
             "steps_per_frame": float(np.sum(steps)) / run.frames if steps is not None and run.frames else None,
             "cpu_s": run.cpu_s, "wall_s": run.wall_s, "compared_at": compared,
             "cpu_ms_per_simulated_s": 1000 * run.cpu_s / simulated_s if simulated_s > 0 else None,
-            "served": {name: int(np.sum(run.columns[name])) for name in SERVED_COLUMNS if name in run.columns}}
+            "served": {name: int(np.sum(run.columns[name])) for name in SERVED_COLUMNS if name in run.columns},
+            # steps that made contacts but softened none (None: the program does not count them)
+            "unsoftened_contact_steps": (int(np.sum(run.columns[UNSOFTENED_COLUMN]))
+                                         if UNSOFTENED_COLUMN in run.columns else None)}
 
 
 def _cost(done: dict, variants: list[str], method: str, cost_profile) -> dict:

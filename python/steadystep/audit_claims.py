@@ -114,6 +114,9 @@ def _ranked(values: dict) -> str:
 def claims(result) -> list[dict]:
     tables = Tables(result)
     out = [_reference(result), _failed(result)]
+    unsoftened = _unsoftened(result)
+    if unsoftened:
+        out.append(unsoftened)
     spread = {v: tables.spread(v) for v in result.variants}
     chosen = [v for v in result.variants if result.roles[v] != "diagnosis"]  # what a program can step with
     if any(math.isfinite(spread[v][0]) for v in chosen):
@@ -385,6 +388,25 @@ def _diagnosis(result, tables: Tables, spread: dict) -> dict | None:
     text = f"Where {_name(base)}'s spread ({_g(total)}, in {spread[base][1]}) comes from: " + "; ".join(sentences) + "."
     return {"kind": "diagnosis", "table": "diagnosis", "base": base, "base_value": total, "steps": steps,
             "residue": residue, "text": text}
+
+
+def _unsoftened(result) -> dict | None:
+    """Steps that made contacts on the stepper's bodies but softened none (the program's unsoftened_contact_steps
+    column): its near callback forgot ssStepper_SoftenContact, so those contacts keep the softness tuned for one step
+    length under every policy."""
+    counts = {}
+    for run in result.runs:
+        if run.get("unsoftened_contact_steps"):
+            counts[run["variant"]] = counts.get(run["variant"], 0) + run["unsoftened_contact_steps"]
+    if not counts:
+        return None
+    total = sum(counts.values())
+    text = (f"{total} steps made contacts but softened none ("
+            + ", ".join(f"{_name(v)} {n}" for v, n in counts.items())
+            + "): call ssStepper_SoftenContact (Python: Stepper.soften_contact) on every contact in the near "
+            "callback; without it those contacts keep the softness tuned for one step length under every policy, "
+            "and this audit compares them so.")
+    return {"kind": "unsoftened", "table": "runs", "steps": counts, "total": total, "text": text}
 
 
 def _served(result) -> list[dict]:

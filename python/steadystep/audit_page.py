@@ -93,14 +93,19 @@ def _whole_deviation_table(result) -> str:
 
 
 def _runs_table(result) -> str:
+    """Every run; the steps that made contacts but softened none when a run made any (the unsoftened claim)."""
+    unsoftened = any(r.get("unsoftened_contact_steps") for r in result.runs)
     rows = []
     for r in result.runs:
         status = "ok" if r["status"] == "ok" else f"<span class=bad>{html.escape(r['status'])}</span>"
+        count = r.get("unsoftened_contact_steps")
         rows.append([_variant(result, r["variant"]), html.escape(r["profile"]), str(r["seed"]), str(r["frames"]),
                      _number(r["simulated_s"], 4), _number(r["steps_per_frame"]), html.escape(r["compared_at"]),
-                     _number(r["cpu_s"] * 1000, 3), status])
+                     _number(r["cpu_s"] * 1000, 3)] + ([str(count) if count is not None else "-"] if unsoftened else [])
+                    + [status])
     return _table(["variant", "profile", "seed", "frames", "simulated (s)", "steps / frame", "compared at",
-                   "CPU (ms)", "status"], rows, "runs")
+                   "CPU (ms)"] + (["steps with contacts, none softened"] if unsoftened else []) + ["status"], rows,
+                  "runs")
 
 
 def _cost_table(result) -> str:

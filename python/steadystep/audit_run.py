@@ -6,11 +6,11 @@ A program takes part in one of two ways, and both run as a process of their own,
 - an executable (C, C++, anything) that takes ``--profile SPEC --seed N --duration S`` and, when it runs through the
   library, ``--policy NAME`` (the diagnosis variants add ``--max-step-scale F`` or ``--iterations-scale N``), and
   prints CSV on stdout: a header ``t_s,<quantity>_<unit>,...`` then one row per frame (a row at t = 0 first).
-  Optional count columns (``steps``, ``rows_by_mapping``, ...: OPTIONAL_COLUMNS) say what each frame did (-1 on
-  every frame: not counted, left out). Exit 0 when every frame stepped, 1 when a frame failed (the rows up to it are
-  kept, the run's status says so), anything else is a bad program. The frame durations are also handed over in a
-  file named by STEADYSTEP_AUDIT_FRAMES (steadystep/audit/protocol.h reads them; the lab's audit_flags.h makes the
-  same frames from --profile).
+  Optional count columns (``steps``, ``rows_by_mapping``, ..., ``unsoftened_contact_steps``: OPTIONAL_COLUMNS) say
+  what each frame did (-1 on every frame: not counted, left out). Exit 0 when every frame stepped, 1 when a frame
+  failed (the rows up to it are kept, the run's status says so), anything else is a bad program. The frame
+  durations are also handed over in a file named by STEADYSTEP_AUDIT_FRAMES (steadystep/audit/protocol.h reads
+  them; the lab's audit_flags.h makes the same frames from --profile).
 - a Python file defining ``build_world()`` and ``read_quantities(world)`` (and, for its own stepping,
   ``own_frame(world, time_s, frame_s)``): run by ``python -m steadystep.audit_worker``, which follows the same
   protocol (audit_worker.py).
@@ -53,7 +53,8 @@ TIME_COLUMN = "t_s"
 STEP_COLUMN = "steps"
 SERVED_COLUMNS = ("rows_by_mapping", "rows_handed_to_matched", "rows_handed_to_implicit_euler",
                   "contacts_by_mapping", "contacts_handed_to_matched", "contacts_handed_to_implicit_euler")
-OPTIONAL_COLUMNS = (STEP_COLUMN, *SERVED_COLUMNS)  # counts per frame, not followed quantities
+UNSOFTENED_COLUMN = "unsoftened_contact_steps"  # steps that made contacts but softened none (ssFrameReport's)
+OPTIONAL_COLUMNS = (STEP_COLUMN, *SERVED_COLUMNS, UNSOFTENED_COLUMN)  # counts per frame, not followed quantities
 NOT_COUNTED = -1  # a count column holding this on every frame (after the t = 0 row) is one the program cannot count
 STDERR_SHOWN = 300  # characters of a program's stderr quoted in a message
 FRAMES_VARIABLE = "STEADYSTEP_AUDIT_FRAMES"  # steadystep/audit/protocol.h's SS_AUDIT_RUN_FRAMES_VARIABLE

@@ -43,7 +43,8 @@ import time
 from pathlib import Path
 
 from steadystep.audit_run import (DIAGNOSIS_BASE, DONE_MARK, FRAMES_VARIABLE, LOOP_CPU_MARK, OWN, REFUSAL_MARK,
-                                  REFUSED_EXIT, SERVED_COLUMNS, STEP_COLUMN, TIME_COLUMN, PythonWorld)
+                                  REFUSED_EXIT, SERVED_COLUMNS, STEP_COLUMN, TIME_COLUMN, UNSOFTENED_COLUMN,
+                                  PythonWorld)
 
 
 class Refusal(BaseException):
@@ -188,10 +189,12 @@ def _per_step(shown: str, before_step):
 
 
 def _served(report) -> dict:
+    """The frame's served counts and its steps that made contacts but softened none."""
     rows, contacts = report.rows, report.contacts
-    return dict(zip(SERVED_COLUMNS, (rows.by_mapping, rows.handed_to_matched, rows.handed_to_implicit_euler,
-                                     contacts.by_mapping, contacts.handed_to_matched,
-                                     contacts.handed_to_implicit_euler)))
+    return {**dict(zip(SERVED_COLUMNS, (rows.by_mapping, rows.handed_to_matched, rows.handed_to_implicit_euler,
+                                        contacts.by_mapping, contacts.handed_to_matched,
+                                        contacts.handed_to_implicit_euler))),
+            UNSOFTENED_COLUMN: report.unsoftened_contact_steps}
 
 
 def run(path: str, profile: str, seed: int, duration_s: float, policy: str | None, max_step_scale: float,
@@ -235,7 +238,8 @@ def run(path: str, profile: str, seed: int, duration_s: float, policy: str | Non
                                 (lambda s: call_user(shown, "collide", collide, s)),
                                 contact_group=built.contact_group, before_step=_per_step(shown, built.before_step))
         time_s = 0.0
-        recorder.row(time_s, {STEP_COLUMN: 0, **({name: 0 for name in SERVED_COLUMNS} if stepper else {})})
+        recorder.row(time_s, {STEP_COLUMN: 0,
+                              **({name: 0 for name in (*SERVED_COLUMNS, UNSOFTENED_COLUMN)} if stepper else {})})
         started_cpu = time.process_time()
         for frame_s in _frames(profile, seed, duration_s):
             if built.before_frame is not None:

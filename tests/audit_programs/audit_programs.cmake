@@ -22,6 +22,22 @@ foreach(name box_stack ragdoll maze hopper)
   endif()
 endforeach()
 
+# box_stack_unsoftened: the box stack whose near callback forgets ssStepper_SoftenContact: every step under a policy
+# makes contacts and softens none, which the unsoftened_contact_steps column counts.
+add_executable(steadystep_audit_box_stack_unsoftened ${STEADYSTEP_AUDIT_PROGRAMS_DIR}/box_stack.c)
+target_compile_definitions(steadystep_audit_box_stack_unsoftened PRIVATE GAME_FORGETS_SOFTEN=1)
+target_link_libraries(steadystep_audit_box_stack_unsoftened PRIVATE ${STEADYSTEP_AUDIT_PROGRAMS_CORE} m)
+if(BUILD_TESTING OR STEADYSTEP_TESTS)
+  add_test(NAME audit_program_box_stack_unsoftened_counted
+           COMMAND steadystep_audit_box_stack_unsoftened --policy exact --profile fixed:30 --duration 0.1)
+  set_tests_properties(audit_program_box_stack_unsoftened_counted PROPERTIES PASS_REGULAR_EXPRESSION
+                       ",unsoftened_contact_steps\n0,[^\n]+,0,0,0,0,0,0,0,0\n0\\.0[0-9]+,[^\n]+,0,0,0,[1-9][0-9]*\n")
+  add_test(NAME audit_program_box_stack_softened_counted
+           COMMAND steadystep_audit_box_stack --policy exact --profile fixed:30 --duration 0.1)
+  set_tests_properties(audit_program_box_stack_softened_counted PROPERTIES PASS_REGULAR_EXPRESSION
+                       ",unsoftened_contact_steps\n0,[^\n]+,0,0,0,0,0,0,0,0\n0\\.0[0-9]+,[^\n]+,([1-9][0-9]*,[0-9]+,[0-9]+|[0-9]+,[1-9][0-9]*,[0-9]+|[0-9]+,[0-9]+,[1-9][0-9]*),0\n")
+endif()
+
 add_executable(steadystep_audit_protocol_cxx ${STEADYSTEP_AUDIT_PROGRAMS_DIR}/protocol_cxx.cpp)
 target_link_libraries(steadystep_audit_protocol_cxx PRIVATE ${STEADYSTEP_AUDIT_PROGRAMS_CORE} m)
 if(BUILD_TESTING OR STEADYSTEP_TESTS)

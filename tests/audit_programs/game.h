@@ -18,6 +18,9 @@
 #define GAME_TUNED_STEP_S (1.0 / 60)
 #define GAME_MAX_CONTACTS 4
 #define GAME_MAX_QUANTITIES 8
+#ifndef GAME_FORGETS_SOFTEN
+#define GAME_FORGETS_SOFTEN 0 /* 1: the near callback forgets ssStepper_SoftenContact (the audit says so) */
+#endif
 
 typedef struct Game {
   const char* name;                    /* the program's name, for messages */
@@ -41,7 +44,7 @@ typedef struct Game {
 static Game* game_;
 
 /* The program's near callback: its own surface; adopted, data is the stepper, which softens each contact for its
- * step. */
+ * step (unless built with GAME_FORGETS_SOFTEN=1, as a program that forgot the line would be). */
 static inline void gameNear(void* data, dGeomID g1, dGeomID g2) {
   dBodyID b1 = dGeomGetBody(g1), b2 = dGeomGetBody(g2);
   if (b1 != 0 && b2 != 0 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
@@ -49,7 +52,7 @@ static inline void gameNear(void* data, dGeomID g1, dGeomID g2) {
   int count = dCollide(g1, g2, GAME_MAX_CONTACTS, &contact[0].geom, sizeof(dContact));
   for (int i = 0; i < count; ++i) {
     contact[i].surface = game_->surface;
-    if (data != NULL) ssStepper_SoftenContact((ssStepper*)data, &contact[i], b1, b2);
+    if (data != NULL && !GAME_FORGETS_SOFTEN) ssStepper_SoftenContact((ssStepper*)data, &contact[i], b1, b2);
     dJointAttach(dJointCreateContact(game_->world, game_->contacts, &contact[i]), b1, b2);
     game_->contacts_last_collide += 1;
     if (contact[i].geom.depth > game_->deepest_contact_m) game_->deepest_contact_m = contact[i].geom.depth;

@@ -13,7 +13,7 @@ import math
 import pytest
 
 KNOWN_KINDS = {"reference", "failed", "least_spread", "least_deviation", "cheapest", "recommend", "diagnosis",
-               "served"}
+               "served", "unsoftened"}
 UNITS = ("m_per_s2", "rad_per_s2", "m_per_s", "rad_per_s", "N_m", "N_s", "kg_m2", "m", "rad", "deg", "N", "J", "W",
          "kg", "s", "Pa", "Hz", "count")
 
@@ -266,6 +266,14 @@ def check(metrics: dict) -> list[str]:
             _check_recommend(metrics, claim, reader)
         elif kind == "diagnosis":
             _check_diagnosis(metrics, claim, reader)
+        elif kind == "unsoftened":
+            counts = {}
+            for run in metrics["runs"]:
+                if run.get("unsoftened_contact_steps"):
+                    counts[run["variant"]] = counts.get(run["variant"], 0) + run["unsoftened_contact_steps"]
+            assert claim["steps"] == counts and claim["total"] == sum(counts.values()) > 0, (claim, counts)
+            assert f"{claim['total']} steps made contacts but softened none" in claim["text"]
+            assert "ssStepper_SoftenContact" in claim["text"]
         elif kind == "served":
             for variant, counts in claim["served"].items():
                 assert variant in ("matched", "exact", "fixed-matched", "fixed-exact")
@@ -274,4 +282,6 @@ def check(metrics: dict) -> list[str]:
                     assert count == sum(r["served"][name] for r in runs), (variant, name)
     if not metrics["reference_check"]["usable"]:
         assert "least_deviation" not in kinds
+    # a run that made contacts without softening them is never left unsaid
+    assert ("unsoftened" in kinds) == any(r.get("unsoftened_contact_steps") for r in metrics["runs"]), kinds
     return kinds

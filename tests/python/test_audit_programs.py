@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parents[2]
 BUILD = ROOT / "build"
 SCRIPT = Path(sys.executable).parent / "steadystep"
 COMMAND = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "steadystep.cli"]
-PROGRAMS = ("box_stack", "ragdoll", "maze", "hopper")
+PROGRAMS = ("box_stack", "ragdoll", "maze", "hopper", "box_stack_unsoftened")
 AUDITED = ["--duration", "3", "--profiles", "fixed:60", "uniform:15:45", "--seeds", "1", "2"]
 # The separate runs: other profiles and seeds than the audit's.
 SEPARATE = [("fixed:45", 1), ("uniform:15:45", 7), ("uniform:20:50", 8)]
@@ -162,12 +162,30 @@ def test_box_stack(programs, tmp_path):
         assert metrics["cost"]["method"] == "instructions" and metrics["cost"]["repeat_difference"] < 1e-3
         assert "cheapest" in [c["kind"] for c in metrics["claims"]]
     assert all(r["compared_at"] in ("shared", "baseline") for r in metrics["runs"] if r["variant"] == "fixed")
+    # its near callback softens every contact: counted under every policy, and none left unsoftened
+    assert all(r["unsoftened_contact_steps"] == 0 for r in metrics["runs"] if r["variant"] != "own")
+    assert "unsoftened" not in [c["kind"] for c in metrics["claims"]]
     recommended, spreads = check_by_separate_runs(programs["box_stack"], metrics)
     assert recommended == "fixed" and all(v == (0.0, 0.0) for v in spreads["fixed"].values())
     # what the diagnosis says, in numbers the tables hold
     diagnosis = next(c for c in metrics["claims"] if c["kind"] == "diagnosis")
     assert [s["step"] for s in diagnosis["steps"]] == ["the cut", "the mapping", "the step length", "the solver",
                                                       "identical steps"]
+
+
+def test_box_stack_that_forgets_to_soften_is_told(programs, tmp_path):
+    """The same stack with a near callback that forgets ssStepper_SoftenContact: every step under a policy makes
+    contacts and softens none; the audit says how many, names the call, and shows the count beside each run."""
+    policies = ("implicit-euler", "fixed")
+    metrics = audit(tmp_path, programs["box_stack_unsoftened"], "--cost", "none", "--no-diagnosis",
+                    "--policies", *policies)
+    claim = next(c for c in metrics["claims"] if c["kind"] == "unsoftened")
+    assert set(claim["steps"]) == set(policies) and all(n > 0 for n in claim["steps"].values()), claim
+    assert "ssStepper_SoftenContact" in claim["text"] and "near callback" in claim["text"]
+    for run in metrics["runs"]:  # own stepping does not count (-1: the column left out); every policy run did
+        count = run["unsoftened_contact_steps"]
+        assert count is None if run["variant"] == "own" else count > 0, run
+    assert "steps with contacts, none softened" in (tmp_path / "audit.html").read_text()
 
 
 def test_ragdoll_claims_spread_where_the_reference_parts(programs, tmp_path):

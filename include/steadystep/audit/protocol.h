@@ -19,8 +19,8 @@
  *
  * Output: CSV on stdout. The header "t_s,<quantity>_<unit>,...", a row at t = 0, then one row per frame at the
  * stepper's clock (ssFrameReport.time_s), with optional count columns (SS_AUDIT_RUN_COUNTS_HEADER: the frame's
- * steps and what served its rows and contacts). Exit 0: every frame stepped; 1: a frame failed (after its message on
- * stderr); 2: a bad flag. So taking part is a few lines:
+ * steps, what served its rows and contacts, and its steps that made contacts but softened none). Exit 0: every frame
+ * stepped; 1: a frame failed (after its message on stderr); 2: a bad flag. So taking part is a few lines:
  *
  *   ssAuditRun run;
  *   int parsed = ssAuditRun_Parse("my_game", argc, argv, &run);      // 0 run, 2 bad flag, -1 after --help
@@ -65,7 +65,7 @@ extern "C" {
 /** The optional count columns, in the order ssAuditRun_Row prints them. */
 #define SS_AUDIT_RUN_COUNTS_HEADER                                                                           \
   "steps,rows_by_mapping,rows_handed_to_matched,rows_handed_to_implicit_euler,contacts_by_mapping,"          \
-  "contacts_handed_to_matched,contacts_handed_to_implicit_euler"
+  "contacts_handed_to_matched,contacts_handed_to_implicit_euler,unsoftened_contact_steps"
 
 /** One run's flags and frame clock. Filled by ssAuditRun_Parse; the fields are read-only for the program. */
 typedef struct ssAuditRun {
@@ -235,7 +235,7 @@ static inline double ssAuditRun_NextFrame(ssAuditRun* run, double time_s) {
 
 /* Prints time_s, the values and the counts; returns 0 when a value is not finite. */
 static inline int ssAuditRun_Print_(const ssAuditRun* run, double time_s, int count, const double* values,
-                                    const int counts[7]) {
+                                    const int counts[8]) {
   int finite = isfinite(time_s);
   printf("%.17g", time_s);
   for (int i = 0; i < count; ++i) {
@@ -243,22 +243,23 @@ static inline int ssAuditRun_Print_(const ssAuditRun* run, double time_s, int co
     printf(",%.17g", values[i]);
   }
   if (run->counts)
-    printf(",%d,%d,%d,%d,%d,%d,%d", counts[0], counts[1], counts[2], counts[3], counts[4], counts[5], counts[6]);
+    printf(",%d,%d,%d,%d,%d,%d,%d,%d", counts[0], counts[1], counts[2], counts[3], counts[4], counts[5], counts[6],
+           counts[7]);
   printf("\n");
   return finite;
 }
 
-/** Prints one row at full precision: time_s (s), the count values, and with the count columns the frame's steps
- *  and served counts from report (NULL: zeros, for the t = 0 row). Returns 0 when a value is not finite: the frame
- *  failed. */
+/** Prints one row at full precision: time_s (s), the count values, and with the count columns the frame's steps,
+ *  served counts and unsoftened_contact_steps from report (NULL: zeros, for the t = 0 row). Returns 0 when a value
+ *  is not finite: the frame failed. */
 static inline int ssAuditRun_Row(const ssAuditRun* run, double time_s, int count, const double* values,
                                  const ssFrameReport* report) {
-  int counts[7] = {0, 0, 0, 0, 0, 0, 0};
+  int counts[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   if (report != NULL) {
     const ssServedCounts *rows = &report->rows, *contacts = &report->contacts;
-    int taken[7] = {report->steps,           rows->by_mapping,          rows->handed_to_matched,
+    int taken[8] = {report->steps,           rows->by_mapping,          rows->handed_to_matched,
                     rows->handed_to_implicit_euler, contacts->by_mapping, contacts->handed_to_matched,
-                    contacts->handed_to_implicit_euler};
+                    contacts->handed_to_implicit_euler, report->unsoftened_contact_steps};
     memcpy(counts, taken, sizeof counts);
   }
   return ssAuditRun_Print_(run, time_s, count, values, counts);
@@ -267,7 +268,7 @@ static inline int ssAuditRun_Row(const ssAuditRun* run, double time_s, int count
 /** A row of the program's own stepping (no library): the physics steps the frame took, nothing served (-1). */
 static inline int ssAuditRun_OwnRow(const ssAuditRun* run, double time_s, int count, const double* values,
                                     int steps) {
-  int counts[7] = {steps, -1, -1, -1, -1, -1, -1};
+  int counts[8] = {steps, -1, -1, -1, -1, -1, -1, -1};
   return ssAuditRun_Print_(run, time_s, count, values, counts);
 }
 
