@@ -1,15 +1,20 @@
-"""Every fenced code block of README.md and docs/*.md is compiled or run (issue 28), chosen by its language tag:
+"""Every code block of README.md and docs/*.md is fenced and compiled or run (issue 28), chosen by its language tag:
 
 - c, cpp: the file's C blocks, in order, one translation unit behind stubs for what they take from the program
   around them (a world, a space, a car, a frame clock, a renderer), compiled as C and as C++ against the package's
-  headers and ODE's, warnings as errors;
+  headers and ODE's, warnings as errors; a block tagged `c fragment` (statements from inside a function) is
+  compiled as the body of a function of its own;
 - python: run, on a small odepy world (or PyODE's, for a block that imports ode) with what the block names from
-  the program around it (world, space, contacts, collide, frame_s);
+  the program around it (world, space, contacts, collide, frame_s); `python compile-only` (a block that needs a
+  program or files of the reader's): compiled, and every steadystep function it calls exists and takes the
+  arguments it is given;
 - sh: each command checked without running it: `steadystep ...` parsed by the command line's own parser, `cmake`'s
-  -D options declared in CMakeLists.txt, `scripts/...` present and executable;
+  -D options declared in CMakeLists.txt, `scripts/...` present and executable, `build/steadystep_example_NAME` and
+  `build/steadystep_test_NAME` with their sources, `.venv/bin/python FILE` with FILE present;
 - diff: every line of the block is a line of the real `diff -u` of the two files it names, in order;
 - text, output: not code (a diagram, a program's output), not checked.
-A block with another tag, or none, fails: tag it, or teach this test to check it.
+A block with another tag, or none, fails: tag it, or teach this test to check it. An indented code block (four
+spaces, or four beyond a list item's text) fails too: fence it, so that it has a tag.
 """
 
 from __future__ import annotations
@@ -29,6 +34,7 @@ REPO = Path(__file__).resolve().parents[2]
 INCLUDE = Path(ss.__file__).parent / "_native" / "include"  # the headers the package was built from
 NOT_CODE = {"text", "output"}
 CHECKED = {"c", "cpp", "python", "sh", "diff"}
+VARIANTS = {"c fragment", "python compile-only"}  # checked as the module's docstring says
 
 
 def documents() -> list[Path]:
@@ -36,12 +42,14 @@ def documents() -> list[Path]:
 
 
 def fenced_blocks(path: Path) -> list[tuple[int, str, str]]:
-    """(line, language tag, text) of every fenced block (``` or ~~~) of a Markdown file."""
+    """(line, language tag, text) of every fenced block (``` or ~~~) of a Markdown file; the tag is the info string's
+    first word, with a second word that says how to check it kept after a space (`c fragment`)."""
     blocks, inside, start, tag, lines = [], None, 0, "", []
     for number, line in enumerate(path.read_text().splitlines(), 1):
-        fence = re.match(r"^(\s*)(```+|~~~+)\s*([^\s`]*)", line)
+        fence = re.match(r"^(\s*)(```+|~~~+)\s*([^\s`]*)[ \t]*([^\s`]*)", line)
         if inside is None and fence:
-            inside, start, tag, lines = fence.group(2), number, fence.group(3).lower(), []
+            tag = " ".join(word for word in (fence.group(3).lower(), fence.group(4).lower()) if word)
+            inside, start, lines = fence.group(2), number, []
         elif inside is not None and line.strip().startswith(inside) and not line.strip().strip(inside[0]):
             blocks.append((start, tag, "\n".join(lines) + "\n"))
             inside = None
@@ -61,9 +69,49 @@ def _id(block) -> str:
 
 def test_every_block_has_a_tag_this_test_checks():
     blocks = all_blocks()
-    assert len(blocks) >= 8  # README's two C loops, python.md's three, ...
-    unknown = [_id(b) for b in blocks if b[2] not in CHECKED | NOT_CODE]
+    assert len(blocks) >= 30  # README's two C loops and its two commands, python.md's three, ...
+    unknown = [_id(b) for b in blocks if b[2] not in CHECKED | NOT_CODE | VARIANTS]
     assert not unknown, f"blocks this test cannot check (tag them text or output if they are not code): {unknown}"
+
+
+def indented_blocks(path: Path) -> list[int]:
+    """The first line of every indented code block of a Markdown file (CommonMark: after a blank line, indented four
+    spaces, or four beyond the text of the list item it is in), outside fenced blocks."""
+    found, inside, blank, item = [], None, True, None  # item: the indent of the current list item's text
+    for number, line in enumerate(path.read_text().splitlines(), 1):
+        indent = len(line) - len(line.lstrip(" "))
+        fence = re.match(r"^\s*(```+|~~~+)", line)
+        if inside is not None:
+            inside = None if line.strip().startswith(inside) and not line.strip().strip(inside[0]) else inside
+            continue
+        if not line.strip():
+            blank = True
+            continue
+        marker = re.match(r"^(\s*)([-*+]|\d+[.)])\s+", line)
+        if item is not None and indent < item and not marker and blank:
+            item = None  # back at the text's left edge after a blank line: out of the list
+        if blank and indent >= (item or 0) + 4:
+            found.append(number)
+            inside = None
+        elif fence:
+            inside = fence.group(1)
+        elif marker and indent < (item or 0) + 4:
+            item = len(marker.group(0))
+        blank = False
+    return found
+
+
+@pytest.mark.parametrize("path", documents(), ids=lambda p: p.name)
+def test_no_indented_code_blocks(path):
+    """An indented block has no tag, so nothing here would check it: fence it with one."""
+    assert not indented_blocks(path), f"{path.name}: indented code blocks at lines {indented_blocks(path)}"
+
+
+def test_an_indented_block_is_found(tmp_path):
+    page = tmp_path / "page.md"
+    page.write_text("Text:\n\n    scripts/report\n\n- an item\n\n  its second paragraph\n\n      code in the item\n\n"
+                    "```sh\n    scripts/test\n```\n")
+    assert indented_blocks(page) == [3, 9]
 
 
 # What a README-style C block takes from the program around it.
@@ -80,10 +128,18 @@ static double next_frame_seconds(void) { return 1.0 / 60; }
 static void draw(const double position[3], const double quaternion[4]) { (void)position, (void)quaternion; }
 static void restore_last_good_state(void) {}
 """
+# What a `c fragment` block (statements from inside one of the program's functions) takes from around it: the names of
+# examples/vehicle_steadystep.c it is added to (docs/examples.md).
+FRAGMENT_STUBS = """#include <steadystep/steadystep.h>
+enum { WHEEL_COUNT = 4 };
+static ssRegistry* registry;
+static dJointID hinges[WHEEL_COUNT];
+static const double chassis_mass = 900.0;
+"""
 
 
 def _c_documents() -> list[Path]:
-    return [path for path in documents() if any(tag in ("c", "cpp") for _, tag, _ in fenced_blocks(path))]
+    return [path for path in documents() if any(tag in ("c", "cpp", "c fragment") for _, tag, _ in fenced_blocks(path))]
 
 
 @pytest.mark.parametrize("language", ["c", "c++"])
@@ -92,9 +148,12 @@ def test_c_blocks_compile(tmp_path, path, language):
     compiler = shutil.which("cc" if language == "c" else "c++")
     if compiler is None:
         pytest.skip(f"no {language} compiler")
-    code = "".join(text for _, tag, text in fenced_blocks(path) if tag in ("c", "cpp"))
+    blocks = fenced_blocks(path)
+    code = "".join(text for _, tag, text in blocks if tag in ("c", "cpp"))
+    fragments = "".join(f"static void fragment_{line}(void) {{\n{text}}}\n" for line, tag, text in blocks
+                        if tag == "c fragment")
     source = tmp_path / "blocks.c"
-    source.write_text(C_STUBS + code)
+    source.write_text(C_STUBS + (FRAGMENT_STUBS if fragments else "") + code + fragments)
     ode = subprocess.run(["pkg-config", "--cflags", "ode"], capture_output=True, text=True).stdout.split()
     standard = "-std=c17" if language == "c" else "-std=c++17"
     flags = [standard, "-fsyntax-only", "-Wall", "-Wextra", "-Werror", "-Wno-unused-function",
@@ -152,6 +211,31 @@ def test_python_blocks_run(block):
         stepper.close()
 
 
+COMPILE_ONLY = [b for b in all_blocks() if b[2] == "python compile-only"]
+
+
+@pytest.mark.parametrize("block", COMPILE_ONLY, ids=_id)
+def test_python_compile_only_blocks_call_what_exists(block):
+    """Compiled; every call of a steadystep module's function binds to its signature (placeholders for the values)."""
+    import ast
+    import importlib
+    import inspect
+
+    tree = ast.parse(block[3], _id(block))
+    modules = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] == "steadystep":
+            for alias in node.names:
+                modules[alias.asname or alias.name] = importlib.import_module(f"{node.module}.{alias.name}")
+    calls = [node for node in ast.walk(tree) if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+             and isinstance(node.func.value, ast.Name) and node.func.value.id in modules]
+    assert calls, f"{_id(block)}: calls nothing of steadystep"
+    for call in calls:
+        function = getattr(modules[call.func.value.id], call.func.attr, None)
+        assert callable(function), f"{_id(block)}: {call.func.value.id}.{call.func.attr} does not exist"
+        inspect.signature(function).bind(*call.args, **{k.arg: k.value for k in call.keywords})
+
+
 def _check_command(words: list[str]) -> str | None:
     """Why a shell command of the docs would fail, or None."""
     while words and re.match(r"^[A-Z_]+=", words[0]):  # VARIABLE=value before the command
@@ -164,8 +248,8 @@ def _check_command(words: list[str]) -> str | None:
 
         try:
             cli.build_parser().parse_args(args)
-        except SystemExit:
-            return f"steadystep's parser refuses {args}"
+        except SystemExit as done:  # --version and --help exit 0
+            return f"steadystep's parser refuses {args}" if done.code else None
         return None
     if command == "cmake":
         declared = (REPO / "CMakeLists.txt").read_text()
@@ -174,6 +258,13 @@ def _check_command(words: list[str]) -> str | None:
             if option and not option.group(1).startswith("CMAKE_") and option.group(1) not in declared:
                 return f"cmake option {option.group(1)} is not declared in CMakeLists.txt"
         return None
+    built = re.match(r"^build/steadystep_(example|test)_(\w+)$", command)
+    if built:
+        source = (REPO / "examples" / f"{built.group(2)}.c" if built.group(1) == "example" else
+                  REPO / "tests" / "c" / f"test_{built.group(2)}.cpp")
+        return None if source.is_file() else f"{command}: no {source.relative_to(REPO)} it is built from"
+    if command.endswith("bin/python"):
+        return None if args and (REPO / args[0]).is_file() else f"{command} {args[:1]}: no such file in the repository"
     if command.startswith("scripts/"):
         script = REPO / command
         return None if script.is_file() and script.stat().st_mode & 0o111 else f"{command} is not an executable script"
