@@ -7,6 +7,7 @@
 
 #include "error.h"
 #include "interpolation_internal.h"
+#include "pointer_set.h"
 #include "steadystep/interpolation.h"
 
 typedef struct Pose {
@@ -20,8 +21,9 @@ typedef struct History {
 } History;
 
 struct ssPoseHistory {
-  History* bodies; /* sorted by body address, as the stepper's known list */
-  dBodyID* ids;     /* bodies[i].body, packed: the check that the known list is unchanged reads nothing else */
+  History* bodies;    /* in the order of the stepper's known list */
+  dBodyID* ids;       /* bodies[i].body, packed: the check that the known list is unchanged reads nothing else */
+  ssPointerMap index; /* body -> its place in bodies */
   int count;
   int restart; /* every body starts again from its pose at the next frame */
   int off;     /* ssStepper_SetInterpolation(stepper, 0): nothing kept */
@@ -41,9 +43,9 @@ static void restartAt(History* history) {
   history->previous = history->current;
 }
 
-static int compareBody(const void* key, const void* element) {
-  uintptr_t a = (uintptr_t)key, b = (uintptr_t)((const History*)element)->body;
-  return (a > b) - (a < b);
+static const History* find(const ssPoseHistory* history, dBodyID body) {
+  int at = ssPointerMapGet(&history->index, body, -1);
+  return at >= 0 ? &history->bodies[at] : NULL;
 }
 
 /* The same bodies as before, in the same order: nothing to do (the usual frame). */
@@ -67,16 +69,18 @@ ssStatus ssPoseHistoryBeginFrame(ssPoseHistory** out, const dBodyID* bodies, int
   if (!sameBodies(history, bodies, count)) {
     History* kept = malloc((size_t)(count > 0 ? count : 1) * sizeof *kept);
     dBodyID* ids = malloc((size_t)(count > 0 ? count : 1) * sizeof *ids);
-    if (kept == NULL || ids == NULL) {
+    ssPointerMap index = {NULL, NULL, 0, 0};
+    int indexed = 1;
+    for (int i = 0; i < count && indexed; ++i) indexed = ssPointerMapPut(&index, bodies[i], i) >= 0;
+    if (kept == NULL || ids == NULL || !indexed) {
       free(kept);
       free(ids);
+      ssPointerMapFree(&index);
       return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory for the pose history of %d bodies", count);
     }
     if (count > 0) memcpy(ids, bodies, (size_t)count * sizeof *ids);
     for (int i = 0; i < count; ++i) {
-      const History* old = history->count > 0 ? bsearch(bodies[i], history->bodies, (size_t)history->count,
-                                                         sizeof *history->bodies, compareBody)
-                                              : NULL;
+      const History* old = find(history, bodies[i]);
       if (old != NULL) {
         kept[i] = *old;
       } else {
@@ -86,8 +90,10 @@ ssStatus ssPoseHistoryBeginFrame(ssPoseHistory** out, const dBodyID* bodies, int
     }
     free(history->bodies);
     free(history->ids);
+    ssPointerMapFree(&history->index);
     history->bodies = kept;
     history->ids = ids;
+    history->index = index;
     history->count = count;
   }
   if (history->restart) {
@@ -124,12 +130,15 @@ void ssPoseHistoryEndFrame(ssPoseHistory* history, int steps, double interpolati
 
 void ssPoseHistoryForgetBody(ssPoseHistory* history, dBodyID body) {
   if (history == NULL || history->count == 0) return;
-  History* found = bsearch(body, history->bodies, (size_t)history->count, sizeof *history->bodies, compareBody);
-  if (found == NULL) return;
-  int at = (int)(found - history->bodies);
-  memmove(found, found + 1, (size_t)(history->count - at - 1) * sizeof *found);
-  memmove(history->ids + at, history->ids + at + 1, (size_t)(history->count - at - 1) * sizeof *history->ids);
-  history->count -= 1;
+  int at = ssPointerMapGet(&history->index, body, -1), last = history->count - 1;
+  if (at < 0) return;
+  ssPointerMapRemove(&history->index, body);
+  if (at != last) { /* the last takes its place, as on the known list (known_bodies.c) */
+    history->bodies[at] = history->bodies[last];
+    history->ids[at] = history->ids[last];
+    ssPointerMapPut(&history->index, history->ids[at], at); /* replaces a value: allocates nothing */
+  }
+  history->count = last;
 }
 
 void ssPoseHistoryForget(ssPoseHistory* history) {
@@ -140,6 +149,7 @@ void ssPoseHistoryDestroy(ssPoseHistory* history) {
   if (history == NULL) return;
   free(history->bodies);
   free(history->ids);
+  ssPointerMapFree(&history->index);
   free(history);
 }
 
@@ -166,10 +176,7 @@ void ssSlerp(const double from[4], const double to[4], double a, double out[4]) 
 }
 
 ssStatus ssPoseHistoryPose(const ssPoseHistory* history, dBodyID body, double position[3], double quaternion[4]) {
-  const History* h = history != NULL && history->count > 0
-                         ? bsearch(body, history->bodies, (size_t)history->count, sizeof *history->bodies,
-                                   compareBody)
-                         : NULL;
+  const History* h = history != NULL ? find(history, body) : NULL;
   if (h == NULL)
     return ssFail(SS_ERROR_NOT_FOUND, "body %p: not known to the stepper at its last frame (bind, adopt or watch "
                   "it)", (void*)body);

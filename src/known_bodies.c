@@ -19,8 +19,12 @@ void ssKnownFree(ssKnownBodies* known) {
   free(known->ids);
   free(known->values);
   free(known->joints);
+  free(known->awake);
+  free(known->reached);
+  free(known->queue);
   free(known->pushed);
   free(known->geared);
+  ssPointerMapFree(&known->index);
   memset(known, 0, sizeof *known);
 }
 
@@ -59,10 +63,14 @@ static ssJointSignature jointSignature(dBodyID body) {
   return signature;
 }
 
+/* body's place in the list, or -1 */
+static int placeOf(const ssKnownBodies* known, dBodyID body) {
+  return known->valid ? ssPointerMapGet(&known->index, body, -1) : -1;
+}
+
 static const ssKnownBody* findOld(const ssKnownBodies* known, dBodyID body) {
-  if (!known->valid) return NULL;
-  const dBodyID* found = bsearch(&body, known->ids, (size_t)known->count, sizeof body, ssCompareHandles);
-  return found != NULL ? &known->bodies[found - known->ids] : NULL;
+  int k = placeOf(known, body);
+  return k >= 0 ? &known->bodies[k] : NULL;
 }
 
 static void listPushed(ssKnownBodies* known) {
@@ -94,95 +102,140 @@ static uint64_t positionBound(dBodyID body) {
   return bound > 0 ? magnitudeBits(bound) : 0;
 }
 
+/* Room for capacity bodies in every array (the list as it was when out of memory: 0 returned). */
+static int reserve(ssKnownBodies* known, int capacity) {
+  if (capacity <= known->capacity) return 1;
+  int room = known->capacity > 0 ? 2 * known->capacity : 16;
+  while (room < capacity) room *= 2;
+  size_t n = (size_t)room;
+  void* grown[] = {realloc(known->bodies, n * sizeof *known->bodies), NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+  if (grown[0] != NULL) known->bodies = grown[0];
+  if ((grown[1] = realloc(known->ids, n * sizeof *known->ids)) != NULL) known->ids = grown[1];
+  if ((grown[2] = realloc(known->values, n * sizeof *known->values)) != NULL) known->values = grown[2];
+  if ((grown[3] = realloc(known->joints, n * sizeof *known->joints)) != NULL) known->joints = grown[3];
+  if ((grown[4] = realloc(known->awake, n * sizeof *known->awake)) != NULL) known->awake = grown[4];
+  if ((grown[5] = realloc(known->reached, n * sizeof *known->reached)) != NULL) known->reached = grown[5];
+  if ((grown[6] = realloc(known->queue, n * sizeof *known->queue)) != NULL) known->queue = grown[6];
+  if ((grown[7] = realloc(known->pushed, n * sizeof *known->pushed)) != NULL) known->pushed = grown[7];
+  for (int i = 0; i < 8; ++i)
+    if (grown[i] == NULL) return 0;
+  known->capacity = room;
+  return 1;
+}
+
+/* Appends body (not listed): 1, or 0 when out of memory. */
+static int append(ssKnownBodies* known, dBodyID body) {
+  if (!reserve(known, known->count + 1)) return 0;
+  int k = known->count;
+  if (ssPointerMapPut(&known->index, body, k) < 0) return 0;
+  if (ssGeared(body)) {
+    dBodyID* geared = realloc(known->geared, (size_t)(known->geared_count + 1) * sizeof *geared);
+    if (geared == NULL) {
+      ssPointerMapRemove(&known->index, body);
+      return 0;
+    }
+    known->geared = geared;
+    known->geared[known->geared_count++] = body;
+  }
+  known->bodies[k] = (ssKnownBody){.body = body};
+  known->ids[k] = body;
+  known->values[k] = (ssBodyValues){dBodyGetPosition(body), dBodyGetLinearVel(body), dBodyGetAngularVel(body),
+                                    dBodyGetForce(body),    dBodyGetTorque(body),    positionBound(body)};
+  known->joints[k] = jointSignature(body);
+  known->awake[k] = 1; /* checked at the next check, whatever ODE does with it */
+  known->reached[k] = 0;
+  known->count += 1;
+  return 1;
+}
+
+/* Adds the bodies of walk.list from `from` on that are not listed, and what they reach through joints. */
+static int addReached(ssKnownBodies* known, BodyWalk* walk) {
+  for (int i = 0; i < walk->count && !walk->failed; ++i) {
+    dBodyID body = walk->list[i];
+    if (placeOf(known, body) >= 0) continue; /* listed: what it reaches is listed with it */
+    if (!append(known, body)) return 0;
+    for (int j = 0, joints = dBodyGetNumJoints(body); j < joints; ++j) {
+      dJointID joint = dBodyGetJoint(body, j);
+      if (dJointGetType(joint) == dJointTypeContact) continue;
+      visitBody(walk, dJointGetBody(joint, 0));
+      visitBody(walk, dJointGetBody(joint, 1));
+    }
+  }
+  return !walk->failed;
+}
+
 ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const dBodyID* watched, int watched_count) {
   BodyWalk walk = {0};
   ssRegistry_VisitBodies(registry, visitBody, &walk);
   for (int i = 0; i < watched_count; ++i) visitBody(&walk, watched[i]);
-  /* what they reach through joints (contacts are transient, and reach only what collision reaches anyway) */
-  for (int i = 0; i < walk.count && !walk.failed; ++i) {
-    dBodyID body = walk.list[i];
-    for (int j = 0, joints = dBodyGetNumJoints(body); j < joints; ++j) {
-      dJointID joint = dBodyGetJoint(body, j);
-      if (dJointGetType(joint) == dJointTypeContact) continue;
-      visitBody(&walk, dJointGetBody(joint, 0));
-      visitBody(&walk, dJointGetBody(joint, 1));
-    }
-  }
-  size_t count = (size_t)walk.count, room = count > 0 ? count : 1;
-  ssKnownBody* bodies = walk.failed ? NULL : calloc(room, sizeof *bodies);
-  dBodyID* ids = walk.failed ? NULL : malloc(room * sizeof *ids);
-  ssBodyValues* values = walk.failed ? NULL : malloc(room * sizeof *values);
-  ssJointSignature* joints = walk.failed ? NULL : malloc(room * sizeof *joints);
-  int* pushed = walk.failed ? NULL : malloc(room * sizeof *pushed);
-  ssPointerSetFree(&walk.seen);
-  if (bodies == NULL || ids == NULL || values == NULL || joints == NULL || pushed == NULL) {
-    free(walk.list);
-    free(bodies);
-    free(ids);
-    free(values);
-    free(joints);
-    free(pushed);
-    return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
-  }
-  if (count > 0) qsort(walk.list, count, sizeof(dBodyID), ssCompareHandles);
-  for (size_t i = 0; i < count; ++i) {
-    dBodyID body = walk.list[i];
-    const ssKnownBody* old = findOld(known, body);
-    bodies[i] = old != NULL ? *old : (ssKnownBody){.body = body};
-    ids[i] = body;
-    values[i] = (ssBodyValues){dBodyGetPosition(body),  dBodyGetLinearVel(body), dBodyGetAngularVel(body),
-                               dBodyGetForce(body),     dBodyGetTorque(body),
-                               positionBound(body)};
-    /* a body that stays keeps the joints it was listed with: a joint attached since is still seen as new */
-    joints[i] = old != NULL ? known->joints[old - known->bodies] : jointSignature(body);
-  }
+  /* the new list, bodies that stay keeping their forces and the joints they were listed with (a joint attached
+   * since is still seen as new) */
+  ssKnownBodies rebuilt = {.valid = 1,
+                           .carrying = known->carrying,
+                           .registry_generation = known->registry_generation,
+                           .watched_generation = known->watched_generation};
+  int added = addReached(&rebuilt, &walk);
   free(walk.list);
-  int geared_count = 0;
-  for (size_t i = 0; i < count; ++i) geared_count += ssGeared(ids[i]);
-  dBodyID* geared_ids = geared_count > 0 ? malloc((size_t)geared_count * sizeof *geared_ids) : NULL;
-  if (geared_count > 0 && geared_ids == NULL) {
-    free(bodies);
-    free(ids);
-    free(values);
-    free(joints);
-    free(pushed);
+  ssPointerSetFree(&walk.seen);
+  if (!added) {
+    ssKnownFree(&rebuilt);
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
   }
-  for (size_t i = 0, g = 0; i < count; ++i)
-    if (ssGeared(ids[i])) geared_ids[g++] = ids[i];
-  unsigned registry_generation = known->registry_generation, watched_generation = known->watched_generation;
-  int carrying = known->carrying;
+  for (int k = 0; k < rebuilt.count; ++k) {
+    int old = placeOf(known, rebuilt.ids[k]);
+    if (old < 0) continue;
+    rebuilt.bodies[k] = known->bodies[old];
+    rebuilt.joints[k] = known->joints[old];
+  }
   ssKnownFree(known);
-  *known = (ssKnownBodies){.bodies = bodies,
-                           .ids = ids,
-                           .values = values,
-                           .joints = joints,
-                           .count = (int)count,
-                           .pushed = pushed,
-                           .carrying = carrying,
-                           .geared = geared_ids,
-                           .geared_count = geared_count,
-                           .valid = 1,
-                           .registry_generation = registry_generation,
-                           .watched_generation = watched_generation};
+  *known = rebuilt;
   listPushed(known);
   return SS_OK;
 }
 
+ssStatus ssKnownAdd(ssKnownBodies* known, dBodyID body) {
+  if (placeOf(known, body) >= 0) return SS_OK;
+  BodyWalk walk = {0};
+  visitBody(&walk, body);
+  int added = addReached(known, &walk);
+  free(walk.list);
+  ssPointerSetFree(&walk.seen);
+  return added ? SS_OK : ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
+}
+
 int ssKnownContains(const ssKnownBodies* known, dBodyID body) { return findOld(known, body) != NULL; }
 
+void ssKnownCheckAllOnce(ssKnownBodies* known) {
+  if (known->count > 0) memset(known->awake, 1, (size_t)known->count);
+}
+
+int ssKnownJoined(const ssKnownBodies* known, dBodyID body) {
+  int k = placeOf(known, body);
+  return k >= 0 && known->joints[k].count > 0;
+}
+
 void ssKnownForget(ssKnownBodies* known, dBodyID body) {
-  const ssKnownBody* found = findOld(known, body);
-  if (found == NULL) return;
-  size_t k = (size_t)(found - known->bodies), after = (size_t)known->count - k - 1;
-  memmove(&known->bodies[k], &known->bodies[k + 1], after * sizeof *known->bodies);
-  memmove(&known->ids[k], &known->ids[k + 1], after * sizeof *known->ids);
-  memmove(&known->values[k], &known->values[k + 1], after * sizeof *known->values);
-  memmove(&known->joints[k], &known->joints[k + 1], after * sizeof *known->joints);
-  known->count -= 1;
+  int k = placeOf(known, body), last = known->count - 1;
+  if (k < 0) return;
+  int pushed = known->bodies[k].pushed;
+  ssPointerMapRemove(&known->index, body);
+  if (k != last) {
+    known->bodies[k] = known->bodies[last];
+    known->ids[k] = known->ids[last];
+    known->values[k] = known->values[last];
+    known->joints[k] = known->joints[last];
+    known->awake[k] = known->awake[last];
+    known->reached[k] = known->reached[last];
+    ssPointerMapPut(&known->index, known->ids[k], k); /* replaces a value: allocates nothing */
+  }
+  known->count = last;
   for (int g = 0; g < known->geared_count; ++g)
     if (known->geared[g] == body) known->geared[g--] = known->geared[--known->geared_count];
-  listPushed(known);
+  /* the pushed list names places: the forgotten body's goes, the moved body's follows it */
+  for (int p = 0; p < known->pushed_count; ++p) {
+    if (pushed && known->pushed[p] == k) known->pushed[p--] = known->pushed[--known->pushed_count];
+    else if (known->pushed[p] == last) known->pushed[p] = k;
+  }
 }
 
 /* How many bodies ahead the passes ask for a body's memory: a large world's bodies are out of cache after ODE's step
@@ -217,6 +270,11 @@ ssStatus ssKnownCollectJoints(const ssKnownBodies* known, ssPointerSet* joints) 
   return SS_OK;
 }
 
+int ssKnownJointsChangedOf(const ssKnownBodies* known, dBodyID body) {
+  int k = placeOf(known, body);
+  return k < 0 || jointsChangedAt(known, k);
+}
+
 void ssKnownTakeJointsOf(ssKnownBodies* known, dBodyID body) {
   const ssKnownBody* found = findOld(known, body);
   if (found != NULL) known->joints[found - known->bodies] = jointSignature(body);
@@ -234,6 +292,7 @@ int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body) {
 void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces) {
   for (int i = 0; i < known->count; ++i) {
     const ssKnownBody* body = &known->bodies[i];
+    if (!body->pushed && !known->awake[i]) continue; /* asleep: its force waits for the step that wakes it */
     const double* f = body->frame_force;
     int pushed = with_frame_forces && body->pushed;
     dBodySetForce(body->body, pushed ? f[0] : 0, pushed ? f[1] : 0, pushed ? f[2] : 0);
@@ -339,29 +398,106 @@ static void prefetchState(const ssBodyValues* v) {
   __builtin_prefetch(v->angular_vel);
 }
 
-ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
-                      dBodyID* failed) {
-  const double max_speed2 = bounds->max_speed * bounds->max_speed;
-  const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
-  const ssBodyValues* values = known->values;
-  /* the whole list first, with no branch a body (the usual case: all pass); the first failure is found after */
-  int all = 1;
-  const int count = known->count, until = prefetchUntil(count), forces = bounds->forces;
-  for (int k = 0; k < count; ++k) {
-    if (k < until) prefetchState(&values[k + kPrefetchAhead]);
-    all &= stateWithin(&values[k], max_speed2, max_spin2) & (!forces || forcesWithin(&values[k]));
-  }
+/* The first body of known that fails the check, named, or SS_OK. */
+static ssStatus nameFailure(const ssKnownBodies* known, int k, const ssBodyBounds* bounds, const char* when, int step,
+                            int steps, dBodyID* failed) {
   char named[64];
-  for (int k = 0; !all && k < known->count; ++k) {
-    if (stateWithin(&values[k], max_speed2, max_spin2) && (!bounds->forces || forcesWithin(&values[k]))) continue;
-    *failed = known->ids[k];
-    snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
-    return describe(known->ids[k], bounds, named);
+  *failed = known->ids[k];
+  snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
+  return describe(known->ids[k], bounds, named);
+}
+
+static int bodyWithin(const ssBodyValues* v, double max_speed2, double max_spin2, int forces) {
+  return stateWithin(v, max_speed2, max_spin2) & (!forces || forcesWithin(v));
+}
+
+/* The walk from the bodies ODE steps to the sleeping ones it wakes through their joints (contacts too): ODE's island
+ * takes a disabled body joined to an enabled one, and every disabled body joined to that. Visits each listed body
+ * it reaches once (reached[] holds this check's number); visit returns 0 to stop the walk at a failing body, which
+ * the walk returns (else -1). The queue starts with the bodies [0, queued) of known->queue. */
+static int wakeWalk(ssKnownBodies* known, int queued, int (*visit)(ssKnownBodies*, int, void*), void* context) {
+  for (int head = 0; head < queued; ++head) {
+    dBodyID body = known->ids[known->queue[head]];
+    for (int j = 0, joints = dBodyGetNumJoints(body); j < joints; ++j) {
+      dJointID joint = dBodyGetJoint(body, j);
+      for (int side = 0; side < 2; ++side) {
+        dBodyID other = dJointGetBody(joint, side);
+        int k = other != 0 && other != body ? placeOf(known, other) : -1;
+        if (k < 0 || known->reached[k] == known->checks) continue;
+        known->reached[k] = known->checks;
+        known->awake[k] = 1;
+        if (!visit(known, k, context)) return k;
+        known->queue[queued++] = k;
+      }
+    }
+  }
+  return -1;
+}
+
+typedef struct CheckVisit {
+  double max_speed2, max_spin2;
+  int forces;
+} CheckVisit;
+
+static int checkVisit(ssKnownBodies* known, int k, void* context) {
+  const CheckVisit* check = context;
+  return bodyWithin(&known->values[k], check->max_speed2, check->max_spin2, check->forces);
+}
+
+/* Marks the bodies ODE steps (awake[], reached[]) and queues them for the wake walk: enabled bodies, and those that
+ * were awake at the last check (ODE stepped them before it disabled them). Returns how many were queued. */
+static int queueAwake(ssKnownBodies* known) {
+  known->checks += 1;
+  int queued = 0, asleep = 0;
+  for (int k = 0; k < known->count; ++k) {
+    int enabled = dBodyIsEnabled(known->ids[k]) != 0;
+    if (!(enabled | known->awake[k])) {
+      asleep = 1;
+      continue;
+    }
+    known->awake[k] = (unsigned char)enabled;
+    known->reached[k] = known->checks;
+    known->queue[queued++] = k;
+  }
+  return asleep ? queued : -queued - 1; /* negative: nobody asleep, no walk needed */
+}
+
+/* The place of body on the list, marked as met by this check (-1: not listed, or met already). */
+static int meetAlso(ssKnownBodies* known, dBodyID body) {
+  int k = placeOf(known, body);
+  if (k < 0 || known->reached[k] == known->checks) return -1;
+  known->reached[k] = known->checks;
+  return k;
+}
+
+ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
+                      const dBodyID* also, int also_count, dBodyID* failed) {
+  CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed,
+                      bounds->forces};
+  const ssBodyValues* values = known->values;
+  int queued = queueAwake(known), walk = queued >= 0;
+  if (!walk) queued = -queued - 1;
+  /* the queued bodies first, with no branch a body (the usual case: all pass); the first failure is found after */
+  int all = 1;
+  const int until = prefetchUntil(queued);
+  for (int q = 0; q < queued; ++q) {
+    if (q < until) prefetchState(&values[known->queue[q + kPrefetchAhead]]);
+    all &= bodyWithin(&values[known->queue[q]], check.max_speed2, check.max_spin2, check.forces);
+  }
+  for (int q = 0; !all && q < queued; ++q)
+    if (!bodyWithin(&values[known->queue[q]], check.max_speed2, check.max_spin2, check.forces))
+      return nameFailure(known, known->queue[q], bounds, when, step, steps, failed);
+  int woken = walk ? wakeWalk(known, queued, checkVisit, &check) : -1;
+  if (woken >= 0) return nameFailure(known, woken, bounds, when, step, steps, failed);
+  for (int a = 0; a < also_count; ++a) {
+    int k = meetAlso(known, also[a]);
+    if (k >= 0 && !checkVisit(known, k, &check)) return nameFailure(known, k, bounds, when, step, steps, failed);
   }
   for (int g = 0; g < known->geared_count && bounds->gear_step_s > 0; ++g) {
     dBodyID body = known->geared[g];
     double turn = ssGearTurn(body, bounds->gear_step_s);
     if (turn <= SS_MAX_GEAR_TURN_RAD) continue;
+    char named[64];
     *failed = body;
     snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
     return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: turns its transmission gear %g rad in a step of %g s %s (spin, and "
@@ -393,29 +529,46 @@ static int startBody(ssKnownBodies* known, int k, double max_speed2, double max_
   return 1;
 }
 
-ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBodyID* failed, int* joints_changed) {
-  const double max_speed2 = bounds->max_speed * bounds->max_speed;
-  const double max_spin2 = bounds->max_angular_speed * bounds->max_angular_speed;
+static int startVisit(ssKnownBodies* known, int k, void* context) {
+  const CheckVisit* check = context;
+  return startBody(known, k, check->max_speed2, check->max_spin2);
+}
+
+ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, const dBodyID* also, int also_count,
+                           dBodyID* failed, int* joints_changed) {
+  CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed, 1};
   *joints_changed = 0;
   /* last frame's pushed bodies are unmarked through their list: only a pushed body's entry is written */
   for (int p = 0; p < known->pushed_count; ++p) known->bodies[known->pushed[p]].pushed = 0;
   known->pushed_count = 0;
   const int count = known->count, until = prefetchUntil(count);
-  for (int k = 0; k < count; ++k) { /* one loop: startBody inlined once */
-    if (k < until) {
-      const ssBodyValues* ahead = &known->values[k + kPrefetchAhead];
-      prefetchJoints(known, k + kPrefetchAhead);
-      prefetchState(ahead);
-      __builtin_prefetch(ahead->force);
-      __builtin_prefetch(ahead->torque);
-    }
+  for (int k = 0; k < count; ++k) { /* the joints of every body: a sleeping body's joint may be destroyed too */
+    if (k < until) prefetchJoints(known, k + kPrefetchAhead);
     if (jointsChangedAt(known, k)) {
       *joints_changed = 1;
       return SS_OK;
     }
-    if (startBody(known, k, max_speed2, max_spin2)) continue;
-    *failed = known->ids[k];
-    return describe(known->ids[k], bounds, "before the frame");
   }
-  return SS_OK;
+  int queued = queueAwake(known), walk = queued >= 0;
+  if (!walk) queued = -queued - 1;
+  const int ahead = prefetchUntil(queued);
+  for (int q = 0; q < queued; ++q) { /* one loop: startBody inlined once */
+    if (q < ahead) {
+      const ssBodyValues* next = &known->values[known->queue[q + kPrefetchAhead]];
+      prefetchState(next);
+      __builtin_prefetch(next->force);
+      __builtin_prefetch(next->torque);
+    }
+    if (startBody(known, known->queue[q], check.max_speed2, check.max_spin2)) continue;
+    *failed = known->ids[known->queue[q]];
+    return describe(*failed, bounds, "before the frame");
+  }
+  int woken = walk ? wakeWalk(known, queued, startVisit, &check) : -1;
+  for (int a = 0; woken < 0 && a < also_count; ++a) {
+    int k = meetAlso(known, also[a]);
+    if (k >= 0 && !startVisit(known, k, &check)) woken = k;
+  }
+  if (woken < 0) return SS_OK;
+  *failed = known->ids[woken];
+  return describe(*failed, bounds, "before the frame");
 }

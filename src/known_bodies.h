@@ -2,7 +2,8 @@
  *
  * Known: the registry's bodies (bound, adopted), the watched ones, and every body reachable from those through
  * joints other than contacts (a bob hung by a hinge from a known body is known whether or not it was bound), each
- * once, sorted by address. Their forces are kept over a frame and their state and forces are checked before every
+ * once, found through an index by address. Bodies come and go one at a time (ssKnownAdd, ssKnownForget) at the cost
+ * of the change; the list is built whole (ssKnownRebuild) only when the watch list changes or joints do. Their forces are kept over a frame and their state and forces are checked before every
  * physics step. ODE attaches a new joint at the head of a body's list, so a body's first joint, kept here, changes
  * when a joint is attached to it: that is how joints made since the list was built are found, for one read a body. */
 #ifndef STEADYSTEP_KNOWN_BODIES_H
@@ -51,7 +52,14 @@ typedef struct ssKnownBodies {
   dBodyID* ids;           /* bodies[i].body, packed */
   ssBodyValues* values;   /* bodies[i]'s values, packed: the checks read nothing else */
   ssJointSignature* joints; /* each body's joints when listed */
-  int count;
+  /* whether ODE stepped the body at the last check or would step it next (enabled, or woken through its joints):
+   * a body ODE has disabled since is checked once more, then no more until it wakes */
+  unsigned char* awake;
+  unsigned* reached;  /* the check that last met the body through joints (ssKnownCheck's walk) */
+  int* queue;         /* that walk's bodies still to visit */
+  unsigned checks;    /* checks made, numbering them for reached */
+  ssPointerMap index; /* body -> its place in the arrays above */
+  int count, capacity;
   int* pushed; /* indices into bodies of those with pushed set, and only those */
   int pushed_count;
   int carrying; /* whether any body may carry a force */
@@ -68,15 +76,29 @@ void ssKnownFree(ssKnownBodies* known);
  * was: SS_ERROR_OUT_OF_MEMORY. */
 ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const dBodyID* watched, int watched_count);
 
+/* Adds body (alive, not 0) and every body it reaches through joints other than contacts, those not listed yet: at
+ * the cost of what is added. Errors: SS_ERROR_OUT_OF_MEMORY, with the bodies added before it listed. */
+ssStatus ssKnownAdd(ssKnownBodies* known, dBodyID body);
+
 /* Whether body is on the list. */
 int ssKnownContains(const ssKnownBodies* known, dBodyID body);
 
-/* Takes body off the list at once (it is about to be destroyed). */
+/* Has every listed body checked at the next check, asleep or not (the spaces were listed in full: a sleeping body
+ * the program moved is not told from the others). */
+void ssKnownCheckAllOnce(ssKnownBodies* known);
+
+/* Whether body is listed with joints other than contacts (bodies may be known through it). */
+int ssKnownJoined(const ssKnownBodies* known, dBodyID body);
+
+/* Takes body off the list at once (it is about to be destroyed): the last body takes its place. */
 void ssKnownForget(ssKnownBodies* known, dBodyID body);
 
 /* Whether a body's joints differ from those listed (a joint was attached, detached or destroyed since), giving the
  * first such body (body may be NULL). */
 int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body);
+
+/* Whether body's joints differ from those listed with it, or body is not listed. */
+int ssKnownJointsChangedOf(const ssKnownBodies* known, dBodyID body);
 
 /* Adds every joint of every listed body (contacts aside) to joints: the joints alive and attached to a known body.
  * Errors: SS_ERROR_OUT_OF_MEMORY. */
@@ -85,7 +107,8 @@ ssStatus ssKnownCollectJoints(const ssKnownBodies* known, ssPointerSet* joints);
 /* Takes body's joints as they are now, once the stepper followed their change (adopted what they reach). */
 void ssKnownTakeJointsOf(ssKnownBodies* known, dBodyID body);
 
-/* Sets every listed body's force and torque accumulators to its frame force (with_frame_forces) or to zero. */
+/* Sets the force and torque accumulators of every listed body ODE steps (pushed or awake) to its frame force
+ * (with_frame_forces) or to zero; a sleeping body's are left for the step that wakes it. */
 void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces);
 
 /* What a check reads of a body, and its bounds. */
@@ -97,18 +120,24 @@ typedef struct ssBodyBounds {
   double gear_step_s;
 } ssBodyBounds;
 
-/* Checks every listed body in one pass over the packed values (a second names the first failure): its position
- * within SS_MAX_POSITION_M, velocities finite and within the bounds, a geared body's turn within a step
- * (bounds->gear_step_s), and with bounds->forces its accumulators. On the first failure records the message (the
+/* Checks the listed bodies ODE steps: in one pass over the packed values (a second names the first failure) every
+ * enabled body, every body disabled since the last check (ODE stepped it before it fell asleep), then every disabled
+ * body joined (contacts too) to one of those, which ODE wakes in its step; and the bodies of also[also_count] (a
+ * sleeping body the program moved, which collision reads). A body asleep and alone is not read: ODE neither steps
+ * it nor lets its joints act. Checked: its position within SS_MAX_POSITION_M, velocities finite and within the
+ * bounds, a geared body's turn within a step (bounds->gear_step_s), and with bounds->forces its accumulators. On the first failure records the message (the
  * body, the quantity, its value, "`when` step `step` of `steps`", formatted then only), sets *failed to the body and
  * returns SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a
  * force or torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). */
-ssStatus ssKnownCheck(const ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
-                      dBodyID* failed);
+ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
+                      const dBodyID* also, int also_count, dBodyID* failed);
 
 /* Before a frame, one pass: *joints_changed says whether a body's first joint changed (then nothing else was done:
- * the caller rebuilds the list and calls again); else every body is checked as ssKnownCheck with state and forces,
- * and, all passing, its accumulators become its frame force (pushed marks a force or a carried force). */
-ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, dBodyID* failed, int* joints_changed);
+ * the caller rebuilds the list and calls again); else the bodies ODE steps are checked as ssKnownCheck with state
+ * and forces (also: sleeping bodies the program moved), and, all passing, the accumulators of those it steps become
+ * their frame force (pushed marks a force or a carried force). A sleeping body's force waits in its accumulator, as
+ * in ODE, and acts in the step that wakes it. */
+ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, const dBodyID* also, int also_count,
+                           dBodyID* failed, int* joints_changed);
 
 #endif

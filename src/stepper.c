@@ -15,19 +15,22 @@
 #include "ode_bounds.h"
 #include "pointer_set.h"
 #include "registry_internal.h"
+#include "seen_spaces.h"
 #include "steadystep/adopt.h"
 #include "steadystep/stepper.h"
 
 /* Frame times are sums of floating-point parts: a frame of exactly 2·max_step_s must not become 3 substeps. */
 static const double kStepCountSlack = 1e-9;
 
-/* A space the stepper adopted from, as it was when last walked (spacesChanged says what tells a change). */
-typedef struct SeenSpace {
-  dSpaceID space;
-  int geoms;
-  dGeomID first;
-  int sweep_and_prune; /* walked at every look (spacesChanged) */
-} SeenSpace;
+/* A contact's surface as the program gave it and as ssStepper_SoftenContact wrote it, within one step: a near
+ * callback gives most contacts the same surface, and the softness depends on nothing else (contact.c), so the next
+ * such contact is written from here. */
+typedef struct ContactMemo {
+  int valid; /* 0 from the start of every step: the step's length, the mapping or the tuned world changed */
+  int mode_in, mode_out;
+  dReal erp_in, cfm_in, erp_out, cfm_out;
+  ssRowFallback handed_on;
+} ContactMemo;
 
 struct ssStepper {
   ssStepperDef def;            /* def.registry: the registry in use, the given one or owned_registry */
@@ -42,19 +45,22 @@ struct ssStepper {
   dBodyID* watched;
   int watched_count, watched_capacity;
   unsigned watched_generation;
-  ssKnownBodies known; /* rebuilt when the registry's bindings, the watch list or a known body's joints change */
-  SeenSpace* spaces;    /* def.space and the spaces nested in it */
-  int space_count, space_capacity;
+  ssKnownBodies known; /* kept as bodies come and go; rebuilt when the watch list or a known body's joints change */
+  ssSeenSpaces seen;   /* def.space and the spaces nested in it, as last seen */
+  ssBodyList found;    /* the last look's new bodies, and those refused before: adopted at the next look */
+  ssBodyList moved;    /* sleeping bodies the program moved, seen at the last look: checked before collision */
   int apply_due;         /* bindings were added within the frame: the next step applies whatever the mapping */
   int adopt_known_due;   /* the known list was rebuilt: bodies on it the registry has not are adopted (adoptKnown) */
   int relist_due;        /* the known list is listed again at the next look, keeping what stays (joints changed) */
-  ssPointerSet anchored; /* the bodies with a geom in the adopted spaces at the last listing (forgetDestroyed) */
-  int adopt_anchored_due; /* the spaces were listed: their bodies the registry has not are adopted (adoptAnchored) */
+  /* a body was destroyed through the stepper after a joint of its was: no body left may show that joint's loss, so
+   * the next look unbinds every bound joint attached to no known body (forgetDestroyed) */
+  int lost_joints_due;
   int in_step;           /* inside ssStepper_Step: its callbacks are running */
   int destroy_requested; /* ssStepper_Destroy was called from a callback: done when ssStepper_Step returns */
   int rebase_gears;      /* ssStepper_Reset was called: the next frame has ODE measure its gears afresh (gears.h) */
   ssStepInfo current;
   ssContactCache contact_cache; /* a program softens many contacts with the same numbers */
+  ContactMemo contact_memo;     /* the last contact softened in this step, as given and as written */
   ssFrameReport* report; /* the frame being stepped, for ssStepper_SoftenContact's counts */
   ssPoseHistory* poses;  /* SS_CUT_FIXED: the known bodies' last two states, to draw (interpolation.c) */
   /* the first failure, latched until ssStepper_Reset */
@@ -121,6 +127,7 @@ static void describeNextStep(ssStepper* stepper) {
   if (step_s == 0) step_s = stepping->cut == SS_CUT_FIXED ? stepping->max_step_s : stepping->fixed_step_s;
   stepper->current = (ssStepInfo){stepping->mapping, step_s,           softnessStep(stepping, step_s),
                                    stepper->previous_step_s, 0, 1, stepper->time_s};
+  stepper->contact_memo.valid = 0;
 }
 
 /* A seed of its own for ODE's generator (splitmix64's finalizer): nearby seeds give unrelated row orders. */
@@ -137,7 +144,8 @@ static void resolveSpeeds(ssStepping* stepping) {
   if (stepping->max_angular_speed == 0) stepping->max_angular_speed = SS_MAX_SAFE_SPEED;
 }
 
-static ssStatus listSpaces(ssStepper* stepper, ssPointerSet* live);
+static int knownInStep(const ssStepper* stepper);
+static void keepKnownInStep(ssStepper* stepper);
 static ssStatus refreshKnown(ssStepper* stepper);
 static int knownListDue(const ssStepper* stepper);
 
@@ -155,25 +163,23 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
   stepper->def.stepping = stepping;
   stepper->tuned_step_s = tuned_step_s;
   if (def->space != 0) {
-    /* the space is walked again at the first frame (geoms -1): a body adoption did not reach is adopted then */
     ssRegistry* registry = def->registry;
-    if (!ssReserveOne((void**)&stepper->spaces, 0, &stepper->space_capacity, sizeof(SeenSpace)) ||
-        (registry == NULL && (registry = stepper->owned_registry = ssRegistry_Create(def->world)) == NULL)) {
-      free(stepper->spaces);
+    if (registry == NULL && (registry = stepper->owned_registry = ssRegistry_Create(def->world)) == NULL) {
       free(stepper);
       return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory creating a stepper");
     }
-    stepper->spaces[stepper->space_count++] = (SeenSpace){def->space, -1, 0, 0};
     /* adopted, and the spaces listed as they are: what the program destroys from now on is told by the listing */
+    ssBodyList gone = {NULL, 0, 0};
     if ((status = ssRegistry_Adopt(registry, tuned_step_s, def->space, &stepper->adopted)) != SS_OK ||
-        (status = listSpaces(stepper, &stepper->anchored)) != SS_OK) {
+        (status = ssSeenList(&stepper->seen, def->space, &gone)) != SS_OK) {
       ssRegistry_Destroy(stepper->owned_registry);
-      ssPointerSetFree(&stepper->anchored);
-      free(stepper->spaces);
+      ssSeenFree(&stepper->seen);
       free(stepper);
       return status;
     }
+    ssBodyListFree(&gone);
     stepper->def.registry = registry;
+    stepper->seen.listed = 0; /* listed in full again at the first frame: a body adoption did not reach is adopted */
   }
   resolveSpeeds(&stepper->def.stepping);
   stepper->row_order_seed = rowOrderSeed(stepping.step_seed);
@@ -221,8 +227,9 @@ void ssStepper_Destroy(ssStepper* stepper) {
   ssRegistry_Destroy(stepper->owned_registry);
   free(stepper->watched);
   ssKnownFree(&stepper->known);
-  free(stepper->spaces);
-  ssPointerSetFree(&stepper->anchored);
+  ssSeenFree(&stepper->seen);
+  ssBodyListFree(&stepper->found);
+  ssBodyListFree(&stepper->moved);
   ssPoseHistoryDestroy(stepper->poses);
   free(stepper);
 }
@@ -247,13 +254,22 @@ static int watched(const ssStepper* stepper, dBodyID body) {
  * the program destroys through the stepper): forgotten by the
  * known list, the watch list, the registry and the pose history, by its address alone. */
 static void forgetBody(ssStepper* stepper, dBodyID body) {
+  int was_watched = 0;
   for (int i = 0; i < stepper->watched_count; ++i)
-    if (stepper->watched[i] == body) stepper->watched[i--] = stepper->watched[--stepper->watched_count];
+    if (stepper->watched[i] == body) stepper->watched[i--] = stepper->watched[--stepper->watched_count], was_watched = 1;
   ssRegistry* registry = stepper->def.registry;
+  int in_step = knownInStep(stepper);
   if (registry != NULL && ssRegistryHasBody(registry, body)) ssRegistry_UnbindBody(registry, body);
+  /* the known list follows at the cost of the change; a body joined to others may leave some known only through it,
+   * so the list is built again then (and after a watch, which the list does not follow) */
+  int joined = ssKnownJoined(&stepper->known, body);
   ssKnownForget(&stepper->known, body);
+  if (in_step && !joined && !was_watched) keepKnownInStep(stepper);
+  else if (was_watched) stepper->watched_generation += 1;
+  else stepper->relist_due = 1;
+  for (int i = 0; i < stepper->found.count; ++i)
+    if (stepper->found.list[i] == body) stepper->found.list[i--] = stepper->found.list[--stepper->found.count];
   ssPoseHistoryForgetBody(stepper->poses, body);
-  stepper->watched_generation += 1;
 }
 
 ssStatus ssStepper_WatchBody(ssStepper* stepper, dBodyID body) {
@@ -300,15 +316,14 @@ ssStatus ssStepper_DestroyBody(ssStepper* stepper, dBodyID body) {
   REQUIRE_STEPPER(stepper);
   if (body == 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "body = NULL: a body is required");
   ssRegistry* registry = stepper->def.registry;
+  if (ssKnownJointsChangedOf(&stepper->known, body)) stepper->lost_joints_due = 1;
   /* ODE leaves the body's joints detached on one side, where some of its getters assert: they are unbound */
   for (int i = registry != NULL ? dBodyGetNumJoints(body) - 1 : -1; i >= 0; --i) {
     dJointID joint = dBodyGetJoint(body, i);
     if (ssRegistryHasJoint(registry, joint)) ssRegistry_UnbindJoint(registry, joint);
   }
   forgetBody(stepper, body); /* at once: inside a frame, the next check must not read it */
-  /* a box spawned in its place leaves a space's count as it was, and may take its geom's or its own address: the
-   * spaces are walked again before the next step */
-  if (stepper->space_count > 0) stepper->spaces[0].geoms = -1;
+  ssSeenForget(&stepper->seen, body); /* its geoms leave the spaces' count, destroyed before or after */
   dBodyDestroy(body);
   return SS_OK;
 }
@@ -384,42 +399,94 @@ ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper) {
   return (ssStepInfo){SS_MAPPING_IMPLICIT_EULER, 0, 0, 0, 0, 0, 0};
 }
 
-ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
+/* Whether a contact's position, normal and depth are finite: a product with 0 is 0 for a finite number and NaN
+ * otherwise, in one sum without a branch a value. */
+static int contactFinite(const dContactGeom* geom) {
+  double probe = 0.0 * geom->depth;
+  for (int i = 0; i < 3; ++i) probe += 0.0 * geom->pos[i] + 0.0 * geom->normal[i];
+  return probe == 0.0;
+}
+
+static void countContact(ssStepper* stepper, ssRowFallback handed_on) {
+  if (stepper->report == NULL) return;
+  ssServedCounts* contacts = &stepper->report->contacts;
+  if (handed_on.to_implicit_euler) contacts->handed_to_implicit_euler += 1;
+  else if (handed_on.exact_to_matched) contacts->handed_to_matched += 1;
+  else contacts->by_mapping += 1;
+}
+
+/* Whether the contact's surface is the one the memo was written from (the values its mode uses). */
+static int sameSurface(const ContactMemo* memo, const dSurfaceParameters* surface) {
+  return memo->valid && surface->mode == memo->mode_in &&
+         (!(surface->mode & dContactSoftERP) || surface->soft_erp == memo->erp_in) &&
+         (!(surface->mode & dContactSoftCFM) || surface->soft_cfm == memo->cfm_in);
+}
+
+/* Kept out of line: the usual contact's path (ssStepper_SoftenContact) then needs no frame of its own. */
+#if defined(__GNUC__)
+#define SS_OUT_OF_LINE __attribute__((noinline, cold))
+#else
+#define SS_OUT_OF_LINE
+#endif
+
+/* A contact not like the last one: softened by its law (contact.c), and remembered. */
+static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
   REQUIRE_STEPPER(stepper);
   if (contact == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "contact = NULL: a contact is required");
   double tuned_step_s = ssRegistry_TunedStep(stepper->def.registry);
   if (tuned_step_s == 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "tuned step = 0 s: adopt the world first (ssRegistry_Adopt), or soften "
                                          "with a spring of your own (ssContactSoften)");
+  dSurfaceParameters* surface = &contact->surface;
   ssSoftness world = ssRegistryTunedWorld(stepper->def.registry);
-  const dSurfaceParameters* surface = &contact->surface;
+  ContactMemo given = {1, surface->mode, 0, surface->soft_erp, surface->soft_cfm, 0, 0, {0, 0}};
   double erp = (surface->mode & dContactSoftERP) ? surface->soft_erp : world.erp;
   double cfm = (surface->mode & dContactSoftCFM) ? surface->soft_cfm : world.cfm;
   const ssStepInfo* step = &stepper->current;
-  ssRowFallback handed_on;
   ssStatus status = ssContactSoftenCached(&stepper->contact_cache, contact, body1, body2, erp, cfm, tuned_step_s,
-                                          step->mapping, step->softness_step_s, step->previous_step_s, &handed_on);
+                                          step->mapping, step->softness_step_s, step->previous_step_s,
+                                          &given.handed_on);
   if (status != SS_OK) return status;
-  if (stepper->report != NULL) {
-    ssServedCounts* contacts = &stepper->report->contacts;
-    if (handed_on.to_implicit_euler) contacts->handed_to_implicit_euler += 1;
-    else if (handed_on.exact_to_matched) contacts->handed_to_matched += 1;
-    else contacts->by_mapping += 1;
-  }
+  given.mode_out = surface->mode;
+  given.erp_out = surface->soft_erp;
+  given.cfm_out = surface->soft_cfm;
+  stepper->contact_memo = given;
+  countContact(stepper, given.handed_on);
+  return SS_OK;
+}
+
+ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
+  if (stepper == NULL || contact == NULL || !sameSurface(&stepper->contact_memo, &contact->surface) ||
+      !contactFinite(&contact->geom))
+    return softenNewContact(stepper, contact, body1, body2);
+  const ContactMemo* memo = &stepper->contact_memo; /* the usual contact: as the last one */
+  contact->surface.mode = memo->mode_out;
+  contact->surface.soft_erp = memo->erp_out;
+  contact->surface.soft_cfm = memo->cfm_out;
+  countContact(stepper, memo->handed_on);
   return SS_OK;
 }
 
 /* ---- the bodies the stepper knows ---- */
 
 /* Whether the known list is to be built again (refreshKnown): the registry's bindings or the watch list changed
- * since it was built, or a body's joints did. Building it reads every bound joint: what the program destroyed is
- * forgotten first (forgetDestroyed). */
+ * since it was built (and it did not follow), or a body's joints did. Building it reads every bound joint: what the
+ * program destroyed is forgotten first (forgetDestroyed). */
 static int knownListDue(const ssStepper* stepper) {
   const ssRegistry* registry = stepper->def.registry;
   unsigned generation = registry != NULL ? ssRegistryGeneration(registry) : 0;
   const ssKnownBodies* known = &stepper->known;
   return !known->valid || stepper->relist_due || known->registry_generation != generation ||
          known->watched_generation != stepper->watched_generation;
+}
+
+/* Whether the known list holds what the registry and the watch list reach now: a change the list then follows
+ * itself (ssKnownAdd, ssKnownForget) keeps it so (keepKnownInStep). */
+static int knownInStep(const ssStepper* stepper) { return !knownListDue(stepper); }
+
+static void keepKnownInStep(ssStepper* stepper) {
+  const ssRegistry* registry = stepper->def.registry;
+  stepper->known.registry_generation = registry != NULL ? ssRegistryGeneration(registry) : 0;
 }
 
 /* The known list, built again when it is due (knownListDue). */
@@ -438,13 +505,15 @@ static ssStatus refreshKnown(ssStepper* stepper) {
   return SS_OK;
 }
 
-
 /* Adopts body and what it reaches, when the stepper adopts (def.space); otherwise the known list reaches it through
- * its joints when rebuilt. */
+ * its joints when rebuilt. A list in step with the registry follows at the cost of what was adopted. */
 static ssStatus adoptBody(ssStepper* stepper, dBodyID body) {
   if (stepper->def.space == 0) return SS_OK;
+  int in_step = knownInStep(stepper);
   ssStatus status = ssRegistry_AdoptBody(stepper->def.registry, body, &stepper->adopted);
-  if (status == SS_OK) stepper->apply_due = 1;
+  if (status != SS_OK) return status;
+  stepper->apply_due = 1;
+  if (in_step && (status = ssKnownAdd(&stepper->known, body)) == SS_OK) keepKnownInStep(stepper);
   return status;
 }
 
@@ -465,116 +534,70 @@ static ssStatus adoptKnown(ssStepper* stepper) {
   return status == SS_OK && adopted ? refreshKnown(stepper) : status;
 }
 
-/* Whether a space may hold a geom of a body the stepper has not adopted: its count changed, its first geom is another,
- * or the first geom's body is not known (a geom destroyed and another added may reuse its address: the body tells).
- * ODE adds a geom at the head of a simple or hash space's list; a sweep-and-prune space reorders its geoms as they
- * move (dSpaceGetGeom lists the moved ones first) and puts a new one among them, so it is walked at every look. */
-static int spacesChanged(const ssStepper* stepper) {
-  for (int i = 0; i < stepper->space_count; ++i) {
-    const SeenSpace* seen = &stepper->spaces[i];
-    if (seen->sweep_and_prune) return 1;
-    int geoms = dSpaceGetNumGeoms(seen->space);
-    if (geoms != seen->geoms) return 1;
-    if (geoms == 0) continue;
-    dGeomID first = dSpaceGetGeom(seen->space, 0);
-    if (first != seen->first) return 1;
-    dBodyID body = dGeomIsSpace(first) ? 0 : dGeomGetBody(first);
-    if (body != 0 && !ssRegistryHasBody(stepper->def.registry, body)) return 1;
+/* Lists the adopted spaces in full: the bodies that held a geom there and hold none now were destroyed with their
+ * geoms (or lost them) and are forgotten; the bodies there the registry has not are found. */
+static ssStatus listSpaces(ssStepper* stepper) {
+  ssBodyList gone = {NULL, 0, 0};
+  ssStatus status = ssSeenList(&stepper->seen, stepper->def.space, &gone);
+  for (int i = 0; status == SS_OK && i < gone.count; ++i) forgetBody(stepper, gone.list[i]);
+  ssBodyListFree(&gone);
+  stepper->found.count = stepper->moved.count = 0;
+  ssKnownCheckAllOnce(&stepper->known); /* a sleeping body moved is not told from the others */
+  const ssPointerMap* held = &stepper->seen.bodies;
+  for (size_t i = 0; status == SS_OK && i < held->capacity; ++i) {
+    dBodyID body = (dBodyID)held->keys[i];
+    if (body == 0 || ssRegistryHasBody(stepper->def.registry, body)) continue;
+    if (!ssReserveOne((void**)&stepper->found.list, stepper->found.count, &stepper->found.capacity, sizeof body))
+      status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces' bodies");
+    else
+      stepper->found.list[stepper->found.count++] = body;
   }
-  return 0;
+  return status;
 }
 
-/* Whether space is listed among the adopted spaces already. */
-static int spaceListed(const ssStepper* stepper, dSpaceID space) {
-  for (int k = 0; k < stepper->space_count; ++k)
-    if (stepper->spaces[k].space == space) return 1;
-  return 0;
-}
-
-/* Lists def.space and every space nested in it, at any depth (breadth first: the list is the queue), and in live
- * the bodies their geoms hold now. Reads the spaces and their geoms only: a body destroyed with its geom is not
- * met, and one destroyed alone left its geoms without a body. A failed listing (a quadtree space) remembers
- * nothing, so the next look lists again and refuses again until the program takes the space out. */
-static ssStatus listSpaces(ssStepper* stepper, ssPointerSet* live) {
-  stepper->space_count = 1;
-  stepper->spaces[0] = (SeenSpace){stepper->def.space, -1, 0, 0};
-  ssStatus status = SS_OK;
-  for (int walked = 0; status == SS_OK && walked < stepper->space_count; ++walked) {
-    dSpaceID space = stepper->spaces[walked].space;
-    if ((status = ssCheckSpaceListable(walked == 0 ? "def.space" : "nested space", space)) != SS_OK) break;
-    for (int i = 0, geoms = dSpaceGetNumGeoms(space); i < geoms && status == SS_OK; ++i) {
-      dGeomID geom = dSpaceGetGeom(space, i);
-      if (dGeomIsSpace(geom)) {
-        if (spaceListed(stepper, (dSpaceID)geom)) continue;
-        if (!ssReserveOne((void**)&stepper->spaces, stepper->space_count, &stepper->space_capacity,
-                          sizeof(SeenSpace)))
-          status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
-        else
-          stepper->spaces[stepper->space_count++] = (SeenSpace){(dSpaceID)geom, -1, 0, 0};
-      } else if (dGeomGetBody(geom) != 0 && ssPointerSetAdd(live, dGeomGetBody(geom)) < 0) {
-        status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces' bodies");
-      }
-    }
-  }
-  if (status != SS_OK) { /* nothing remembered: the next look lists again */
-    stepper->space_count = 1;
-    return status;
-  }
-  for (int i = 0; i < stepper->space_count; ++i) {
-    SeenSpace* seen = &stepper->spaces[i];
-    seen->geoms = dSpaceGetNumGeoms(seen->space);
-    seen->first = seen->geoms > 0 ? dSpaceGetGeom(seen->space, 0) : 0;
-    seen->sweep_and_prune = dSpaceGetClass(seen->space) == dSweepAndPruneSpaceClass;
-  }
-  return SS_OK;
-}
-
-/* What the program destroyed with ODE's own calls since the last look, found by reading only what is alive:
- *  - from the adopted spaces (alive while def.space is), when they changed: bodies that had a geom there and have
- *    none now were destroyed with their geoms (or lost them), and are forgotten; the bodies there now are kept for
- *    adoption (adoptAnchored);
+/* What the program made, moved or destroyed with ODE's own calls since the last look, found by reading only what is
+ * alive:
+ *  - in the adopted spaces (alive while def.space is): the bodies of new geoms are found (adopted by findNew), the
+ *    sleeping bodies the program moved are kept for the checks, and when the spaces' count tells that a geom was
+ *    destroyed the spaces are listed in full (listSpaces);
  *  - from the known bodies (alive, since a body with a geom was checked above and one without must be destroyed
  *    with ssStepper_DestroyBody), when their joints changed or a body was forgotten: a bound joint attached to no
  *    known body any more was destroyed (or detached from all), and is unbound without being read. */
 static ssStatus forgetDestroyed(ssStepper* stepper, int look_at_joints) {
   int forgot = 0;
-  if (stepper->def.space != 0 && spacesChanged(stepper)) {
-    ssPointerSet live = {NULL, 0, 0};
-    ssStatus status = listSpaces(stepper, &live);
-    if (status != SS_OK) {
-      ssPointerSetFree(&live);
-      return status;
+  if (stepper->def.space != 0) {
+    int known_before = stepper->known.count;
+    int looked = ssSeenLook(&stepper->seen, &stepper->found, &stepper->moved);
+    if (looked < 0) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory looking at the adopted spaces");
+    if (looked == 0) {
+      ssStatus status = listSpaces(stepper);
+      if (status != SS_OK) return status;
     }
-    for (size_t i = 0; i < stepper->anchored.capacity; ++i) {
-      dBodyID body = (dBodyID)stepper->anchored.slots[i];
-      if (body == 0 || ssPointerSetHas(&live, body)) continue;
-      forgetBody(stepper, body);
-      forgot += 1;
-    }
-    ssPointerSetFree(&stepper->anchored);
-    stepper->anchored = live;
-    stepper->adopt_anchored_due = 1;
+    forgot = stepper->known.count < known_before;
   }
   ssRegistry* registry = stepper->def.registry;
-  if (registry == NULL || !(forgot > 0 || ((look_at_joints || knownListDue(stepper)) &&
-                                           ssKnownJointsChanged(&stepper->known, NULL))))
+  if (registry == NULL || !(forgot || stepper->lost_joints_due ||
+                            ((look_at_joints || knownListDue(stepper)) && ssKnownJointsChanged(&stepper->known, NULL))))
     return SS_OK;
   ssPointerSet alive = {NULL, 0, 0};
   ssStatus status = ssKnownCollectJoints(&stepper->known, &alive);
   if (status == SS_OK && ssRegistryUnbindJointsNotIn(registry, &alive) > 0) stepper->apply_due = 1;
+  if (status == SS_OK) stepper->lost_joints_due = 0;
   ssPointerSetFree(&alive);
   return status;
 }
 
-/* Adopts the bodies the adopted spaces hold that the registry has not (a box spawned after the stepper was made),
- * with what their joints reach. */
-static ssStatus adoptAnchored(ssStepper* stepper) {
+/* Adopts the bodies found in the adopted spaces that the registry has not (a box spawned after the stepper was made),
+ * with what their joints reach. One refused stays found, and is refused again at the next look until repaired. */
+static ssStatus adoptFound(ssStepper* stepper) {
   ssStatus status = SS_OK;
-  for (size_t i = 0; i < stepper->anchored.capacity && status == SS_OK; ++i) {
-    dBodyID body = (dBodyID)stepper->anchored.slots[i];
-    if (body != 0 && !ssRegistryHasBody(stepper->def.registry, body)) status = adoptBody(stepper, body);
+  int kept = 0;
+  for (int i = 0; i < stepper->found.count; ++i) {
+    dBodyID body = stepper->found.list[i];
+    if (status == SS_OK && !ssRegistryHasBody(stepper->def.registry, body)) status = adoptBody(stepper, body);
+    if (status != SS_OK) stepper->found.list[kept++] = body;
   }
-  stepper->adopt_anchored_due = status != SS_OK; /* refused: again at the next look, until repaired */
+  stepper->found.count = kept;
   return status;
 }
 
@@ -582,7 +605,8 @@ static ssStatus adoptAnchored(ssStepper* stepper) {
  * spaces, and with look_at_joints the joints attached to known bodies (and the bodies beyond them). */
 static ssStatus findNew(ssStepper* stepper, int look_at_joints) {
   ssStatus status = forgetDestroyed(stepper, look_at_joints);
-  if (status == SS_OK && stepper->adopt_anchored_due) status = adoptAnchored(stepper);
+  if (status == SS_OK) status = refreshKnown(stepper);
+  if (status == SS_OK && stepper->found.count > 0) status = adoptFound(stepper);
   if (status == SS_OK) status = refreshKnown(stepper);
   if (status == SS_OK && stepper->adopt_known_due) status = adoptKnown(stepper);
   dBodyID changed;
@@ -674,7 +698,8 @@ static ssStatus checkKnown(ssStepper* stepper, int forces, const char* when, int
   const ssStepping* stepping = &stepper->def.stepping;
   ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, forces, step_s};
   dBodyID failed = 0;
-  ssStatus status = ssKnownCheck(&stepper->known, &bounds, when, index + 1, steps, &failed);
+  ssStatus status = ssKnownCheck(&stepper->known, &bounds, when, index + 1, steps, stepper->moved.list,
+                                 stepper->moved.count, &failed);
   if (status != SS_OK) report->failed_body = failed;
   return status;
 }
@@ -763,6 +788,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
         return status;
     }
     stepper->current = (ssStepInfo){mapping, step_s, softness_step_s, previous_step_s, i, steps, stepper->time_s};
+    stepper->contact_memo.valid = 0;
     if (def->before_step) def->before_step(def->before_step_context, stepper);
     /* what before_step destroyed with ODE's own calls is forgotten before anything reads it */
     if (def->before_step && !stepper->destroy_requested && (status = forgetDestroyed(stepper, 1)) != SS_OK)
@@ -797,6 +823,9 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistoryBeforeLastStep(stepper->poses);
     int stepped = odeStep(stepper, step_s);
     if (def->contact_group) dJointGroupEmpty(def->contact_group);
+    /* the step moved what it stepped to the spaces' heads: what the program adds or moves next lands before the
+     * first geom it could not move */
+    ssSeenMark(&stepper->seen);
     if (!stepped) return latch(stepper, ssFail(SS_ERROR_OUT_OF_MEMORY, "ODE ran out of memory in its step"));
     report->steps += 1;
     addServed(&report->rows, &applied.rows);
@@ -884,7 +913,8 @@ static ssStatus startFrame(ssStepper* stepper, ssFrameReport* report) {
   ssStatus status = findNew(stepper, 0);
   for (int joints_changed = 1; status == SS_OK && joints_changed;) {
     dBodyID failed = 0;
-    status = ssKnownStartFrame(&stepper->known, &bounds, &failed, &joints_changed);
+    status = ssKnownStartFrame(&stepper->known, &bounds, stepper->moved.list, stepper->moved.count, &failed,
+                               &joints_changed);
     if (status != SS_OK) {
       report->failed_body = failed;
       return latch(stepper, status);

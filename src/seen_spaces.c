@@ -1,0 +1,176 @@
+/* The adopted spaces as last seen (seen_spaces.h): a full listing when the counts require it, otherwise a walk of
+ * each space's head, up to the first geom the last step could not move. */
+#include "seen_spaces.h"
+
+#include <stdlib.h>
+
+#include "array.h"
+#include "error.h"
+#include "ode_bounds.h"
+
+void ssSeenFree(ssSeenSpaces* seen) {
+  free(seen->spaces);
+  ssPointerMapFree(&seen->bodies);
+  ssPointerSetFree(&seen->met);
+  *seen = (ssSeenSpaces){0};
+}
+
+void ssBodyListFree(ssBodyList* list) {
+  free(list->list);
+  *list = (ssBodyList){NULL, 0, 0};
+}
+
+static int pushBody(ssBodyList* list, dBodyID body) {
+  if (!ssReserveOne((void**)&list->list, list->count, &list->capacity, sizeof body)) return 0;
+  list->list[list->count++] = body;
+  return 1;
+}
+
+static int spaceListed(const ssSeenSpaces* seen, dSpaceID space) {
+  for (int k = 0; k < seen->count; ++k)
+    if (seen->spaces[k].space == space) return 1;
+  return 0;
+}
+
+/* How many of body's geoms lie in the listed spaces. */
+static int geomsHeld(const ssSeenSpaces* seen, dBodyID body) {
+  int held = 0;
+  for (dGeomID geom = dBodyGetFirstGeom(body); geom != 0; geom = dBodyGetNextGeom(geom))
+    held += dGeomGetSpace(geom) != 0 && spaceListed(seen, dGeomGetSpace(geom));
+  return held;
+}
+
+static long geomsNow(const ssSeenSpaces* seen) {
+  long geoms = 0;
+  for (int i = 0; i < seen->count; ++i) geoms += dSpaceGetNumGeoms(seen->spaces[i].space);
+  return geoms;
+}
+
+/* Breadth first (the list is the queue); bodies -> their geoms counted there. */
+static ssStatus listInto(ssSeenSpaces* seen, dSpaceID root, ssPointerMap* bodies) {
+  seen->count = 0;
+  if (!ssReserveOne((void**)&seen->spaces, 0, &seen->capacity, sizeof *seen->spaces))
+    return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
+  seen->spaces[seen->count++] = (ssSeenSpace){root, 0, 0, 0, 0};
+  for (int walked = 0; walked < seen->count; ++walked) {
+    dSpaceID space = seen->spaces[walked].space;
+    ssStatus status = ssCheckSpaceListable(walked == 0 ? "def.space" : "nested space", space);
+    if (status != SS_OK) return status;
+    seen->spaces[walked].sweep_and_prune = dSpaceGetClass(space) == dSweepAndPruneSpaceClass;
+    for (int i = 0, geoms = dSpaceGetNumGeoms(space); i < geoms; ++i) {
+      dGeomID geom = dSpaceGetGeom(space, i);
+      if (dGeomIsSpace(geom)) {
+        if (spaceListed(seen, (dSpaceID)geom)) continue;
+        if (!ssReserveOne((void**)&seen->spaces, seen->count, &seen->capacity, sizeof *seen->spaces))
+          return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
+        seen->spaces[seen->count++] = (ssSeenSpace){(dSpaceID)geom, 0, 0, 0, 0};
+        continue;
+      }
+      dBodyID body = dGeomGetBody(geom);
+      if (body != 0 && ssPointerMapPut(bodies, body, ssPointerMapGet(bodies, body, 0) + 1) < 0)
+        return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces' bodies");
+    }
+  }
+  return SS_OK;
+}
+
+ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone) {
+  ssPointerMap bodies = {NULL, NULL, 0, 0};
+  ssStatus status = listInto(seen, root, &bodies);
+  for (size_t i = 0; status == SS_OK && i < seen->bodies.capacity; ++i) {
+    dBodyID body = (dBodyID)seen->bodies.keys[i];
+    if (body != 0 && ssPointerMapGet(&bodies, body, 0) == 0 && !pushBody(gone, body))
+      status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces' bodies");
+  }
+  if (status != SS_OK) { /* nothing remembered: the next look lists again */
+    ssPointerMapFree(&bodies);
+    seen->listed = 0;
+    seen->count = seen->count > 0 ? 1 : 0;
+    return status;
+  }
+  ssPointerMapFree(&seen->bodies);
+  seen->bodies = bodies;
+  seen->geoms = geomsNow(seen);
+  seen->listed = 1;
+  ssSeenMark(seen);
+  return SS_OK;
+}
+
+/* The head of one space: up to its marker (the whole list when there is none). Returns 1, or 0 when the space must be
+ * listed (a new nested space, a static geom moved or added, the marker moved), -1 when out of memory. *added counts
+ * the geoms of the bodies met that the listing does not account for. */
+static int walkHead(ssSeenSpaces* seen, const ssSeenSpace* space, ssBodyList* found, ssBodyList* moved,
+                    long* added) {
+  for (int i = 0, geoms = dSpaceGetNumGeoms(space->space); i < geoms; ++i) {
+    dGeomID geom = dSpaceGetGeom(space->space, i);
+    /* what lies behind the marker was there at the mark, unless it moved: then another follows it. The marker's own
+     * move does not show when it was first already, so its body is taken as moved too */
+    int marker = geom == space->marker;
+    if (marker && (space->after_marker != (i + 1 < geoms ? dSpaceGetGeom(space->space, i + 1) : 0) ||
+                   space->marker_body != dGeomGetBody(geom)))
+      return 0;
+    if (dGeomIsSpace(geom)) {
+      if (!spaceListed(seen, (dSpaceID)geom)) return 0;
+      continue;
+    }
+    dBodyID body = dGeomGetBody(geom);
+    if (body == 0) return marker; /* a static geom added or moved, or one whose body was taken from it */
+    int met = ssPointerSetAdd(&seen->met, body);
+    if (met < 0) return -1;
+    if (met == 0) {
+      if (marker) return 1;
+      continue;
+    }
+    int held = geomsHeld(seen, body), listed = ssPointerMapGet(&seen->bodies, body, 0);
+    *added += held - listed;
+    if (held != listed && ssPointerMapPut(&seen->bodies, body, held) < 0) return -1;
+    if (listed == 0 && !pushBody(found, body)) return -1;
+    if (listed > 0 && !dBodyIsEnabled(body) && !pushBody(moved, body)) return -1;
+    if (marker) return 1;
+  }
+  return space->marker == 0; /* a marker not met was destroyed (or taken out of the space) */
+}
+
+int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved) {
+  moved->count = 0;
+  if (!seen->listed) return 0;
+  long added = 0;
+  int looked = 1;
+  for (int i = 0; looked == 1 && i < seen->count; ++i)
+    looked = seen->spaces[i].sweep_and_prune ? 0 : walkHead(seen, &seen->spaces[i], found, moved, &added);
+  /* the met set is emptied, its memory kept for the next look */
+  for (size_t i = 0; i < seen->met.capacity; ++i) seen->met.slots[i] = NULL;
+  seen->met.count = 0;
+  if (looked != 1) return looked;
+  long now = geomsNow(seen);
+  if (now != seen->geoms + added) return 0; /* a geom destroyed with ODE's own calls, or one added unseen */
+  seen->geoms = now;
+  return 1;
+}
+
+void ssSeenMark(ssSeenSpaces* seen) {
+  for (int s = 0; s < seen->count; ++s) {
+    ssSeenSpace* space = &seen->spaces[s];
+    space->marker = space->after_marker = 0;
+    space->marker_body = 0;
+    for (int i = 0, geoms = dSpaceGetNumGeoms(space->space); i < geoms; ++i) {
+      dGeomID geom = dSpaceGetGeom(space->space, i);
+      if (dGeomIsSpace(geom)) continue; /* a nested space moves with any geom in it */
+      dBodyID body = dGeomGetBody(geom);
+      if (body != 0 && dBodyIsEnabled(body)) continue;
+      space->marker = geom;
+      space->marker_body = body;
+      space->after_marker = i + 1 < geoms ? dSpaceGetGeom(space->space, i + 1) : 0;
+      break;
+    }
+  }
+}
+
+void ssSeenForget(ssSeenSpaces* seen, dBodyID body) {
+  int held = ssPointerMapGet(&seen->bodies, body, 0);
+  if (held == 0) return;
+  seen->geoms -= held;
+  ssPointerMapRemove(&seen->bodies, body);
+}
+
+int ssSeenHolds(const ssSeenSpaces* seen, dBodyID body) { return ssPointerMapGet(&seen->bodies, body, 0) > 0; }

@@ -1,0 +1,66 @@
+/* Internal: the adopted spaces as the stepper last saw them, and what the program changed in them since, found at
+ * the cost of the change.
+ *
+ * ODE keeps a simple or hash space's geoms in a list and puts a geom at its head when it is added, and again when it
+ * moves (dGeomMoved: a body stepped or set). So after a step every geom ODE did not move (a static geom, a sleeping
+ * body's) lies behind the geoms it moved, and whatever the program adds or moves later lands in front of them: the
+ * first geom ODE's step cannot move, the marker, divides the list into a head that holds everything new and a tail
+ * that holds nothing new. A look walks the heads only. What no walk sees, a geom the program destroyed, shows in the
+ * count: the spaces hold as many geoms as at the last listing, plus those found since, less those the stepper
+ * removed, or something was destroyed with ODE's own calls, and the spaces are listed in full. A sweep-and-prune space
+ * reorders its geoms as they move (dSpaceGetGeom lists the moved ones first) and is listed at every look. */
+#ifndef STEADYSTEP_SEEN_SPACES_H
+#define STEADYSTEP_SEEN_SPACES_H
+
+#include <ode/ode.h>
+
+#include "pointer_set.h"
+#include "steadystep/status.h"
+
+/* A growable list of bodies. */
+typedef struct ssBodyList {
+  dBodyID* list;
+  int count, capacity;
+} ssBodyList;
+
+typedef struct ssSeenSpace {
+  dSpaceID space;
+  dGeomID marker;       /* the first geom ODE's step does not move, when last marked; 0: none (the whole list is head) */
+  dGeomID after_marker; /* the geom behind it then: the marker moved since when another follows it */
+  dBodyID marker_body;  /* the marker's body then (0: static) */
+  int sweep_and_prune;
+} ssSeenSpace;
+
+typedef struct ssSeenSpaces {
+  ssSeenSpace* spaces; /* the root space first, then those nested in it at any depth */
+  int count, capacity;
+  int listed;          /* 0: the next look lists in full */
+  long geoms;          /* the geoms the spaces hold, as the listing and the looks since account for them */
+  ssPointerMap bodies; /* each body with a geom in the spaces -> how many of its geoms are there */
+  ssPointerSet met;    /* a look's bodies, each counted once */
+} ssSeenSpaces;
+
+void ssSeenFree(ssSeenSpaces* seen);
+void ssBodyListFree(ssBodyList* list);
+
+/* Lists root and every space nested in it, and the bodies their geoms hold: *gone gets the bodies of the last
+ * listing that hold no geom there now (destroyed with their geoms, or moved out), and the listing replaces the last.
+ * Reads the spaces and their geoms only. Errors, remembering nothing (the next look lists again):
+ * SS_ERROR_UNSUPPORTED for a space ODE cannot list (a quadtree: ssCheckSpaceListable), SS_ERROR_OUT_OF_MEMORY. */
+ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone);
+
+/* Walks the spaces' heads: *found gets the bodies with a geom there that the listing had not (appended), *moved the
+ * sleeping bodies the program moved (replaced). Returns 1 when the counts tell that nothing else changed (the new bodies then belong
+ * to the listing), 0 when the spaces must be listed in full (ssSeenList), -1 when out of memory. */
+int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved);
+
+/* After a step: each space's marker set to its first geom the next step cannot move. */
+void ssSeenMark(ssSeenSpaces* seen);
+
+/* body, about to be destroyed through the stepper: its geoms there leave the count (destroyed before or after). */
+void ssSeenForget(ssSeenSpaces* seen, dBodyID body);
+
+/* Whether body holds a geom in the spaces, as last seen. */
+int ssSeenHolds(const ssSeenSpaces* seen, dBodyID body);
+
+#endif
