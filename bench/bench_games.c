@@ -1,0 +1,244 @@
+/* What the library costs where games spend it: a field of boxes resting on a plane in a hash space, softened
+ * contacts made in the program's near callback, stepped by the program's own loop (dSpaceCollide, dWorldQuickStep,
+ * dJointGroupEmpty) and by the same world adopted through its space under `naive` (bit for bit the same motion).
+ * Four scenes:
+ *  - static: the boxes rest, awake;
+ *  - spawning: besides, one projectile made each frame and the one made 60 frames earlier destroyed (dGeomDestroy,
+ *    then dBodyDestroy in the program's loop, ssStepper_DestroyBody adopted);
+ *  - asleep: the boxes disabled by ODE's auto-disable, the level at rest;
+ *  - asleep, spawning: both.
+ * Projectiles fly up from beside the field and never touch a box, so that a sleeping level stays asleep. The two
+ * copies are stepped in alternating blocks, timed by this thread's CPU time; the ratio of adopted to own is printed,
+ * median and range over the repeats.
+ *
+ * Then the library's share of a frame as the world grows (10 to 100,000 boxes, `implicit-euler`, static boxes): the
+ * adopted frame's time over the own frame's, less one.
+ *
+ * Under valgrind, `callgrind --toggle-collect=` on gameFrameOwn and gameFrameAdopted counts the instructions of each
+ * copy (docs/measurements.md).
+ *
+ *   bench_games [frames] [repeats] [largest box count]   (default 120 frames, 5 repeats, 100000) */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <steadystep/steadystep.h>
+
+#include "bench_common.h"
+
+enum { kBlock = 10, kLifetime = 60, kMaxContacts = 4 };
+static const double kFrame_s = 1.0 / 60.0;
+
+typedef struct Game {
+  dWorldID world;
+  dSpaceID space;
+  dJointGroupID contacts;
+  ssStepper* stepper; /* NULL: the program's own loop */
+  int spawning;
+  dBodyID projectiles[kLifetime];
+  long frame;
+} Game;
+
+/* until bench_common.h has it */
+static void benchPrintMachine(const char* bench, const char* when) {
+  double load[3] = {-1, -1, -1};
+  if (getloadavg(load, 3) != 3) load[0] = load[1] = load[2] = -1;
+  printf("%s: load average %.2f %.2f %.2f %s, %ld cores online\n", bench, load[0], load[1], load[2], when,
+         sysconf(_SC_NPROCESSORS_ONLN));
+}
+
+static void check(ssStatus status, const char* what) { benchCheck("bench_games", status, what); }
+
+static void nearCallback(void* data, dGeomID o1, dGeomID o2) {
+  Game* game = data;
+  dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
+  if (b1 != 0 && b2 != 0 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
+  dContact contact[kMaxContacts];
+  int count = dCollide(o1, o2, kMaxContacts, &contact[0].geom, sizeof(dContact));
+  for (int i = 0; i < count; ++i) {
+    contact[i].surface.mode = dContactSoftCFM | dContactSoftERP | dContactApprox1;
+    contact[i].surface.mu = 0.8;
+    contact[i].surface.soft_erp = 0.2;
+    contact[i].surface.soft_cfm = 1e-4;
+    if (game->stepper != NULL) ssStepper_SoftenContact(game->stepper, &contact[i], b1, b2);
+    dJointAttach(dJointCreateContact(game->world, game->contacts, &contact[i]), b1, b2);
+  }
+}
+
+static void collide(void* context, ssStepper* stepper) {
+  (void)stepper;
+  Game* game = context;
+  dSpaceCollide(game->space, game, nearCallback);
+}
+
+/* boxes of 0.5 m on a square grid 1 m apart, resting on the plane z = 0 */
+static Game* build(int boxes, int asleep, int spawning, const char* policy) {
+  Game* game = calloc(1, sizeof *game);
+  if (game == NULL) exit(1);
+  *game = (Game){dWorldCreate(), dHashSpaceCreate(0), dJointGroupCreate(0), NULL, spawning, {0}, 0};
+  dWorldSetGravity(game->world, 0, 0, -9.81);
+  dWorldSetQuickStepNumIterations(game->world, 10);
+  dWorldSetAutoDisableFlag(game->world, asleep);
+  dCreatePlane(game->space, 0, 0, 1, 0);
+  int side = (int)ceil(sqrt((double)boxes));
+  for (int i = 0; i < boxes; ++i) {
+    dBodyID body = dBodyCreate(game->world);
+    dMass mass;
+    dMassSetBoxTotal(&mass, 1.0, 0.5, 0.5, 0.5);
+    dBodySetMass(body, &mass);
+    dBodySetPosition(body, i % side, i / side, 0.25);
+    dGeomSetBody(dCreateBox(game->space, 0.5, 0.5, 0.5), body);
+  }
+  /* settled by the program before it is adopted: the boxes sit in their contacts (and fall asleep) */
+  for (int i = 0; i < 60; ++i) {
+    dSpaceCollide(game->space, game, nearCallback);
+    dWorldQuickStep(game->world, kFrame_s);
+    dJointGroupEmpty(game->contacts);
+  }
+  if (policy == NULL) return game;
+  ssStepperDef def = ssDefaultStepperDef();
+  def.world = game->world;
+  def.space = game->space;
+  def.tuned_step_s = kFrame_s;
+  def.stepping.solver = SS_SOLVER_QUICK;
+  check(ssSteppingForPolicy(policy, kFrame_s, &def.stepping), policy);
+  def.collide = collide;
+  def.collide_context = game;
+  def.contact_group = game->contacts;
+  check(ssStepper_Create(&def, &game->stepper), "stepper");
+  return game;
+}
+
+/* The program's spawning: a projectile made, and the one made kLifetime frames ago destroyed. */
+static void spawnAndDespawn(Game* game) {
+  if (!game->spawning) return;
+  int slot = (int)(game->frame % kLifetime);
+  dBodyID old = game->projectiles[slot];
+  if (old != 0) {
+    dGeomDestroy(dBodyGetFirstGeom(old));
+    if (game->stepper != NULL) check(ssStepper_DestroyBody(game->stepper, old), "destroy body");
+    else dBodyDestroy(old);
+  }
+  dBodyID body = dBodyCreate(game->world);
+  dMass mass;
+  dMassSetSphereTotal(&mass, 0.2, 0.1);
+  dBodySetMass(body, &mass);
+  dBodySetPosition(body, -5.0 - (double)(game->frame % 7), -5.0, 1.0);
+  dBodySetLinearVel(body, 0, 0, 10.0); /* up for two seconds: gone before it lands */
+  dGeomSetBody(dCreateSphere(game->space, 0.1), body);
+  game->projectiles[slot] = body;
+  game->frame += 1;
+}
+
+/* A frame of the program's own loop. Not inlined: callgrind counts it by name. */
+__attribute__((noinline)) void gameFrameOwn(Game* game) {
+  spawnAndDespawn(game);
+  dSpaceCollide(game->space, game, nearCallback);
+  dWorldQuickStep(game->world, kFrame_s);
+  dJointGroupEmpty(game->contacts);
+}
+
+/* A frame of the adopted copy. */
+__attribute__((noinline)) void gameFrameAdopted(Game* game) {
+  spawnAndDespawn(game);
+  check(ssStepper_Step(game->stepper, kFrame_s, NULL), "step");
+}
+
+static void destroy(Game* game) {
+  ssStepper_Destroy(game->stepper);
+  dJointGroupDestroy(game->contacts);
+  dSpaceDestroy(game->space);
+  dWorldDestroy(game->world);
+  free(game);
+}
+
+/* One pair of copies (own, adopted) stepped through frames in alternating blocks; each copy's CPU seconds. */
+static void measure(int boxes, int asleep, int spawning, const char* policy, int frames, double seconds[2]) {
+  Game* games[2] = {build(boxes, asleep, spawning, NULL), build(boxes, asleep, spawning, policy)};
+  seconds[0] = seconds[1] = 0;
+  for (int done = 0, block = 0; done < frames; done += kBlock, ++block) {
+    for (int k = 0; k < 2; ++k) {
+      int g = (k + block) % 2; /* the order alternates: neither is always first */
+      double start = benchCpuSeconds();
+      for (int i = 0; i < kBlock; ++i) {
+        if (g == 0) gameFrameOwn(games[0]);
+        else gameFrameAdopted(games[1]);
+      }
+      seconds[g] += benchCpuSeconds() - start;
+    }
+  }
+  destroy(games[0]);
+  destroy(games[1]);
+}
+
+/* The median ratio adopted / own over the repeats, printed with its range and the own frame's time. */
+static double reportScene(const char* name, int boxes, int asleep, int spawning, const char* policy, int frames,
+                          int repeats) {
+  double ratios[64], own_us = 0;
+  for (int r = 0; r < repeats; ++r) {
+    double seconds[2];
+    measure(boxes, asleep, spawning, policy, frames, seconds);
+    ratios[r] = seconds[1] / seconds[0];
+    own_us += 1e6 * seconds[0] / frames / repeats;
+  }
+  benchSort(ratios, repeats);
+  printf("  %-22s %6d boxes  own %9.1f us/frame  adopted/own %.4f  (%.4f to %.4f)\n", name, boxes, own_us,
+         ratios[repeats / 2], ratios[0], ratios[repeats - 1]);
+  return ratios[repeats / 2];
+}
+
+static const struct {
+  const char* name;
+  int asleep, spawning;
+} kScenes[] = {{"static", 0, 0}, {"spawning", 0, 1}, {"asleep", 1, 0}, {"asleep, spawning", 1, 1}};
+enum { kSceneCount = sizeof kScenes / sizeof kScenes[0] };
+
+/* bench_games count <scene 0-3> <boxes> <frames>: both copies stepped, untimed, for callgrind's counts. */
+static int countInstructions(int argc, char** argv) {
+  int scene = argc > 2 ? atoi(argv[2]) : -1, boxes = argc > 3 ? atoi(argv[3]) : 0;
+  int frames = argc > 4 ? atoi(argv[4]) : 0;
+  if (scene < 0 || scene >= kSceneCount || boxes <= 0 || frames <= 0) {
+    fprintf(stderr, "usage: bench_games count <scene 0-%d> <boxes> <frames>\n", kSceneCount - 1);
+    return 2;
+  }
+  dInitODE2(0);
+  Game* own = build(boxes, kScenes[scene].asleep, kScenes[scene].spawning, NULL);
+  Game* adopted = build(boxes, kScenes[scene].asleep, kScenes[scene].spawning, "naive");
+  for (int i = 0; i < frames; ++i) gameFrameOwn(own);
+  for (int i = 0; i < frames; ++i) gameFrameAdopted(adopted);
+  destroy(own);
+  destroy(adopted);
+  return 0;
+}
+
+int main(int argc, char** argv) {
+  if (argc > 1 && strcmp(argv[1], "count") == 0) return countInstructions(argc, argv);
+  int frames = argc > 1 ? atoi(argv[1]) : 120;
+  int repeats = argc > 2 ? atoi(argv[2]) : 5;
+  int largest = argc > 3 ? atoi(argv[3]) : 100000;
+  if (frames <= 0 || repeats <= 0 || repeats > 64 || largest < 10 || argc > 4) {
+    fprintf(stderr, "usage: bench_games [frames > 0] [repeats 1..64] [largest box count >= 10]\n");
+    return 2;
+  }
+  frames = (frames + kBlock - 1) / kBlock * kBlock;
+  dInitODE2(0);
+  benchPrintMachine("bench_games", "before");
+  printf("bench_games: boxes resting on a plane in a hash space, %d frames of 1/60 s a repeat, thread CPU time\n"
+         "adopted under naive against the program's own loop (target: at most 1.02)\n", frames);
+  for (int boxes = 1000; boxes <= 10000; boxes *= 10)
+    for (int s = 0; s < kSceneCount; ++s)
+      reportScene(kScenes[s].name, boxes, kScenes[s].asleep, kScenes[s].spawning, "naive",
+                  boxes >= 10000 ? (frames / 4 + kBlock - 1) / kBlock * kBlock : frames, repeats);
+  printf("the library's share of a frame as the world grows, implicit-euler, static boxes (target: the share at "
+         "100,000 at most 1.5 times the share at 1,000)\n");
+  for (int boxes = 10; boxes <= largest; boxes *= 10) {
+    int scaled = boxes >= 100000 ? 10 : boxes >= 10000 ? frames / 4 : frames; /* a few seconds a repeat */
+    scaled = (scaled + kBlock - 1) / kBlock * kBlock;
+    double ratio = reportScene("static", boxes, 0, 0, "implicit-euler", scaled, boxes >= 100000 ? 3 : repeats);
+    printf("    share %.2f %%\n", 100.0 * (ratio - 1.0));
+  }
+  benchPrintMachine("bench_games", "after");
+  return 0;
+}
