@@ -22,7 +22,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <steadystep/steadystep.h>
 
@@ -40,14 +39,6 @@ typedef struct Game {
   dBodyID projectiles[kLifetime];
   long frame;
 } Game;
-
-/* until bench_common.h has it */
-static void benchPrintMachine(const char* bench, const char* when) {
-  double load[3] = {-1, -1, -1};
-  if (getloadavg(load, 3) != 3) load[0] = load[1] = load[2] = -1;
-  printf("%s: load average %.2f %.2f %.2f %s, %ld cores online\n", bench, load[0], load[1], load[2], when,
-         sysconf(_SC_NPROCESSORS_ONLN));
-}
 
 static void check(ssStatus status, const char* what) { benchCheck("bench_games", status, what); }
 
