@@ -80,9 +80,8 @@ ssContactCache ssContactCacheEmpty(void) {
   return cache;
 }
 
-ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID body1, dBodyID body2,
-                               double tuned_erp, double tuned_cfm, double tuned_step_s, ssMapping mapping,
-                               double step_s, double previous_step_s, ssRowFallback* handed_on) {
+ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, double tuned_erp, double tuned_cfm,
+                               double tuned_step_s, ssMapping mapping, double step_s, ssRowFallback* handed_on) {
   ssStatus checked = checkContactGeometry(contact);
   if (checked != SS_OK) return checked;
   if (tuned_erp != cache->tuned_erp || tuned_cfm != cache->tuned_cfm || tuned_step_s != cache->tuned_step_s) {
@@ -95,7 +94,6 @@ ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID
     cache->tuned_step_s = tuned_step_s;
     cache->law = law;
   }
-  (void)body1, (void)body2, (void)previous_step_s; /* no contact's softness reads them (above) */
   int same = cache->has_softness && mapping == cache->mapping && step_s == cache->step_s;
   if (!same) {
     ssSoftness softness;

@@ -166,11 +166,10 @@ ssContactCache ssContactCacheEmpty(void);
 
 /* Softens contact as the law that tuned_erp and tuned_cfm stand for at tuned_step_s (ssRowLawFromTuned), for a step
  * of step_s under mapping, through the cache; *handed_on (may be NULL) says whether an accurate mapping handed the
- * contact on to implicit Euler (it always does: exact_to_matched is never set). body1, body2 and previous_step_s
- * are not read (no contact's softness depends on them). Errors, with contact unchanged: those of ssRowLawFromTuned and
+ * contact on to implicit Euler (it always does: exact_to_matched is never set). No contact's softness depends on its
+ * bodies or on the step before (contact.c). Errors, with contact unchanged: those of ssRowLawFromTuned and
  * ssContactSoften. */
-ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, dBodyID body1, dBodyID body2,
-                               double tuned_erp, double tuned_cfm, double tuned_step_s, ssMapping mapping,
-                               double step_s, double previous_step_s, ssRowFallback* handed_on);
+ssStatus ssContactSoftenCached(ssContactCache* cache, dContact* contact, double tuned_erp, double tuned_cfm,
+                               double tuned_step_s, ssMapping mapping, double step_s, ssRowFallback* handed_on);
 
 #endif

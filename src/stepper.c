@@ -410,8 +410,7 @@ static int contactFinite(const dContactGeom* geom) {
 static void countContact(ssStepper* stepper, ssRowFallback handed_on) {
   if (stepper->report == NULL) return;
   ssServedCounts* contacts = &stepper->report->contacts;
-  if (handed_on.to_implicit_euler) contacts->handed_to_implicit_euler += 1;
-  else if (handed_on.exact_to_matched) contacts->handed_to_matched += 1;
+  if (handed_on.to_implicit_euler) contacts->handed_to_implicit_euler += 1; /* a contact is never handed to matched */
   else contacts->by_mapping += 1;
 }
 
@@ -430,7 +429,7 @@ static int sameSurface(const ContactMemo* memo, const dSurfaceParameters* surfac
 #endif
 
 /* A contact not like the last one: softened by its law (contact.c), and remembered. */
-static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
+static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* contact) {
   REQUIRE_STEPPER(stepper);
   if (contact == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "contact = NULL: a contact is required");
   double tuned_step_s = ssRegistry_TunedStep(stepper->def.registry);
@@ -443,9 +442,8 @@ static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* co
   double erp = (surface->mode & dContactSoftERP) ? surface->soft_erp : world.erp;
   double cfm = (surface->mode & dContactSoftCFM) ? surface->soft_cfm : world.cfm;
   const ssStepInfo* step = &stepper->current;
-  ssStatus status = ssContactSoftenCached(&stepper->contact_cache, contact, body1, body2, erp, cfm, tuned_step_s,
-                                          step->mapping, step->softness_step_s, step->previous_step_s,
-                                          &given.handed_on);
+  ssStatus status = ssContactSoftenCached(&stepper->contact_cache, contact, erp, cfm, tuned_step_s, step->mapping,
+                                          step->softness_step_s, &given.handed_on);
   if (status != SS_OK) return status;
   given.mode_out = surface->mode;
   given.erp_out = surface->soft_erp;
@@ -456,9 +454,10 @@ static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* co
 }
 
 ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
+  (void)body1, (void)body2; /* no contact's softness depends on its bodies (contact.c) */
   if (stepper == NULL || contact == NULL || !sameSurface(&stepper->contact_memo, &contact->surface) ||
       !contactFinite(&contact->geom))
-    return softenNewContact(stepper, contact, body1, body2);
+    return softenNewContact(stepper, contact);
   const ContactMemo* memo = &stepper->contact_memo; /* the usual contact: as the last one */
   contact->surface.mode = memo->mode_out;
   contact->surface.soft_erp = memo->erp_out;
