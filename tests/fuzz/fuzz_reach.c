@@ -423,9 +423,11 @@ static void nearCallback(void* data, dGeomID g1, dGeomID g2) {
   Program* p = &program;
   dBodyID b1 = dGeomGetBody(g1), b2 = dGeomGetBody(g2);
   if (b1 != 0 && b2 != 0 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
-  dContact contact[2];
+  /* room for every point a box pair makes (8): with fewer, ODE's box-box collider culls them, and its cullPoints
+   * asserts on boxes that hinges with stops have pressed into one another ("*iret != i0"), plain ODE's doing */
+  dContact contact[8];
   memset(contact, 0, sizeof contact);
-  int count = dCollide(g1, g2, 2, &contact[0].geom, sizeof contact[0]);
+  int count = dCollide(g1, g2, 8, &contact[0].geom, sizeof contact[0]);
   for (int i = 0; i < count; ++i) {
     contact[i].surface.mode = dContactSoftCFM;
     contact[i].surface.mu = 0.5;
