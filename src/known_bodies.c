@@ -451,22 +451,27 @@ static int checkVisit(ssKnownBodies* known, int k, void* context) {
   return bodyWithin(&known->values[k], check->max_speed2, check->max_spin2, check->forces);
 }
 
-/* Marks the bodies ODE steps (awake[], reached[]) and queues them for the wake walk: enabled bodies, and those that
- * were awake at the last check (ODE stepped them before it disabled them). Returns how many were queued. */
-static int queueAwake(ssKnownBodies* known) {
-  known->checks += 1;
-  int queued = 0, asleep = 0;
+/* Marks the bodies ODE steps (awake[], and reached[] for this check): enabled bodies, and those that were awake at
+ * the last check (ODE stepped them before it disabled them). Returns how many are asleep: none, the usual case in a
+ * level at play, and the checks need no walk. */
+static int markAwake(ssKnownBodies* known) {
+  const unsigned check = ++known->checks;
+  int asleep = 0;
   for (int k = 0; k < known->count; ++k) {
-    int enabled = dBodyIsEnabled(known->ids[k]) != 0;
-    if (!(enabled | known->awake[k])) {
-      asleep = 1;
-      continue;
-    }
+    int enabled = dBodyIsEnabled(known->ids[k]) != 0, due = enabled | known->awake[k];
     known->awake[k] = (unsigned char)enabled;
-    known->reached[k] = known->checks;
-    known->queue[queued++] = k;
+    known->reached[k] = due ? check : known->reached[k];
+    asleep += !due;
   }
-  return asleep ? queued : -queued - 1; /* negative: nobody asleep, no walk needed */
+  return asleep;
+}
+
+/* The bodies marked this check, queued for the wake walk: how many. */
+static int queueMarked(ssKnownBodies* known) {
+  int queued = 0;
+  for (int k = 0; k < known->count; ++k)
+    if (known->reached[k] == known->checks) known->queue[queued++] = k;
+  return queued;
 }
 
 /* The place of body on the list, marked as met by this check (-1: not listed, or met already). */
@@ -482,19 +487,25 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
   CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed,
                       bounds->forces};
   const ssBodyValues* values = known->values;
-  int queued = queueAwake(known), walk = queued >= 0;
-  if (!walk) queued = -queued - 1;
-  /* the queued bodies first, with no branch a body (the usual case: all pass); the first failure is found after */
+  const int asleep = markAwake(known), count = known->count, until = prefetchUntil(count);
+  const unsigned check_number = known->checks;
+  /* the marked bodies first, with no branch a body (the usual case: all pass); the first failure is found after */
   int all = 1;
-  const int until = prefetchUntil(queued);
-  for (int q = 0; q < queued; ++q) {
-    if (q < until) prefetchState(&values[known->queue[q + kPrefetchAhead]]);
-    all &= bodyWithin(&values[known->queue[q]], check.max_speed2, check.max_spin2, check.forces);
+  if (asleep == 0) {
+    for (int k = 0; k < count; ++k) {
+      if (k < until) prefetchState(&values[k + kPrefetchAhead]);
+      all &= bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
+    }
+  } else { /* a sleeping body's values are not read */
+    for (int k = 0; k < count; ++k)
+      if (known->reached[k] == check_number)
+        all &= bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
   }
-  for (int q = 0; !all && q < queued; ++q)
-    if (!bodyWithin(&values[known->queue[q]], check.max_speed2, check.max_spin2, check.forces))
-      return nameFailure(known, known->queue[q], bounds, when, step, steps, failed);
-  int woken = walk ? wakeWalk(known, queued, checkVisit, &check) : -1;
+  for (int k = 0; !all && k < count; ++k)
+    if ((asleep == 0 || known->reached[k] == check_number) &&
+        !bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces))
+      return nameFailure(known, k, bounds, when, step, steps, failed);
+  int woken = asleep > 0 ? wakeWalk(known, queueMarked(known), checkVisit, &check) : -1;
   if (woken >= 0) return nameFailure(known, woken, bounds, when, step, steps, failed);
   for (int a = 0; a < also_count; ++a) {
     int k = meetAlso(known, also[a]);
@@ -556,21 +567,21 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
       return SS_OK;
     }
   }
-  int queued = queueAwake(known), walk = queued >= 0;
-  if (!walk) queued = -queued - 1;
-  const int ahead = prefetchUntil(queued);
-  for (int q = 0; q < queued; ++q) { /* one loop: startBody inlined once */
-    if (q < ahead) {
-      const ssBodyValues* next = &known->values[known->queue[q + kPrefetchAhead]];
+  const int asleep = markAwake(known);
+  const unsigned check_number = known->checks;
+  for (int k = 0; k < count; ++k) { /* one loop: startBody inlined once */
+    if (k < until) {
+      const ssBodyValues* next = &known->values[k + kPrefetchAhead];
       prefetchState(next);
       SS_PREFETCH(next->force);
       SS_PREFETCH(next->torque);
     }
-    if (startBody(known, known->queue[q], check.max_speed2, check.max_spin2)) continue;
-    *failed = known->ids[known->queue[q]];
+    if ((asleep > 0 && known->reached[k] != check_number) || startBody(known, k, check.max_speed2, check.max_spin2))
+      continue;
+    *failed = known->ids[k];
     return describe(*failed, bounds, "before the frame");
   }
-  int woken = walk ? wakeWalk(known, queued, startVisit, &check) : -1;
+  int woken = asleep > 0 ? wakeWalk(known, queueMarked(known), startVisit, &check) : -1;
   for (int a = 0; woken < 0 && a < also_count; ++a) {
     int k = meetAlso(known, also[a]);
     if (k >= 0 && !startVisit(known, k, &check)) woken = k;

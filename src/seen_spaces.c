@@ -11,7 +11,6 @@
 void ssSeenFree(ssSeenSpaces* seen) {
   free(seen->spaces);
   ssPointerMapFree(&seen->bodies);
-  ssPointerSetFree(&seen->met);
   *seen = (ssSeenSpaces){0};
 }
 
@@ -115,17 +114,13 @@ static int walkHead(ssSeenSpaces* seen, const ssSeenSpace* space, ssBodyList* fo
     }
     dBodyID body = dGeomGetBody(geom);
     if (body == 0) return marker; /* a static geom added or moved, or one whose body was taken from it */
-    int met = ssPointerSetAdd(&seen->met, body);
-    if (met < 0) return -1;
-    if (met == 0) {
-      if (marker) return 1;
-      continue;
+    if (ssPointerMapGet(&seen->bodies, body, 0) > 0) { /* listed: moved (a geom added to it shows in the count) */
+      if (!dBodyIsEnabled(body) && !pushBody(moved, body)) return -1;
+    } else { /* new: all its geoms there counted at its first (its next ones find it listed) */
+      int held = geomsHeld(seen, body);
+      *added += held;
+      if (ssPointerMapPut(&seen->bodies, body, held) < 0 || !pushBody(found, body)) return -1;
     }
-    int held = geomsHeld(seen, body), listed = ssPointerMapGet(&seen->bodies, body, 0);
-    *added += held - listed;
-    if (held != listed && ssPointerMapPut(&seen->bodies, body, held) < 0) return -1;
-    if (listed == 0 && !pushBody(found, body)) return -1;
-    if (listed > 0 && !dBodyIsEnabled(body) && !pushBody(moved, body)) return -1;
     if (marker) return 1;
   }
   return space->marker == 0; /* a marker not met was destroyed (or taken out of the space) */
@@ -138,9 +133,6 @@ int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved) {
   int looked = 1;
   for (int i = 0; looked == 1 && i < seen->count; ++i)
     looked = seen->spaces[i].sweep_and_prune ? 0 : walkHead(seen, &seen->spaces[i], found, moved, &added);
-  /* the met set is emptied, its memory kept for the next look */
-  for (size_t i = 0; i < seen->met.capacity; ++i) seen->met.slots[i] = NULL;
-  seen->met.count = 0;
   if (looked != 1) return looked;
   long now = geomsNow(seen);
   if (now != seen->geoms + added) return 0; /* a geom destroyed with ODE's own calls, or one added unseen */

@@ -37,7 +37,6 @@ typedef struct ssSeenSpaces {
   int listed;          /* 0: the next look lists in full */
   long geoms;          /* the geoms the spaces hold, as the listing and the looks since account for them */
   ssPointerMap bodies; /* each body with a geom in the spaces -> how many of its geoms are there */
-  ssPointerSet met;    /* a look's bodies, each counted once */
 } ssSeenSpaces;
 
 void ssSeenFree(ssSeenSpaces* seen);
