@@ -399,12 +399,13 @@ ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper) {
   return (ssStepInfo){SS_MAPPING_IMPLICIT_EULER, 0, 0, 0, 0, 0, 0};
 }
 
-/* Whether a contact's position, normal and depth are finite: a product with 0 is 0 for a finite number and NaN
- * otherwise, in one sum without a branch a value. */
-static int contactFinite(const dContactGeom* geom) {
-  double probe = 0.0 * geom->depth;
-  for (int i = 0; i < 3; ++i) probe += 0.0 * geom->pos[i] + 0.0 * geom->normal[i];
-  return probe == 0.0;
+/* Whether a contact's position, normal and depth are surely finite: their sum less itself is 0 only then (a NaN or
+ * an infinity makes it NaN). A sum that overflows says no for finite values, and the contact then takes the slow
+ * path, which checks each value (contact.c). */
+static int contactSurelyFinite(const dContactGeom* geom) {
+  double sum = (double)geom->depth + geom->pos[0] + geom->pos[1] + geom->pos[2] + geom->normal[0] + geom->normal[1] +
+               geom->normal[2];
+  return sum - sum == 0.0;
 }
 
 static void countContact(ssStepper* stepper, ssRowFallback handed_on) {
@@ -456,7 +457,7 @@ static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* co
 ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
   (void)body1, (void)body2; /* no contact's softness depends on its bodies (contact.c) */
   if (stepper == NULL || contact == NULL || !sameSurface(&stepper->contact_memo, &contact->surface) ||
-      !contactFinite(&contact->geom))
+      !contactSurelyFinite(&contact->geom))
     return softenNewContact(stepper, contact);
   const ContactMemo* memo = &stepper->contact_memo; /* the usual contact: as the last one */
   contact->surface.mode = memo->mode_out;
