@@ -119,7 +119,10 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
   for (int i = 0; i < ssRegistryBodyBindingCount(registry) && status == SS_OK; ++i) {
     const ssBodyBinding* binding = ssRegistryBodyAt(registry, i);
     int adopted = binding->tuned.damping_step_s > 0 || binding->tuned.auto_disable_step_s > 0;
-    if (!adopted || isnan(binding->written_step_s) || bodyAsWritten(registry, binding)) continue;
+    /* a sleeping body's values are read when it wakes: ODE neither damps it nor counts its idle steps, and Apply
+     * writes it no more than this reads it (ssRegistryWriteBodies) */
+    int asleep = binding->body != 0 && !dBodyIsEnabled(binding->body);
+    if (!adopted || asleep || isnan(binding->written_step_s) || bodyAsWritten(registry, binding)) continue;
     ssBodyBinding* larger_bodies = realloc(bodies, (size_t)(body_count + 1) * sizeof *bodies);
     int* larger_at = realloc(body_at, (size_t)(body_count + 1) * sizeof *body_at);
     if (larger_bodies != NULL) bodies = larger_bodies;

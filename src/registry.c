@@ -372,7 +372,9 @@ static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
 void ssRegistryWriteBodies(ssRegistry* registry, double step_s) {
   for (int i = 0; i < registry->body_count; ++i) {
     ssBodyBinding* binding = &registry->bodies[i];
-    if (binding->written_step_s != step_s) writeBody(binding, registry->world, step_s);
+    /* a sleeping body is written when it wakes, as the program's writes to it are followed then (follow.c) */
+    if (binding->written_step_s != step_s && (binding->body == 0 || dBodyIsEnabled(binding->body)))
+      writeBody(binding, registry->world, step_s);
   }
 }
 
