@@ -237,6 +237,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   dInitODE2(0);
+  benchPrintMachine("bench_stepper", "before");
   frames = (frames + kBlock - 1) / kBlock * kBlock;
   printf("bench_stepper: %d bodies in %d chains, %d soft parameter sets, %d frames a repeat, QuickStep 20 iterations, "
          "%s\ntargets: implicit Euler <= 1.02, matched and exact <= 1.05\n",
@@ -266,5 +267,6 @@ int main(int argc, char** argv) {
     ssRegistry_Destroy(scene.registry);
     dWorldDestroy(scene.world);
   }
+  benchPrintMachine("bench_stepper", "after");
   return 0;
 }
