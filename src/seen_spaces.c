@@ -50,7 +50,7 @@ static ssStatus listInto(ssSeenSpaces* seen, dSpaceID root, ssPointerMap* bodies
   seen->count = 0;
   if (!ssReserveOne((void**)&seen->spaces, 0, &seen->capacity, sizeof *seen->spaces))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
-  seen->spaces[seen->count++] = (ssSeenSpace){root, 0, 0, 0, 0};
+  seen->spaces[seen->count++] = (ssSeenSpace){root, 0, 0, 0, 0, 1};
   for (int walked = 0; walked < seen->count; ++walked) {
     dSpaceID space = seen->spaces[walked].space;
     ssStatus status = ssCheckSpaceListable(walked == 0 ? "def.space" : "nested space", space);
@@ -62,7 +62,7 @@ static ssStatus listInto(ssSeenSpaces* seen, dSpaceID root, ssPointerMap* bodies
         if (spaceListed(seen, (dSpaceID)geom)) continue;
         if (!ssReserveOne((void**)&seen->spaces, seen->count, &seen->capacity, sizeof *seen->spaces))
           return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
-        seen->spaces[seen->count++] = (ssSeenSpace){(dSpaceID)geom, 0, 0, 0, 0};
+        seen->spaces[seen->count++] = (ssSeenSpace){(dSpaceID)geom, 0, 0, 0, 0, 1};
         continue;
       }
       dBodyID body = dGeomGetBody(geom);
@@ -98,8 +98,9 @@ ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone) {
 /* The head of one space: up to its marker (the whole list when there is none). Returns 1, or 0 when the space must be
  * listed (a new nested space, a static geom moved or added, the marker moved), -1 when out of memory. *added counts
  * the geoms of the bodies met that the listing does not account for. */
-static int walkHead(ssSeenSpaces* seen, const ssSeenSpace* space, ssBodyList* found, ssBodyList* moved,
-                    long* added) {
+static int walkHead(ssSeenSpaces* seen, ssSeenSpace* space, ssBodyList* found, ssBodyList* moved, long* added) {
+  enum { kSleepingWorthAMark = 16 }; /* sleeping geoms met before the marker that make the next mark look again */
+  int sleeping = 0;
   for (int i = 0, geoms = dSpaceGetNumGeoms(space->space); i < geoms; ++i) {
     dGeomID geom = dSpaceGetGeom(space->space, i);
     /* what lies behind the marker was there at the mark, unless it moved: then another follows it. The marker's own
@@ -115,7 +116,9 @@ static int walkHead(ssSeenSpaces* seen, const ssSeenSpace* space, ssBodyList* fo
     dBodyID body = dGeomGetBody(geom);
     if (body == 0) return marker; /* a static geom added or moved, or one whose body was taken from it */
     if (ssPointerMapGet(&seen->bodies, body, 0) > 0) { /* listed: moved (a geom added to it shows in the count) */
-      if (!dBodyIsEnabled(body) && !pushBody(moved, body)) return -1;
+      int asleep = !dBodyIsEnabled(body);
+      if (asleep && !marker && ++sleeping == kSleepingWorthAMark) space->rescan = 1;
+      if (asleep && !pushBody(moved, body)) return -1;
     } else { /* new: all its geoms there counted at its first (its next ones find it listed) */
       int held = geomsHeld(seen, body);
       *added += held;
@@ -143,6 +146,10 @@ int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved) {
 void ssSeenMark(ssSeenSpaces* seen) {
   for (int s = 0; s < seen->count; ++s) {
     ssSeenSpace* space = &seen->spaces[s];
+    /* a static marker stays put (its pointer is only compared: the program may have destroyed it); a body's may be
+     * woken, or destroyed, so it is looked for again */
+    if (space->marker != 0 && space->marker_body == 0 && !space->rescan) continue;
+    space->rescan = 0;
     space->marker = space->after_marker = 0;
     space->marker_body = 0;
     for (int i = 0, geoms = dSpaceGetNumGeoms(space->space); i < geoms; ++i) {

@@ -28,6 +28,7 @@ typedef struct ssSeenSpace {
   dGeomID marker;       /* the first geom ODE's step does not move, when last marked; 0: none (the whole list is head) */
   dGeomID after_marker; /* the geom behind it then: the marker moved since when another follows it */
   dBodyID marker_body;  /* the marker's body then (0: static) */
+  int rescan;           /* the next mark looks for a marker nearer the head: sleeping geoms gathered before this one */
   int sweep_and_prune;
 } ssSeenSpace;
 
@@ -53,7 +54,9 @@ ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone);
  * to the listing), 0 when the spaces must be listed in full (ssSeenList), -1 when out of memory. */
 int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved);
 
-/* After a step: each space's marker set to its first geom the next step cannot move. */
+/* After a step: each space's marker set to the first geom from the head that the next step cannot move. A static
+ * marker is kept (nothing behind it is new), unless the last look met sleeping geoms before it: then one nearer the
+ * head is looked for, so that a look walks about as far as the bodies ODE steps. */
 void ssSeenMark(ssSeenSpaces* seen);
 
 /* body, about to be destroyed through the stepper: its geoms there leave the count (destroyed before or after). */
