@@ -68,10 +68,6 @@ static int placeOf(const ssKnownBodies* known, dBodyID body) {
   return known->valid ? ssPointerMapGet(&known->index, body, -1) : -1;
 }
 
-static const ssKnownBody* findOld(const ssKnownBodies* known, dBodyID body) {
-  int k = placeOf(known, body);
-  return k >= 0 ? &known->bodies[k] : NULL;
-}
 
 static void listPushed(ssKnownBodies* known) {
   known->pushed_count = 0;
@@ -203,8 +199,6 @@ ssStatus ssKnownAdd(ssKnownBodies* known, dBodyID body) {
   return added ? SS_OK : ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the known bodies");
 }
 
-int ssKnownContains(const ssKnownBodies* known, dBodyID body) { return findOld(known, body) != NULL; }
-
 void ssKnownCheckAllOnce(ssKnownBodies* known) {
   if (known->count > 0) memset(known->awake, 1, (size_t)known->count);
 }
@@ -283,8 +277,8 @@ int ssKnownJointsChangedOf(const ssKnownBodies* known, dBodyID body) {
 }
 
 void ssKnownTakeJointsOf(ssKnownBodies* known, dBodyID body) {
-  const ssKnownBody* found = findOld(known, body);
-  if (found != NULL) known->joints[found - known->bodies] = jointSignature(body);
+  int k = placeOf(known, body);
+  if (k >= 0) known->joints[k] = jointSignature(body);
 }
 
 int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body) {

@@ -80,9 +80,6 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
  * the cost of what is added. Errors: SS_ERROR_OUT_OF_MEMORY, with the bodies added before it listed. */
 ssStatus ssKnownAdd(ssKnownBodies* known, dBodyID body);
 
-/* Whether body is on the list. */
-int ssKnownContains(const ssKnownBodies* known, dBodyID body);
-
 /* Has every listed body checked at the next check, asleep or not (the spaces were listed in full: a sleeping body
  * the program moved is not told from the others). */
 void ssKnownCheckAllOnce(ssKnownBodies* known);

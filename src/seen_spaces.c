@@ -171,5 +171,3 @@ void ssSeenForget(ssSeenSpaces* seen, dBodyID body) {
   seen->geoms -= held;
   ssPointerMapRemove(&seen->bodies, body);
 }
-
-int ssSeenHolds(const ssSeenSpaces* seen, dBodyID body) { return ssPointerMapGet(&seen->bodies, body, 0) > 0; }

@@ -62,7 +62,4 @@ void ssSeenMark(ssSeenSpaces* seen);
 /* body, about to be destroyed through the stepper: its geoms there leave the count (destroyed before or after). */
 void ssSeenForget(ssSeenSpaces* seen, dBodyID body);
 
-/* Whether body holds a geom in the spaces, as last seen. */
-int ssSeenHolds(const ssSeenSpaces* seen, dBodyID body);
-
 #endif
