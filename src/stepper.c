@@ -255,8 +255,11 @@ static int watched(const ssStepper* stepper, dBodyID body) {
  * known list, the watch list, the registry and the pose history, by its address alone. */
 static void forgetBody(ssStepper* stepper, dBodyID body) {
   int was_watched = 0;
-  for (int i = 0; i < stepper->watched_count; ++i)
-    if (stepper->watched[i] == body) stepper->watched[i--] = stepper->watched[--stepper->watched_count], was_watched = 1;
+  for (int i = 0; i < stepper->watched_count; ++i) {
+    if (stepper->watched[i] != body) continue;
+    stepper->watched[i--] = stepper->watched[--stepper->watched_count];
+    was_watched = 1;
+  }
   ssRegistry* registry = stepper->def.registry;
   int in_step = knownInStep(stepper);
   if (registry != NULL && ssRegistryHasBody(registry, body)) ssRegistry_UnbindBody(registry, body);
