@@ -3,9 +3,10 @@
  * Known: the registry's bodies (bound, adopted), the watched ones, and every body reachable from those through
  * joints other than contacts (a bob hung by a hinge from a known body is known whether or not it was bound), each
  * once, found through an index by address. Bodies come and go one at a time (ssKnownAdd, ssKnownForget) at the cost
- * of the change; the list is built whole (ssKnownRebuild) only when the watch list changes or joints do. Their forces are kept over a frame and their state and forces are checked before every
- * physics step. ODE attaches a new joint at the head of a body's list, so a body's first joint, kept here, changes
- * when a joint is attached to it: that is how joints made since the list was built are found, for one read a body. */
+ * of the change; the list is built whole (ssKnownRebuild) only when the watch list changes or joints do. Their
+ * forces are kept over a frame and their state and forces are checked before every physics step. ODE attaches a new
+ * joint at the head of a body's list, so a body's first joint, kept here, changes when a joint is attached to it:
+ * that is how joints made since the list was built are found, for one read a body. */
 #ifndef STEADYSTEP_KNOWN_BODIES_H
 #define STEADYSTEP_KNOWN_BODIES_H
 
@@ -122,9 +123,9 @@ typedef struct ssBodyBounds {
  * body joined (contacts too) to one of those, which ODE wakes in its step; and the bodies of also[also_count] (a
  * sleeping body the program moved, which collision reads). A body asleep and alone is not read: ODE neither steps
  * it nor lets its joints act. Checked: its position within SS_MAX_POSITION_M, velocities finite and within the
- * bounds, a geared body's turn within a step (bounds->gear_step_s), and with bounds->forces its accumulators. On the first failure records the message (the
- * body, the quantity, its value, "`when` step `step` of `steps`", formatted then only), sets *failed to the body and
- * returns SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a
+ * bounds, a geared body's turn within a step (bounds->gear_step_s), and with bounds->forces its accumulators. On the
+ * first failure records the message (the body, the quantity, its value, "`when` step `step` of `steps`", formatted
+ * then only), sets *failed to the body and returns SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a
  * force or torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). */
 ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       const dBodyID* also, int also_count, dBodyID* failed);

@@ -25,7 +25,7 @@ typedef struct ssBodyList {
 
 typedef struct ssSeenSpace {
   dSpaceID space;
-  dGeomID marker;       /* the first geom ODE's step does not move, when last marked; 0: none (the whole list is head) */
+  dGeomID marker;       /* a geom ODE's step does not move, when last marked; 0: none (the whole list is head) */
   dGeomID after_marker; /* the geom behind it then: the marker moved since when another follows it */
   dBodyID marker_body;  /* the marker's body then (0: static) */
   int rescan;           /* the next mark looks for a marker nearer the head: sleeping geoms gathered before this one */
@@ -50,8 +50,8 @@ void ssBodyListFree(ssBodyList* list);
 ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone);
 
 /* Walks the spaces' heads: *found gets the bodies with a geom there that the listing had not (appended), *moved the
- * sleeping bodies the program moved (replaced). Returns 1 when the counts tell that nothing else changed (the new bodies then belong
- * to the listing), 0 when the spaces must be listed in full (ssSeenList), -1 when out of memory. */
+ * sleeping bodies the program moved (replaced). Returns 1 when the counts tell that nothing else changed (the new
+ * bodies then belong to the listing), 0 when the spaces must be listed in full (ssSeenList), -1 when out of memory. */
 int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved);
 
 /* After a step: each space's marker set to the first geom from the head that the next step cannot move. A static
