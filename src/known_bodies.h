@@ -125,8 +125,9 @@ typedef struct ssBodyBounds {
  * it nor lets its joints act. Checked: its position within SS_MAX_POSITION_M, velocities finite and within the
  * bounds, a geared body's turn within a step (bounds->gear_step_s), and with bounds->forces its accumulators. On the
  * first failure records the message (the body, the quantity, its value, "`when` step `step` of `steps`", formatted
- * then only), sets *failed to the body and returns SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a
- * force or torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). */
+ * then only), sets *failed to the body and returns SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT,
+ * SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a force or torque) or SS_ERROR_OUT_OF_RANGE (one beyond
+ * SS_MAX_FORCE_N). */
 ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       const dBodyID* also, int also_count, dBodyID* failed);
 
