@@ -276,6 +276,8 @@ static void teleport(Program* p, int i, double x) {
   dBodySetPosition(p->bodies[i].body, x, at[1], at[2]); /* exactly as asked */
 }
 
+static void removeOrphans(Program* p);
+
 /* The program repairs its bodies (where they were made, at rest: its saved state) and its numbers (springs), as
  * after a failure it restores a saved state. */
 static void repair(Program* p) {
@@ -295,6 +297,7 @@ static void repair(Program* p) {
   for (int s = 1; s < p->space_count;) /* quadtrees out of the adopted spaces */
     if (p->kind[s] == KIND_QUADTREE) destroyNestedSpace(p, s);
     else ++s;
+  removeOrphans(p); /* bobs that hung from a box of a quadtree */
 }
 
 /* A bob left hanging from nothing a space holds is unknowable (stepper.h: what nothing reaches, it cannot see), so
