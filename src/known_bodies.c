@@ -144,7 +144,7 @@ static int append(ssKnownBodies* known, dBodyID body) {
   return 1;
 }
 
-/* Adds the bodies of walk.list from `from` on that are not listed, and what they reach through joints. */
+/* Adds the bodies of walk->list that are not listed, and what they reach through joints (appended to the walk). */
 static int addReached(ssKnownBodies* known, BodyWalk* walk) {
   for (int i = 0; i < walk->count && !walk->failed; ++i) {
     dBodyID body = walk->list[i];
@@ -399,12 +399,17 @@ static void prefetchState(const ssBodyValues* v) {
   SS_PREFETCH(v->angular_vel);
 }
 
-/* The first body of known that fails the check, named, or SS_OK. */
+/* "`when` step `step` of `steps`", the moment a failure is named at. */
+static void namedStep(char named[64], const char* when, int step, int steps) {
+  snprintf(named, 64, "%s step %d of %d", when, step, steps);
+}
+
+/* Body k's failure of the check, named: *failed set to it, its status returned. */
 static ssStatus nameFailure(const ssKnownBodies* known, int k, const ssBodyBounds* bounds, const char* when, int step,
                             int steps, dBodyID* failed) {
   char named[64];
   *failed = known->ids[k];
-  snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
+  namedStep(named, when, step, steps);
   return describe(known->ids[k], bounds, named);
 }
 
@@ -511,7 +516,7 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
     if (turn <= SS_MAX_GEAR_TURN_RAD) continue;
     char named[64];
     *failed = body;
-    snprintf(named, sizeof named, "%s step %d of %d", when, step, steps);
+    namedStep(named, when, step, steps);
     return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: turns its transmission gear %g rad in a step of %g s %s (spin, and "
                   "speed over the gear's radius): above SS_MAX_GEAR_TURN_RAD = %g rad (ODE 0.16 aborts from pi)",
                   (void*)body, turn, bounds->gear_step_s, named, SS_MAX_GEAR_TURN_RAD);

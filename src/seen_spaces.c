@@ -19,7 +19,7 @@ void ssBodyListFree(ssBodyList* list) {
   *list = (ssBodyList){NULL, 0, 0};
 }
 
-static int pushBody(ssBodyList* list, dBodyID body) {
+int ssBodyListPush(ssBodyList* list, dBodyID body) {
   if (!ssReserveOne((void**)&list->list, list->count, &list->capacity, sizeof body)) return 0;
   list->list[list->count++] = body;
   return 1;
@@ -78,7 +78,7 @@ ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone) {
   ssStatus status = listInto(seen, root, &bodies);
   for (size_t i = 0; status == SS_OK && i < seen->bodies.capacity; ++i) {
     dBodyID body = (dBodyID)seen->bodies.keys[i];
-    if (body != 0 && ssPointerMapGet(&bodies, body, 0) == 0 && !pushBody(gone, body))
+    if (body != 0 && ssPointerMapGet(&bodies, body, 0) == 0 && !ssBodyListPush(gone, body))
       status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces' bodies");
   }
   if (status != SS_OK) { /* nothing remembered: the next look lists again */
@@ -118,11 +118,11 @@ static int walkHead(ssSeenSpaces* seen, ssSeenSpace* space, ssBodyList* found, s
     if (ssPointerMapGet(&seen->bodies, body, 0) > 0) { /* listed: moved (a geom added to it shows in the count) */
       int asleep = !dBodyIsEnabled(body);
       if (asleep && !marker && ++sleeping == kSleepingWorthAMark) space->rescan = 1;
-      if (asleep && !pushBody(moved, body)) return -1;
+      if (asleep && !ssBodyListPush(moved, body)) return -1;
     } else { /* new: all its geoms there counted at its first (its next ones find it listed) */
       int held = geomsHeld(seen, body);
       *added += held;
-      if (ssPointerMapPut(&seen->bodies, body, held) < 0 || !pushBody(found, body)) return -1;
+      if (ssPointerMapPut(&seen->bodies, body, held) < 0 || !ssBodyListPush(found, body)) return -1;
     }
     if (marker) return 1;
   }

@@ -43,6 +43,9 @@ typedef struct ssSeenSpaces {
 void ssSeenFree(ssSeenSpaces* seen);
 void ssBodyListFree(ssBodyList* list);
 
+/* Appends body to list: 1, or 0 when out of memory (the list as it was). */
+int ssBodyListPush(ssBodyList* list, dBodyID body);
+
 /* Lists root and every space nested in it, and the bodies their geoms hold: *gone gets the bodies of the last
  * listing that hold no geom there now (destroyed with their geoms, or moved out), and the listing replaces the last.
  * Reads the spaces and their geoms only. Errors, remembering nothing (the next look lists again):

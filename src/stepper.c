@@ -550,10 +550,8 @@ static ssStatus listSpaces(ssStepper* stepper) {
   for (size_t i = 0; status == SS_OK && i < held->capacity; ++i) {
     dBodyID body = (dBodyID)held->keys[i];
     if (body == 0 || ssRegistryHasBody(stepper->def.registry, body)) continue;
-    if (!ssReserveOne((void**)&stepper->found.list, stepper->found.count, &stepper->found.capacity, sizeof body))
+    if (!ssBodyListPush(&stepper->found, body))
       status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces' bodies");
-    else
-      stepper->found.list[stepper->found.count++] = body;
   }
   return status;
 }
