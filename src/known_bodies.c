@@ -20,6 +20,7 @@ void ssKnownFree(ssKnownBodies* known) {
   free(known->values);
   free(known->joints);
   free(known->awake);
+  free(known->moves_unseen);
   free(known->reached);
   free(known->queue);
   free(known->pushed);
@@ -104,7 +105,7 @@ static int reserve(ssKnownBodies* known, int capacity) {
   int room = known->capacity > 0 ? 2 * known->capacity : 16;
   while (room < capacity) room *= 2;
   size_t n = (size_t)room;
-  void* grown[] = {realloc(known->bodies, n * sizeof *known->bodies), NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+  void* grown[] = {realloc(known->bodies, n * sizeof *known->bodies), NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
   if (grown[0] != NULL) known->bodies = grown[0];
   if ((grown[1] = realloc(known->ids, n * sizeof *known->ids)) != NULL) known->ids = grown[1];
   if ((grown[2] = realloc(known->values, n * sizeof *known->values)) != NULL) known->values = grown[2];
@@ -113,10 +114,19 @@ static int reserve(ssKnownBodies* known, int capacity) {
   if ((grown[5] = realloc(known->reached, n * sizeof *known->reached)) != NULL) known->reached = grown[5];
   if ((grown[6] = realloc(known->queue, n * sizeof *known->queue)) != NULL) known->queue = grown[6];
   if ((grown[7] = realloc(known->pushed, n * sizeof *known->pushed)) != NULL) known->pushed = grown[7];
-  for (int i = 0; i < 8; ++i)
+  if ((grown[8] = realloc(known->moves_unseen, n)) != NULL) known->moves_unseen = grown[8];
+  for (int i = 0; i < 9; ++i)
     if (grown[i] == NULL) return 0;
   known->capacity = room;
   return 1;
+}
+
+/* Whether one of body's geoms is in space or in a space nested in it (0: none). */
+static int hasGeomIn(dBodyID body, dSpaceID space) {
+  for (dGeomID geom = dBodyGetFirstGeom(body); geom != 0 && space != 0; geom = dBodyGetNextGeom(geom))
+    for (dSpaceID in = dGeomGetSpace(geom); in != 0; in = dGeomGetSpace((dGeomID)in))
+      if (in == space) return 1;
+  return 0;
 }
 
 /* Appends body (not listed): 1, or 0 when out of memory. */
@@ -139,6 +149,7 @@ static int append(ssKnownBodies* known, dBodyID body) {
                                     dBodyGetForce(body),    dBodyGetTorque(body),    positionBound(body)};
   known->joints[k] = jointSignature(body);
   known->awake[k] = 1; /* checked at the next check, whatever ODE does with it */
+  known->moves_unseen[k] = !hasGeomIn(body, known->seen_space);
   known->reached[k] = 0;
   known->count += 1;
   return 1;
@@ -167,6 +178,7 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
   /* the new list, bodies that stay keeping their forces and the joints they were listed with (a joint attached
    * since is still seen as new) */
   ssKnownBodies rebuilt = {.valid = 1,
+                           .seen_space = known->seen_space,
                            .carrying = known->carrying,
                            .registry_generation = known->registry_generation,
                            .watched_generation = known->watched_generation};
@@ -219,6 +231,7 @@ void ssKnownForget(ssKnownBodies* known, dBodyID body) {
     known->values[k] = known->values[last];
     known->joints[k] = known->joints[last];
     known->awake[k] = known->awake[last];
+    known->moves_unseen[k] = known->moves_unseen[last];
     known->reached[k] = known->reached[last];
     ssPointerMapPut(&known->index, known->ids[k], k); /* replaces a value: allocates nothing */
   }
@@ -452,17 +465,31 @@ static int checkVisit(ssKnownBodies* known, int k, void* context) {
 
 /* Marks the bodies ODE steps (awake[], and reached[] for this check): enabled bodies, and those that were awake at
  * the last check (ODE stepped them before it disabled them). Returns how many are asleep: none, the usual case in a
- * level at play, and the checks need no walk. */
-static int markAwake(ssKnownBodies* known) {
+ * level at play, and the checks need no walk; *unseen counts those the program could move unseen (moves_unseen). */
+static int markAwake(ssKnownBodies* known, int* unseen) {
   const unsigned check = ++known->checks;
-  int asleep = 0;
+  int asleep = 0, asleep_unseen = 0;
   for (int k = 0; k < known->count; ++k) {
     int enabled = dBodyIsEnabled(known->ids[k]) != 0, due = enabled | known->awake[k];
     known->awake[k] = (unsigned char)enabled;
     known->reached[k] = due ? check : known->reached[k];
     asleep += !due;
+    asleep_unseen += (!due) & known->moves_unseen[k];
   }
+  *unseen = asleep_unseen;
   return asleep;
+}
+
+/* After the walk: the first sleeping body the program could move unseen whose state (and with check->forces its
+ * accumulators) fails the check, or -1. Each is marked as met by this check. */
+static int checkUnseen(ssKnownBodies* known, int unseen, const CheckVisit* check) {
+  for (int k = 0; unseen > 0 && k < known->count; ++k) {
+    if (known->reached[k] == known->checks || !known->moves_unseen[k]) continue;
+    known->reached[k] = known->checks;
+    if (!bodyWithin(&known->values[k], check->max_speed2, check->max_spin2, check->forces)) return k;
+    unseen -= 1;
+  }
+  return -1;
 }
 
 /* The bodies marked this check, queued for the wake walk: how many. */
@@ -486,7 +513,8 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
   CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed,
                       bounds->forces};
   const ssBodyValues* values = known->values;
-  const int asleep = markAwake(known), count = known->count, until = prefetchUntil(count);
+  int unseen;
+  const int asleep = markAwake(known, &unseen), count = known->count, until = prefetchUntil(count);
   const unsigned check_number = known->checks;
   /* the marked bodies first, with no branch a body (the usual case: all pass); the first failure is found after */
   int all = 1;
@@ -505,6 +533,7 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
         !bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces))
       return nameFailure(known, k, bounds, when, step, steps, failed);
   int woken = asleep > 0 ? wakeWalk(known, queueMarked(known), checkVisit, &check) : -1;
+  if (woken < 0) woken = checkUnseen(known, unseen, &check);
   if (woken >= 0) return nameFailure(known, woken, bounds, when, step, steps, failed);
   for (int a = 0; a < also_count; ++a) {
     int k = meetAlso(known, also[a]);
@@ -566,7 +595,8 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
       return SS_OK;
     }
   }
-  const int asleep = markAwake(known);
+  int unseen;
+  const int asleep = markAwake(known, &unseen);
   const unsigned check_number = known->checks;
   for (int k = 0; k < count; ++k) { /* one loop: startBody inlined once */
     if (k < until) {
@@ -581,6 +611,7 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
     return describe(*failed, bounds, "before the frame");
   }
   int woken = asleep > 0 ? wakeWalk(known, queueMarked(known), startVisit, &check) : -1;
+  if (woken < 0) woken = checkUnseen(known, unseen, &check); /* checked only: a sleeping body's force waits */
   for (int a = 0; woken < 0 && a < also_count; ++a) {
     int k = meetAlso(known, also[a]);
     if (k >= 0 && !startVisit(known, k, &check)) woken = k;

@@ -56,10 +56,14 @@ typedef struct ssKnownBodies {
   /* whether ODE stepped the body at the last check or would step it next (enabled, or woken through its joints):
    * a body ODE has disabled since is checked once more, then no more until it wakes */
   unsigned char* awake;
+  /* whether the program could move the body while it sleeps without the stepper's looks seeing it (no geom of it in
+   * seen_space, where ODE puts a moved geom at the head): such a body is checked asleep too */
+  unsigned char* moves_unseen;
   unsigned* reached;  /* the check that last met the body through joints (ssKnownCheck's walk) */
   int* queue;         /* that walk's bodies still to visit */
   unsigned checks;    /* checks made, numbering them for reached */
   ssPointerMap index; /* body -> its place in the arrays above */
+  dSpaceID seen_space; /* the space whose heads the stepper looks at (its def.space, with those nested), or 0 */
   int count, capacity;
   int* pushed; /* indices into bodies of those with pushed set, and only those */
   int pushed_count;
@@ -120,14 +124,14 @@ typedef struct ssBodyBounds {
 
 /* Checks the listed bodies ODE steps: in one pass over the packed values (a second names the first failure) every
  * enabled body, every body disabled since the last check (ODE stepped it before it fell asleep), then every disabled
- * body joined (contacts too) to one of those, which ODE wakes in its step; and the bodies of also[also_count] (a
- * sleeping body the program moved, which collision reads). A body asleep and alone is not read: ODE neither steps
- * it nor lets its joints act. Checked: its position within SS_MAX_POSITION_M, velocities finite and within the
- * bounds, a geared body's turn within a step (bounds->gear_step_s), and with bounds->forces its accumulators. On the
- * first failure records the message (the body, the quantity, its value, "`when` step `step` of `steps`", formatted
- * then only), sets *failed to the body and returns SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT,
- * SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a force or torque) or SS_ERROR_OUT_OF_RANGE (one beyond
- * SS_MAX_FORCE_N). */
+ * body joined (contacts too) to one of those, which ODE wakes in its step; the bodies of also[also_count] (a sleeping
+ * body the program moved, which collision reads); and every sleeping body the program could move unseen (moves_unseen).
+ * Any other body asleep and alone is not read: ODE neither steps it nor lets its joints act. Checked: its position
+ * within SS_MAX_POSITION_M, velocities finite and within the bounds, a geared body's turn within a step
+ * (bounds->gear_step_s), and with bounds->forces its accumulators. On the first failure records the message (the body,
+ * the quantity, its value, "`when` step `step` of `steps`", formatted then only), sets *failed to the body and returns
+ * SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a force or
+ * torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). */
 ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       const dBodyID* also, int also_count, dBodyID* failed);
 

@@ -181,6 +181,7 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
     stepper->def.registry = registry;
     stepper->seen.listed = 0; /* listed in full again at the first frame: a body adoption did not reach is adopted */
   }
+  stepper->known.seen_space = def->space; /* a sleeping body moved there is seen by the looks */
   resolveSpeeds(&stepper->def.stepping);
   stepper->row_order_seed = rowOrderSeed(stepping.step_seed);
   stepper->contact_cache = ssContactCacheEmpty();
