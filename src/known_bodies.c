@@ -260,10 +260,9 @@ enum { kPrefetchAhead = 8, kPrefetchFrom = 256 };
  * cache. */
 static int prefetchUntil(int count) { return count >= kPrefetchFrom ? count - kPrefetchAhead : 0; }
 
-/* The body and the head of its first joint (where ODE keeps its joint list): what dBodyGetJoint reads. */
+/* The head of a body's first joint (where ODE keeps its joint list): what dBodyGetJoint reads beyond the body. */
 static void prefetchJoints(const ssKnownBodies* known, int k) {
   const char* joint = (const char*)known->joints[k].first;
-  SS_PREFETCH(known->ids[k]);
   if (joint != NULL) SS_PREFETCH(joint), SS_PREFETCH(joint + 64);
 }
 
@@ -463,21 +462,28 @@ static int checkVisit(ssKnownBodies* known, int k, void* context) {
   return bodyWithin(&known->values[k], check->max_speed2, check->max_spin2, check->forces);
 }
 
-/* Marks the bodies ODE steps (awake[], and reached[] for this check): enabled bodies, and those that were awake at
- * the last check (ODE stepped them before it disabled them). Returns how many are asleep: none, the usual case in a
- * level at play, and the checks need no walk; *unseen counts those the program could move unseen (moves_unseen). */
-static int markAwake(ssKnownBodies* known, int* unseen) {
-  const unsigned check = ++known->checks;
-  int asleep = 0, asleep_unseen = 0;
-  for (int k = 0; k < known->count; ++k) {
-    int enabled = dBodyIsEnabled(known->ids[k]) != 0, due = enabled | known->awake[k];
-    known->awake[k] = (unsigned char)enabled;
-    known->reached[k] = due ? check : known->reached[k];
-    asleep += !due;
-    asleep_unseen += (!due) & known->moves_unseen[k];
+/* A check's mark of body k, in the pass that reads it: whether ODE steps it (enabled, or awake at the last check:
+ * ODE stepped it before it disabled it), then reached[] is this check's number; a sleeping body is counted in
+ * *asleep, and in *unseen when the program could move it unseen (moves_unseen). awake[] becomes whether it is
+ * enabled. */
+static inline int markBody(ssKnownBodies* known, int k, int* asleep, int* unseen) {
+  int enabled = dBodyIsEnabled(known->ids[k]) != 0, due = enabled | known->awake[k];
+  known->awake[k] = (unsigned char)enabled;
+  if (due) {
+    known->reached[k] = known->checks;
+  } else {
+    *asleep += 1;
+    *unseen += known->moves_unseen[k];
   }
-  *unseen = asleep_unseen;
-  return asleep;
+  return due;
+}
+
+/* A large world's next body asked for: the flags and joints at its head, and the values a pass reads. */
+static void prefetchBody(const ssKnownBodies* known, int k, int forces) {
+  const ssBodyValues* v = &known->values[k];
+  SS_PREFETCH(known->ids[k]);
+  prefetchState(v);
+  if (forces) SS_PREFETCH(v->force), SS_PREFETCH(v->torque);
 }
 
 /* After the walk: the first sleeping body the program could move unseen whose state (and with check->forces its
@@ -513,24 +519,18 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
   CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed,
                       bounds->forces};
   const ssBodyValues* values = known->values;
-  int unseen;
-  const int asleep = markAwake(known, &unseen), count = known->count, until = prefetchUntil(count);
-  const unsigned check_number = known->checks;
-  /* the marked bodies first, with no branch a body (the usual case: all pass); the first failure is found after */
-  int all = 1;
-  if (asleep == 0) {
-    for (int k = 0; k < count; ++k) {
-      if (k < until) prefetchState(&values[k + kPrefetchAhead]);
+  const int count = known->count, until = prefetchUntil(count);
+  const unsigned check_number = ++known->checks;
+  /* one pass reads each body once, marks it and checks what ODE steps (the usual case: all pass; the first failure
+   * is found after); a sleeping body's values are not read */
+  int all = 1, asleep = 0, unseen = 0;
+  for (int k = 0; k < count; ++k) {
+    if (k < until) prefetchBody(known, k + kPrefetchAhead, check.forces);
+    if (markBody(known, k, &asleep, &unseen))
       all &= bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
-    }
-  } else { /* a sleeping body's values are not read */
-    for (int k = 0; k < count; ++k)
-      if (known->reached[k] == check_number)
-        all &= bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
   }
   for (int k = 0; !all && k < count; ++k)
-    if ((asleep == 0 || known->reached[k] == check_number) &&
-        !bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces))
+    if (known->reached[k] == check_number && !bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces))
       return nameFailure(known, k, bounds, when, step, steps, failed);
   int woken = asleep > 0 ? wakeWalk(known, queueMarked(known), checkVisit, &check) : -1;
   if (woken < 0) woken = checkUnseen(known, unseen, &check);
@@ -588,28 +588,24 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   for (int p = 0; p < known->pushed_count; ++p) known->bodies[known->pushed[p]].pushed = 0;
   known->pushed_count = 0;
   const int count = known->count, until = prefetchUntil(count);
-  for (int k = 0; k < count; ++k) { /* the joints of every body: a sleeping body's joint may be destroyed too */
-    if (k < until) prefetchJoints(known, k + kPrefetchAhead);
-    if (jointsChangedAt(known, k)) {
-      *joints_changed = 1;
-      return SS_OK;
-    }
+  const unsigned check_number = ++known->checks;
+  /* one pass reads each body once: its joints (a sleeping body's joint may be destroyed too, so every body's are read
+   * before a failure is told), its mark, and the state and forces of what ODE steps */
+  int all = 1, changed = 0, asleep = 0, unseen = 0;
+  for (int k = 0; k < count; ++k) {
+    if (k < until) prefetchBody(known, k + kPrefetchAhead, 1), prefetchJoints(known, k + kPrefetchAhead);
+    changed |= jointsChangedAt(known, k);
+    if (markBody(known, k, &asleep, &unseen)) all &= startBody(known, k, check.max_speed2, check.max_spin2);
   }
-  int unseen;
-  const int asleep = markAwake(known, &unseen);
-  const unsigned check_number = known->checks;
-  for (int k = 0; k < count; ++k) { /* one loop: startBody inlined once */
-    if (k < until) {
-      const ssBodyValues* next = &known->values[k + kPrefetchAhead];
-      prefetchState(next);
-      SS_PREFETCH(next->force);
-      SS_PREFETCH(next->torque);
-    }
-    if ((asleep > 0 && known->reached[k] != check_number) || startBody(known, k, check.max_speed2, check.max_spin2))
-      continue;
-    *failed = known->ids[k];
-    return describe(*failed, bounds, "before the frame");
+  if (changed) { /* the caller lists the bodies again, each then checked at the next call, and calls again */
+    *joints_changed = 1;
+    return SS_OK;
   }
+  for (int k = 0; !all && k < count; ++k)
+    if (known->reached[k] == check_number && !bodyWithin(&known->values[k], check.max_speed2, check.max_spin2, 1)) {
+      *failed = known->ids[k];
+      return describe(*failed, bounds, "before the frame");
+    }
   int woken = asleep > 0 ? wakeWalk(known, queueMarked(known), startVisit, &check) : -1;
   if (woken < 0) woken = checkUnseen(known, unseen, &check); /* checked only: a sleeping body's force waits */
   for (int a = 0; woken < 0 && a < also_count; ++a) {

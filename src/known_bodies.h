@@ -135,11 +135,11 @@ typedef struct ssBodyBounds {
 ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       const dBodyID* also, int also_count, dBodyID* failed);
 
-/* Before a frame, one pass: *joints_changed says whether a body's first joint changed (then nothing else was done:
- * the caller rebuilds the list and calls again); else the bodies ODE steps are checked as ssKnownCheck with state
- * and forces (also: sleeping bodies the program moved), and, all passing, the accumulators of those it steps become
- * their frame force (pushed marks a force or a carried force). A sleeping body's force waits in its accumulator, as
- * in ODE, and acts in the step that wakes it. */
+/* Before a frame, one pass: *joints_changed says whether a body's joints changed (then nothing is checked: the caller
+ * lists the bodies again and calls again, and the marks and forces read are made again); else the bodies ODE steps are
+ * checked as ssKnownCheck with state and forces (also: sleeping bodies the program moved), and, all passing, the
+ * accumulators of those it steps become their frame force (pushed marks a force or a carried force). A sleeping body's
+ * force waits in its accumulator, as in ODE, and acts in the step that wakes it. */
 ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, const dBodyID* also, int also_count,
                            dBodyID* failed, int* joints_changed);
 
