@@ -73,11 +73,10 @@ static ssStatus followRows(ssRegistry* registry, double step_s, FollowedRow** ou
 }
 
 /* Whether the body binding's numbers in ODE are those the registry last wrote. */
-static int bodyAsWritten(const ssRegistry* registry, const ssBodyBinding* binding) {
+static int bodyAsWritten(dWorldID world, const ssBodyBinding* binding) {
   ssBodyWritten written;
   ssBodyWrittenFor(binding, binding->written_step_s, &written);
   dBodyID body = binding->body;
-  dWorldID world = ssRegistryWorld(registry);
   if (binding->has_damping &&
       (!ssSameInOde(written.linear_scale, body ? dBodyGetLinearDamping(body) : dWorldGetLinearDamping(world)) ||
        !ssSameInOde(written.angular_scale, body ? dBodyGetAngularDamping(body) : dWorldGetAngularDamping(world))))
@@ -116,13 +115,15 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
   ssBodyBinding* bodies = NULL;
   int* body_at = NULL;
   int body_count = 0;
-  for (int i = 0; i < ssRegistryBodyBindingCount(registry) && status == SS_OK; ++i) {
-    const ssBodyBinding* binding = ssRegistryBodyAt(registry, i);
+  const int bound = ssRegistryBodyBindingCount(registry);
+  const ssBodyBinding* bindings = bound > 0 ? ssRegistryBodyAt(registry, 0) : NULL; /* not changed before the end */
+  for (int i = 0; i < bound && status == SS_OK; ++i) {
+    const ssBodyBinding* binding = &bindings[i];
     int adopted = binding->tuned.damping_step_s > 0 || binding->tuned.auto_disable_step_s > 0;
     /* a sleeping body's values are read when it wakes: ODE neither damps it nor counts its idle steps, and Apply
      * writes it no more than this reads it (ssRegistryWriteBodies) */
     int asleep = binding->body != 0 && !dBodyIsEnabled(binding->body);
-    if (!adopted || asleep || isnan(binding->written_step_s) || bodyAsWritten(registry, binding)) continue;
+    if (!adopted || asleep || isnan(binding->written_step_s) || bodyAsWritten(world, binding)) continue;
     ssBodyBinding* larger_bodies = realloc(bodies, (size_t)(body_count + 1) * sizeof *bodies);
     int* larger_at = realloc(body_at, (size_t)(body_count + 1) * sizeof *body_at);
     if (larger_bodies != NULL) bodies = larger_bodies;
