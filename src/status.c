@@ -29,6 +29,11 @@ const char* ssStatusName(ssStatus status) {
 
 const char* ssLastError(void) { return last_error; }
 
+ssStatus ssSetLastError(ssStatus status, const char* message) {
+  snprintf(last_error, sizeof last_error, "%s", message ? message : "");
+  return status;
+}
+
 ssStatus ssFail(ssStatus status, const char* format, ...) {
   va_list args;
   va_start(args, format);

@@ -41,6 +41,12 @@ SS_API const char* ssStatusName(ssStatus status);
 /** The message of the last failure on this thread: one line naming the value at fault. "" when none. */
 SS_API const char* ssLastError(void);
 
+/** Records message as this thread's ssLastError() and returns status unchanged, for code built on the library
+ *  that reports its own failures where the library's are read (the lab does: its status and message reach a caller,
+ *  and Python's SteadystepError, as the core's do). message is copied, at most 255 bytes (longer is cut there);
+ *  NULL records "". Never fails. */
+SS_API ssStatus ssSetLastError(ssStatus status, const char* message);
+
 #ifdef __cplusplus
 }
 #endif

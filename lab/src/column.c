@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "error.h"
+#include "lab_error.h"
 #include "steadystep/lab/scene.h"
 
 /* Appends text to out at *length, counting on past size (as snprintf) but writing only what fits. */
@@ -26,8 +26,8 @@ static void putSpelled(char* out, size_t size, size_t* length, const char* text)
 
 int ssColumnName(const char* name, const char* unit, char* out, size_t size) {
   if (name == NULL || unit == NULL || (out == NULL && size > 0)) {
-    ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssColumnName needs a name, a unit and somewhere to write",
-           name == NULL ? "name" : unit == NULL ? "unit" : "out");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssColumnName needs a name, a unit and somewhere to write",
+              name == NULL ? "name" : unit == NULL ? "unit" : "out");
     return -1;
   }
   size_t length = 0;

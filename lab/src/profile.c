@@ -17,7 +17,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "error.h"
+#include "lab_error.h"
 #include "profile_internal.h"
 #include "rng.h"
 
@@ -90,14 +90,14 @@ static ssStatus parseNumber(const char* raw_spec, const char* field, const char*
   char spec[96], token_text[96];
   SPEC_TEXT(raw_spec, spec);
   escaped(token, strlen(token), token_text, sizeof token_text);
-  if (token[0] == '\0') return ssFail(SS_ERROR_PARSE, "profile \"%s\": %s is empty", spec, field);
+  if (token[0] == '\0') return ssLabFail(SS_ERROR_PARSE, "profile \"%s\": %s is empty", spec, field);
   char* end = NULL;
   errno = 0;
   double value = strtod(token, &end);
   if (end == token || *end != '\0' || isspace((unsigned char)token[0]))
-    return ssFail(SS_ERROR_PARSE, "profile \"%s\": %s = \"%s\" is not a number", spec, field, token_text);
+    return ssLabFail(SS_ERROR_PARSE, "profile \"%s\": %s = \"%s\" is not a number", spec, field, token_text);
   if (!isfinite(value))
-    return ssFail(SS_ERROR_NOT_FINITE, "profile \"%s\": %s = %s: must be finite", spec, field, token_text);
+    return ssLabFail(SS_ERROR_NOT_FINITE, "profile \"%s\": %s = %s: must be finite", spec, field, token_text);
   *out = value;
   return SS_OK;
 }
@@ -105,8 +105,8 @@ static ssStatus parseNumber(const char* raw_spec, const char* field, const char*
 static ssStatus checkPositive(const char* raw_spec, const char* field, double value) {
   char spec[96];
   if (value <= 0)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": %s = %g: must be positive", SPEC_TEXT(raw_spec, spec),
-                  field, value);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": %s = %g: must be positive", SPEC_TEXT(raw_spec, spec),
+                     field, value);
   return SS_OK;
 }
 
@@ -114,8 +114,9 @@ static ssStatus checkPositive(const char* raw_spec, const char* field, double va
 static ssStatus checkFrame(const char* raw_spec, const char* field, double field_value, double frame_s) {
   char spec[96];
   if (!(frame_s >= SS_MIN_PROFILE_FRAME_S && frame_s <= SS_MAX_PROFILE_FRAME_S))
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": %s = %g gives frames of %g s, outside [%g, %g] s",
-                  SPEC_TEXT(raw_spec, spec), field, field_value, frame_s, SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": %s = %g gives frames of %g s, outside [%g, %g] s",
+                     SPEC_TEXT(raw_spec, spec), field, field_value, frame_s, SS_MIN_PROFILE_FRAME_S,
+                     SS_MAX_PROFILE_FRAME_S);
   return SS_OK;
 }
 
@@ -131,21 +132,21 @@ static ssStatus checkRate(const char* spec, const char* field, double rate) {
 static ssStatus readBounded(const char* path_text, const char* raw_path, char** text_out, size_t* length_out) {
   /* Non-blocking, so that opening a FIFO without a writer returns at once instead of waiting for one. */
   int fd = open(raw_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return ssFail(SS_ERROR_IO, "trace \"%s\" cannot be opened: %s", path_text, strerror(errno));
+  if (fd < 0) return ssLabFail(SS_ERROR_IO, "trace \"%s\" cannot be opened: %s", path_text, strerror(errno));
   struct stat info;
   if (fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
     close(fd);
-    return ssFail(SS_ERROR_IO, "trace \"%s\": not a regular file (devices and pipes are not read)", path_text);
+    return ssLabFail(SS_ERROR_IO, "trace \"%s\": not a regular file (devices and pipes are not read)", path_text);
   }
   if (info.st_size > SS_MAX_TRACE_BYTES) {
     close(fd);
-    return ssFail(SS_ERROR_IO, "trace \"%s\": %lld bytes, larger than %d", path_text, (long long)info.st_size,
-                  SS_MAX_TRACE_BYTES);
+    return ssLabFail(SS_ERROR_IO, "trace \"%s\": %lld bytes, larger than %d", path_text, (long long)info.st_size,
+                     SS_MAX_TRACE_BYTES);
   }
   FILE* file = fdopen(fd, "rb");
   if (file == NULL) {
     close(fd);
-    return ssFail(SS_ERROR_IO, "trace \"%s\" cannot be read: %s", path_text, strerror(errno));
+    return ssLabFail(SS_ERROR_IO, "trace \"%s\" cannot be read: %s", path_text, strerror(errno));
   }
   /* Start from the size the file reports and grow to the bound: /proc-like files report 0, growing files more. */
   size_t capacity = (size_t)(info.st_size < SS_MAX_TRACE_BYTES ? info.st_size : SS_MAX_TRACE_BYTES) + 2;
@@ -163,10 +164,10 @@ static ssStatus readBounded(const char* path_text, const char* raw_path, char** 
   }
   int failed = ferror(file);
   fclose(file);
-  if (text == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "trace \"%s\": out of memory", path_text);
-  if (failed) status = ssFail(SS_ERROR_IO, "trace \"%s\": read error", path_text);
+  if (text == NULL) return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "trace \"%s\": out of memory", path_text);
+  if (failed) status = ssLabFail(SS_ERROR_IO, "trace \"%s\": read error", path_text);
   else if (length > SS_MAX_TRACE_BYTES)
-    status = ssFail(SS_ERROR_IO, "trace \"%s\": larger than %d bytes", path_text, SS_MAX_TRACE_BYTES);
+    status = ssLabFail(SS_ERROR_IO, "trace \"%s\": larger than %d bytes", path_text, SS_MAX_TRACE_BYTES);
   if (status != SS_OK) {
     free(text);
     return status;
@@ -183,10 +184,10 @@ static ssStatus parseTraceLine(const char* path_text, long number, char* line, s
   char line_text[96];
   *has_value = 0;
   if (memchr(line, '\0', length) != NULL)
-    return ssFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: contains a NUL byte", path_text, number);
+    return ssLabFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: contains a NUL byte", path_text, number);
   if (length > SS_MAX_TRACE_LINE_CHARS)
-    return ssFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: longer than %d characters", path_text, number,
-                  SS_MAX_TRACE_LINE_CHARS);
+    return ssLabFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: longer than %d characters", path_text, number,
+                     SS_MAX_TRACE_LINE_CHARS);
   while (length > 0 && isspace((unsigned char)line[length - 1])) line[--length] = '\0';
   const char* text = line;
   while (isspace((unsigned char)*text)) ++text;
@@ -194,11 +195,11 @@ static ssStatus parseTraceLine(const char* path_text, long number, char* line, s
   char* end = NULL;
   double parsed = strtod(text, &end);
   if (end == text || *end != '\0' || !isfinite(parsed) || parsed <= 0)
-    return ssFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: \"%s\" is not a positive finite duration in seconds",
-                  path_text, number, escaped(text, strlen(text), line_text, sizeof line_text));
+    return ssLabFail(SS_ERROR_PARSE, "trace \"%s\" line %ld: \"%s\" is not a positive finite duration in seconds",
+                     path_text, number, escaped(text, strlen(text), line_text, sizeof line_text));
   if (!(parsed >= SS_MIN_PROFILE_FRAME_S && parsed <= SS_MAX_PROFILE_FRAME_S))
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "trace \"%s\" line %ld: %g s is outside [%g, %g] s", path_text, number,
-                  parsed, SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "trace \"%s\" line %ld: %g s is outside [%g, %g] s", path_text, number,
+                     parsed, SS_MIN_PROFILE_FRAME_S, SS_MAX_PROFILE_FRAME_S);
   *value = parsed;
   *has_value = 1;
   return SS_OK;
@@ -226,15 +227,15 @@ static ssStatus readTrace(const char* raw_path, double** values_out, long* count
     start = stop + 1;
     if (status != SS_OK || !has_value) continue;
     if (count == SS_MAX_TRACE_FRAMES) {
-      status = ssFail(SS_ERROR_OUT_OF_RANGE, "trace \"%s\": more than %d frame durations", path_text,
-                      SS_MAX_TRACE_FRAMES);
+      status = ssLabFail(SS_ERROR_OUT_OF_RANGE, "trace \"%s\": more than %d frame durations", path_text,
+                         SS_MAX_TRACE_FRAMES);
       break;
     }
     if (count == capacity) {
       long grown = capacity ? 2 * capacity : 64;
       double* more = realloc(values, (size_t)grown * sizeof *values);
       if (more == NULL) {
-        status = ssFail(SS_ERROR_OUT_OF_MEMORY, "trace \"%s\": out of memory at line %ld", path_text, line_number);
+        status = ssLabFail(SS_ERROR_OUT_OF_MEMORY, "trace \"%s\": out of memory at line %ld", path_text, line_number);
         break;
       }
       values = more;
@@ -244,7 +245,7 @@ static ssStatus readTrace(const char* raw_path, double** values_out, long* count
   }
   free(text);
   if (status == SS_OK && count == 0)
-    status = ssFail(SS_ERROR_PARSE, "trace \"%s\": no frame durations in the file", path_text);
+    status = ssLabFail(SS_ERROR_PARSE, "trace \"%s\": no frame durations in the file", path_text);
   if (status != SS_OK) {
     free(values);
     return status;
@@ -268,18 +269,18 @@ static ssStatus setParameters(ssProfile* p, const char* raw_spec, const ssKindDe
       status = checkRate(raw_spec, "MINFPS", v[0]);
       if (status == SS_OK) status = checkRate(raw_spec, "MAXFPS", v[1]);
       if (status == SS_OK && v[0] > v[1])
-        status = ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": MINFPS = %g is above MAXFPS = %g", spec, v[0], v[1]);
+        status = ssLabFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": MINFPS = %g is above MAXFPS = %g", spec, v[0], v[1]);
       p->a_s = 1.0 / v[1];
       p->b_s = 1.0 / v[0];
       break;
     case SS_PROFILE_JITTER:
       status = checkRate(raw_spec, "FPS", v[0]);
       if (status == SS_OK && v[1] < 0)
-        status = ssFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": SPREAD_MS = %g: must not be negative", spec, v[1]);
+        status = ssLabFail(SS_ERROR_OUT_OF_RANGE, "profile \"%s\": SPREAD_MS = %g: must not be negative", spec, v[1]);
       if (status == SS_OK && 3.0 * v[1] >= 1000.0 / v[0])
-        status = ssFail(SS_ERROR_OUT_OF_RANGE,
-                        "profile \"%s\": SPREAD_MS = %g: three deviations must stay below the frame of %g ms", spec,
-                        v[1], 1000.0 / v[0]);
+        status = ssLabFail(SS_ERROR_OUT_OF_RANGE,
+                           "profile \"%s\": SPREAD_MS = %g: three deviations must stay below the frame of %g ms", spec,
+                           v[1], 1000.0 / v[0]);
       p->a_s = 1.0 / v[0];
       p->b_s = v[1] / 1000.0;
       if (status == SS_OK) status = checkFrame(raw_spec, "SPREAD_MS", v[1], p->a_s - 3.0 * p->b_s);
@@ -288,8 +289,8 @@ static ssStatus setParameters(ssProfile* p, const char* raw_spec, const ssKindDe
     case SS_PROFILE_HITCH:
       status = checkRate(raw_spec, "FPS", v[0]);
       if (status == SS_OK && !(v[1] >= 1 && v[1] <= 1e9 && v[1] == floor(v[1])))
-        status = ssFail(SS_ERROR_OUT_OF_RANGE,
-                        "profile \"%s\": EVERY = %g: must be a whole number of frames in [1, 1e9]", spec, v[1]);
+        status = ssLabFail(SS_ERROR_OUT_OF_RANGE,
+                           "profile \"%s\": EVERY = %g: must be a whole number of frames in [1, 1e9]", spec, v[1]);
       if (status == SS_OK) status = checkPositive(raw_spec, "SECONDS", v[2]);
       if (status == SS_OK) status = checkFrame(raw_spec, "SECONDS", v[2], v[2]);
       if (status != SS_OK) break;
@@ -311,8 +312,8 @@ static ssStatus setParameters(ssProfile* p, const char* raw_spec, const ssKindDe
 
 ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out) {
   if (spec == NULL || out == NULL)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssProfile_Create needs a spec and somewhere to write",
-                  spec == NULL ? "spec" : "out");
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssProfile_Create needs a spec and somewhere to write",
+                     spec == NULL ? "spec" : "out");
   char spec_text[96];
   SPEC_TEXT(spec, spec_text);
   const char* colon = strchr(spec, ':');
@@ -321,15 +322,15 @@ ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out) {
   for (size_t i = 0; i < sizeof kinds / sizeof kinds[0]; ++i)
     if (strlen(kinds[i].name) == name_length && strncmp(kinds[i].name, spec, name_length) == 0) kind = &kinds[i];
   if (kind == NULL)
-    return ssFail(SS_ERROR_PARSE, "profile \"%s\": unknown kind (fixed, uniform, jitter, hitch, vsync or trace)",
-                  spec_text);
-  if (colon == NULL) return ssFail(SS_ERROR_PARSE, "profile \"%s\": missing field %s", spec_text, kind->fields[0]);
+    return ssLabFail(SS_ERROR_PARSE, "profile \"%s\": unknown kind (fixed, uniform, jitter, hitch, vsync or trace)",
+                     spec_text);
+  if (colon == NULL) return ssLabFail(SS_ERROR_PARSE, "profile \"%s\": missing field %s", spec_text, kind->fields[0]);
 
   ssProfile profile = {.kind = kind->kind, .seed = seed};
   if (kind->kind == SS_PROFILE_TRACE) {
     /* The path is the rest of the spec: it may itself contain colons. */
     const char* path = colon + 1;
-    if (*path == '\0') return ssFail(SS_ERROR_PARSE, "profile \"%s\": FILE is empty", spec_text);
+    if (*path == '\0') return ssLabFail(SS_ERROR_PARSE, "profile \"%s\": FILE is empty", spec_text);
     ssStatus status = readTrace(path, &profile.trace_s, &profile.trace_count);
     if (status != SS_OK) return status;
   } else {
@@ -340,15 +341,15 @@ ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out) {
       size_t length = field_end ? (size_t)(field_end - field_start) : strlen(field_start);
       char token[64];
       if (length >= sizeof token)
-        return ssFail(SS_ERROR_PARSE, "profile \"%s\": %s is too long", spec_text, kind->fields[i]);
+        return ssLabFail(SS_ERROR_PARSE, "profile \"%s\": %s is too long", spec_text, kind->fields[i]);
       memcpy(token, field_start, length);
       token[length] = '\0';
       ssStatus status = parseNumber(spec, kind->fields[i], token, &values[i]);
       if (status != SS_OK) return status;
       if (i + 1 < kind->field_count && field_end == NULL)
-        return ssFail(SS_ERROR_PARSE, "profile \"%s\": missing field %s", spec_text, kind->fields[i + 1]);
+        return ssLabFail(SS_ERROR_PARSE, "profile \"%s\": missing field %s", spec_text, kind->fields[i + 1]);
       if (i + 1 == kind->field_count && field_end != NULL)
-        return ssFail(SS_ERROR_PARSE, "profile \"%s\": extra field after %s", spec_text, kind->fields[i]);
+        return ssLabFail(SS_ERROR_PARSE, "profile \"%s\": extra field after %s", spec_text, kind->fields[i]);
       field_start = field_end ? field_end + 1 : NULL;
     }
     ssStatus status = setParameters(&profile, spec, kind, values);
@@ -361,7 +362,7 @@ ssStatus ssProfile_Create(const char* spec, uint64_t seed, ssProfile** out) {
     free(made);
     free(spec_copy);
     free(profile.trace_s);
-    return ssFail(SS_ERROR_OUT_OF_MEMORY, "profile \"%s\": out of memory", spec_text);
+    return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "profile \"%s\": out of memory", spec_text);
   }
   strcpy(spec_copy, spec);
   profile.spec = spec_copy;
@@ -380,7 +381,7 @@ void ssProfile_Destroy(ssProfile* profile) {
 
 void ssProfile_Reset(ssProfile* profile) {
   if (profile == NULL) {
-    ssFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to reset");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to reset");
     return;
   }
   ssRngSeed(&profile->rng, profile->seed);
@@ -390,7 +391,7 @@ void ssProfile_Reset(ssProfile* profile) {
 
 const char* ssProfile_Spec(const ssProfile* profile) {
   if (profile == NULL) {
-    ssFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to describe");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to describe");
     return "";
   }
   return profile->spec;
@@ -401,7 +402,7 @@ static double clamp(double value, double low, double high) { return value < low 
 
 double ssProfile_Next(ssProfile* p) {
   if (p == NULL) {
-    ssFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to draw a frame from");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE, "profile = NULL: no profile to draw a frame from");
     return NAN;
   }
   long index = p->frame_index++;

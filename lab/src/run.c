@@ -8,13 +8,14 @@
  * after it in its frame are not). A run is bounded (scene.h): its duration, the frames it is expected to take
  * (refused before it starts) and the frames and steps it does take (stopped with an error when an unlucky random
  * profile reaches them). */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-#include "error.h"
+#include "lab_error.h"
 #include "profile_internal.h"
 #include "scene_internal.h"
 #include "steadystep/lab/profile.h"
@@ -100,8 +101,9 @@ static ssStatus play(ssRun* run, ssScene* scene, ssProfile* profile, double dura
   double elapsed_s = 0;
   while (duration_s - elapsed_s > end_tolerance_s) {
     if (run->frame_count >= SS_MAX_RUN_FRAMES)
-      return ssFail(SS_ERROR_OUT_OF_RANGE, "run: %d frames and %g of duration_s = %g s left: a run takes at most %d frames",
-                    run->frame_count, duration_s - elapsed_s, duration_s, SS_MAX_RUN_FRAMES);
+      return ssLabFail(SS_ERROR_OUT_OF_RANGE,
+                       "run: %d frames and %g of duration_s = %g s left: a run takes at most %d frames",
+                       run->frame_count, duration_s - elapsed_s, duration_s, SS_MAX_RUN_FRAMES);
     double frame_s = fmin(ssProfile_Next(profile), duration_s - elapsed_s);
     double start_s = nowSeconds();
     ssStatus status = ssScene_Frame(scene, frame_s, NULL);
@@ -110,10 +112,11 @@ static ssStatus play(ssRun* run, ssScene* scene, ssProfile* profile, double dura
     elapsed_s += frame_s;
     run->bound_use = ssScene_BoundUse(scene);
     if (run->outcome == SS_RUN_BROKEN) return SS_OK; /* first: it came before anything later in its frame */
-    if (run->out_of_memory) return ssFail(SS_ERROR_OUT_OF_MEMORY, "run: out of memory after %d steps", run->count);
+    if (run->out_of_memory) return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "run: out of memory after %d steps", run->count);
     if (run->too_many_steps)
-      return ssFail(SS_ERROR_OUT_OF_RANGE, "run: %d steps after %g s of duration_s = %g s: a run takes at most %d steps",
-                    run->count, elapsed_s, duration_s, SS_MAX_RUN_STEPS);
+      return ssLabFail(SS_ERROR_OUT_OF_RANGE,
+                       "run: %d steps after %g s of duration_s = %g s: a run takes at most %d steps", run->count,
+                       elapsed_s, duration_s, SS_MAX_RUN_STEPS);
     if (status == SS_ERROR_BLOWUP || status == SS_ERROR_SPEED_LIMIT || status == SS_ERROR_POSITION_LIMIT) {
       run->status = status;
       run->outcome = SS_RUN_BLEW_UP;
@@ -138,34 +141,38 @@ static ssStatus checkSize(const ssRunDef* def, const ssProfile* profile) {
   double mean_frame_s = ssProfileMeanFrame(profile);
   double frames = def->duration_s / mean_frame_s;
   if (frames > SS_MAX_RUN_FRAMES)
-    return ssFail(SS_ERROR_OUT_OF_RANGE,
-                  "duration_s = %g s: profile \"%s\" (mean frame %g s) needs about %.3g frames, a run takes at most %d",
-                  def->duration_s, ssProfile_Spec(profile), mean_frame_s, frames, SS_MAX_RUN_FRAMES);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE,
+                     "duration_s = %g s: profile \"%s\" (mean frame %g s) needs about %.3g frames, a run takes at "
+                     "most %d",
+                     def->duration_s, ssProfile_Spec(profile), mean_frame_s, frames, SS_MAX_RUN_FRAMES);
   double steps = expectedSteps(&def->stepping, def->duration_s, frames, mean_frame_s);
   if (steps > SS_MAX_RUN_STEPS)
-    return ssFail(SS_ERROR_OUT_OF_RANGE,
-                  "duration_s = %g s: cut %s with max_step_s = %g s, fixed_step_s = %g s needs about %.3g steps, "
-                  "a run takes at most %d",
-                  def->duration_s, ssFrameCutName(def->stepping.cut), def->stepping.max_step_s,
-                  def->stepping.fixed_step_s, steps, SS_MAX_RUN_STEPS);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE,
+                     "duration_s = %g s: cut %s with max_step_s = %g s, fixed_step_s = %g s needs about %.3g steps, "
+                     "a run takes at most %d",
+                     def->duration_s, ssFrameCutName(def->stepping.cut), def->stepping.max_step_s,
+                     def->stepping.fixed_step_s, steps, SS_MAX_RUN_STEPS);
   return SS_OK;
 }
 
 ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
   if (def == NULL || out == NULL)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssRun_Execute needs a definition and out",
-                  def == NULL ? "def" : "out");
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssRun_Execute needs a definition and out",
+                     def == NULL ? "def" : "out");
   if (def->scene == NULL || def->profile == NULL)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "def.%s = NULL: a run needs a scene name and a profile spec",
-                  def->scene == NULL ? "scene" : "profile");
-  ssStatus status = ssCheckPositive("duration_s", "s", def->duration_s);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "def.%s = NULL: a run needs a scene name and a profile spec",
+                     def->scene == NULL ? "scene" : "profile");
+  ssStatus status = ssLabCheckRange("duration_s", "s", def->duration_s, -DBL_MAX, DBL_MAX);
+  if (status == SS_OK && !(def->duration_s > 0))
+    status = ssLabFail(SS_ERROR_OUT_OF_RANGE, "duration_s = %g s: must be positive", def->duration_s);
   if (status == SS_OK && def->duration_s > SS_MAX_RUN_DURATION_S)
-    status = ssFail(SS_ERROR_OUT_OF_RANGE, "duration_s = %g s: a run lasts at most %g s", def->duration_s,
-                    SS_MAX_RUN_DURATION_S);
+    status = ssLabFail(SS_ERROR_OUT_OF_RANGE, "duration_s = %g s: a run lasts at most %g s", def->duration_s,
+                       SS_MAX_RUN_DURATION_S);
   if (status != SS_OK) return status;
   const ssSceneInfo* info = ssSceneFind(def->scene);
   if (info == NULL)
-    return ssFail(SS_ERROR_NOT_FOUND, "scene = \"%.64s\": unknown (oscillator, buggy, drop, chain, pile)", def->scene);
+    return ssLabFail(SS_ERROR_NOT_FOUND, "scene = \"%.64s\": unknown (oscillator, buggy, drop, chain, pile)",
+                     def->scene);
   ssProfile* profile = NULL;
   status = ssProfile_Create(def->profile, def->seed, &profile);
   if (status != SS_OK) return status;
@@ -173,7 +180,7 @@ ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
   status = ssScene_Create(def->scene, &def->params, &def->stepping, &scene);
   if (status == SS_OK) status = checkSize(def, profile); /* after the scene has checked the stepping's fields */
   ssRun* run = status == SS_OK ? calloc(1, sizeof *run) : NULL;
-  if (status == SS_OK && run == NULL) status = ssFail(SS_ERROR_OUT_OF_MEMORY, "run: out of memory");
+  if (status == SS_OK && run == NULL) status = ssLabFail(SS_ERROR_OUT_OF_MEMORY, "run: out of memory");
   if (status == SS_OK) {
     run->quantity_count = info->quantity_count;
     ssScene_Sample(scene, run->initial);
@@ -194,7 +201,7 @@ ssStatus ssRun_Execute(const ssRunDef* def, ssRun** out) {
 /* The accessors of a NULL run record why and answer with nothing: 0, NULL, or an error status. */
 static int nullRun(const ssRun* run, const char* what) {
   if (run != NULL) return 0;
-  ssFail(SS_ERROR_OUT_OF_RANGE, "run = NULL: no run to read %s from", what);
+  ssLabFail(SS_ERROR_OUT_OF_RANGE, "run = NULL: no run to read %s from", what);
   return 1;
 }
 

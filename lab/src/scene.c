@@ -5,6 +5,7 @@
  * SS_ERROR_SPEED_LIMIT instead of running on with nonsense. After every step the scene's sanity bounds are checked
  * (scene.h): the first step outside one is kept, with its time, for the run to end on (a run that is finite but
  * wrong is no error of the library, so it is not an ssStatus). */
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -13,8 +14,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "error.h"
-#include "ode_bounds.h"
+#include "lab_error.h"
 #include "scene_internal.h"
 #include "steadystep/interpolation.h"
 
@@ -73,7 +73,7 @@ const ssSceneInfo* ssSceneFind(const char* name) {
 }
 
 static ssStatus findOrFail(const char* name, const ssSceneDesc** out) {
-  if (name == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "name = NULL: needs a scene name (oscillator, buggy, ...)");
+  if (name == NULL) return ssLabFail(SS_ERROR_OUT_OF_RANGE, "name = NULL: needs a scene name (oscillator, buggy, ...)");
   *out = findDesc(name);
   if (*out != NULL) return SS_OK;
   char known[128] = ""; /* the table's names, so that a new scene is one line */
@@ -81,20 +81,20 @@ static ssStatus findOrFail(const char* name, const ssSceneDesc** out) {
     strncat(known, i ? ", " : "", sizeof known - strlen(known) - 1);
     strncat(known, scenes[i]->info.name, sizeof known - strlen(known) - 1);
   }
-  return ssFail(SS_ERROR_NOT_FOUND, "scene = \"%s\": unknown (%s)", name, known);
+  return ssLabFail(SS_ERROR_NOT_FOUND, "scene = \"%s\": unknown (%s)", name, known);
 }
 
 ssStatus ssDefaultSceneParams(const char* name, ssSceneParams* out) {
   const ssSceneDesc* desc;
   ssStatus status = findOrFail(name, &desc);
   if (status != SS_OK) return status;
-  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the parameters");
+  if (out == NULL) return ssLabFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the parameters");
   *out = desc->defaults;
   return SS_OK;
 }
 
 ssStatus ssLabStepping(const char* policy, ssStepping* out) {
-  if (out == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the stepping");
+  if (out == NULL) return ssLabFail(SS_ERROR_OUT_OF_RANGE, "out = NULL: needs somewhere to write the stepping");
   ssStepping stepping = ssDefaultStepping();
   stepping.solver = SS_SOLVER_QUICK;
   stepping.max_step_s = SS_LAB_STEP_S;
@@ -114,22 +114,22 @@ ssStepping ssReferenceStepping(double step_s) {
 
 static ssStatus validateParams(const ssSceneDesc* desc, const ssSceneParams* params) {
   ssStatus status = ssValidateSpring(params->spring);
-  if (status == SS_OK) status = ssCheckMass("mass", params->mass);
-  if (status == SS_OK) status = ssCheckFinite("x0", "m", params->x0);
-  if (status == SS_OK) status = ssCheckFinite("gravity", "m/s^2", params->gravity);
+  if (status == SS_OK) status = ssLabCheckRange("mass", "kg", params->mass, SS_MIN_MASS_KG, SS_MAX_MASS_KG);
+  if (status == SS_OK) status = ssLabCheckRange("x0", "m", params->x0, -DBL_MAX, DBL_MAX);
+  if (status == SS_OK) status = ssLabCheckRange("gravity", "m/s^2", params->gravity, -DBL_MAX, DBL_MAX);
   if (status != SS_OK) return status;
   /* A scene is a few metres across and moves at a few m/s; far beyond that, ODE's products overflow in a step. */
   if (!(fabs(params->x0) <= SS_SCENE_MAX_X0_M))
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "x0 = %g m: must be within +-%g m", params->x0, SS_SCENE_MAX_X0_M);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "x0 = %g m: must be within +-%g m", params->x0, SS_SCENE_MAX_X0_M);
   if (!(fabs(params->gravity) <= SS_SCENE_MAX_GRAVITY_M_PER_S2))
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "gravity = %g m/s^2: must be within +-%g m/s^2", params->gravity,
-                  SS_SCENE_MAX_GRAVITY_M_PER_S2);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "gravity = %g m/s^2: must be within +-%g m/s^2", params->gravity,
+                     SS_SCENE_MAX_GRAVITY_M_PER_S2);
   if (params->body_count < 0)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "body_count = %d: must not be negative (0 = the scene's default)",
-                  params->body_count);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "body_count = %d: must not be negative (0 = the scene's default)",
+                     params->body_count);
   if (desc->max_body_count > 0 && params->body_count > desc->max_body_count)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "body_count = %d: scene \"%s\" takes at most %d", params->body_count,
-                  desc->info.name, desc->max_body_count);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "body_count = %d: scene \"%s\" takes at most %d", params->body_count,
+                     desc->info.name, desc->max_body_count);
   return SS_OK;
 }
 
@@ -204,8 +204,8 @@ ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssS
   ssStatus status = findOrFail(name, &desc);
   if (status != SS_OK) return status;
   if (params == NULL || stepping == NULL || out == NULL)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_Create needs params, stepping and out",
-                  params == NULL ? "params" : stepping == NULL ? "stepping" : "out");
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_Create needs params, stepping and out",
+                     params == NULL ? "params" : stepping == NULL ? "stepping" : "out");
   status = validateParams(desc, params);
   if (status == SS_OK) status = ssValidateStepping(stepping);
   if (status != SS_OK) return status;
@@ -214,7 +214,7 @@ ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssS
   if (resolved.body_count == 0) resolved.body_count = desc->defaults.body_count;
 
   ssScene* scene = calloc(1, sizeof *scene);
-  if (scene == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "scene \"%s\": out of memory", name);
+  if (scene == NULL) return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "scene \"%s\": out of memory", name);
   scene->desc = desc;
   ssEnsureOde();
   scene->parts.world = dWorldCreate();
@@ -222,7 +222,7 @@ ssStatus ssScene_Create(const char* name, const ssSceneParams* params, const ssS
   scene->parts.contacts = dJointGroupCreate(0);
   scene->parts.registry = ssRegistry_Create(scene->parts.world);
   if (scene->parts.registry == NULL) {
-    status = ssFail(SS_ERROR_OUT_OF_MEMORY, "scene \"%s\": out of memory for the registry", name);
+    status = ssLabFail(SS_ERROR_OUT_OF_MEMORY, "scene \"%s\": out of memory for the registry", name);
   } else {
     status = desc->build(&scene->parts, &resolved, &scene->state);
   }
@@ -253,7 +253,7 @@ static void addServed(ssSceneServedCounts* sum, const ssServedCounts* counts) {
 }
 
 ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps) {
-  if (scene == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to step");
+  if (scene == NULL) return ssLabFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to step");
   ssEnsureOde();
   /* dWorldQuickStep shuffles its constraints with ODE's process-wide generator. Giving each scene its own state of
    * it makes a run the same whatever ran before it in the process (or between its frames, on the same thread). */
@@ -273,14 +273,14 @@ ssStatus ssScene_Frame(ssScene* scene, double frame_s, int* steps) {
 
 ssSceneCounters ssScene_Counters(const ssScene* scene) {
   if (scene != NULL) return scene->counters;
-  ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read counters from");
+  ssLabFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read counters from");
   return (ssSceneCounters){0};
 }
 
 int ssScene_Points(const ssScene* scene, double* xyz, int capacity) {
   if (scene == NULL || capacity < 0 || (xyz == NULL && capacity > 0)) {
-    ssFail(SS_ERROR_OUT_OF_RANGE, "%s: ssScene_Points needs a scene, capacity >= 0 and xyz for capacity > 0",
-           scene == NULL ? "scene = NULL" : capacity < 0 ? "capacity < 0" : "xyz = NULL");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE, "%s: ssScene_Points needs a scene, capacity >= 0 and xyz for capacity > 0",
+              scene == NULL ? "scene = NULL" : capacity < 0 ? "capacity < 0" : "xyz = NULL");
     return 0;
   }
   if (scene->desc->points == NULL) return 0;
@@ -289,9 +289,9 @@ int ssScene_Points(const ssScene* scene, double* xyz, int capacity) {
 
 int ssScene_InterpolatedPoints(const ssScene* scene, double* xyz, int capacity) {
   if (scene == NULL || capacity < 0 || (xyz == NULL && capacity > 0)) {
-    ssFail(SS_ERROR_OUT_OF_RANGE,
-           "%s: ssScene_InterpolatedPoints needs a scene, capacity >= 0 and xyz for capacity > 0",
-           scene == NULL ? "scene = NULL" : capacity < 0 ? "capacity < 0" : "xyz = NULL");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE,
+              "%s: ssScene_InterpolatedPoints needs a scene, capacity >= 0 and xyz for capacity > 0",
+              scene == NULL ? "scene = NULL" : capacity < 0 ? "capacity < 0" : "xyz = NULL");
     return 0;
   }
   if (scene->desc->points == NULL) return 0;
@@ -338,7 +338,7 @@ static int awakeIn(dSpaceID space, dBodyID* seen, int* seen_count, int capacity)
 
 int ssScene_AwakeBodies(const ssScene* scene) {
   if (scene == NULL) {
-    ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to count the awake bodies of");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to count the awake bodies of");
     return -1;
   }
   enum { SEEN_CAPACITY = 4096 };
@@ -375,24 +375,24 @@ static ssStatus plainFrame(ssScene* scene, double frame_s) {
   scene->desc->sample(scene->state, sample);
   for (int i = 0; i < scene->desc->info.quantity_count; ++i)
     if (!isfinite(sample[i]))
-      return ssFail(SS_ERROR_BLOWUP, "plain frame at t = %g s: %s is not finite", scene->time_s,
-                    scene->desc->info.quantity_names[i]);
+      return ssLabFail(SS_ERROR_BLOWUP, "plain frame at t = %g s: %s is not finite", scene->time_s,
+                       scene->desc->info.quantity_names[i]);
   return SS_OK;
 }
 
 ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, int count, int plain, double* cpu_s) {
   if (scene == NULL || frames_s == NULL || cpu_s == NULL)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_TimeFrames needs a scene, frames and cpu_s",
-                  scene == NULL ? "scene" : frames_s == NULL ? "frames_s" : "cpu_s");
-  if (count < 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "count = %d: must not be negative", count);
-  if (plain != 0 && plain != 1) return ssFail(SS_ERROR_OUT_OF_RANGE, "plain = %d: must be 0 or 1", plain);
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_TimeFrames needs a scene, frames and cpu_s",
+                     scene == NULL ? "scene" : frames_s == NULL ? "frames_s" : "cpu_s");
+  if (count < 0) return ssLabFail(SS_ERROR_OUT_OF_RANGE, "count = %d: must not be negative", count);
+  if (plain != 0 && plain != 1) return ssLabFail(SS_ERROR_OUT_OF_RANGE, "plain = %d: must be 0 or 1", plain);
   if (plain && scene->counters.frames == 0)
-    return ssFail(SS_ERROR_OUT_OF_RANGE, "plain = 1: step one frame with ssScene_Frame first, so that every "
+    return ssLabFail(SS_ERROR_OUT_OF_RANGE, "plain = 1: step one frame with ssScene_Frame first, so that every "
                                          "softness has been written");
   for (int i = 0; plain && i < count; ++i)
     if (!(frames_s[i] >= SS_MIN_STEP_S && frames_s[i] <= SS_MAX_STEP_S))
-      return ssFail(SS_ERROR_OUT_OF_RANGE, "frames_s[%d] = %g s: a plain frame is one step, in [%g, %g] s", i,
-                    frames_s[i], SS_MIN_STEP_S, SS_MAX_STEP_S);
+      return ssLabFail(SS_ERROR_OUT_OF_RANGE, "frames_s[%d] = %g s: a plain frame is one step, in [%g, %g] s", i,
+                       frames_s[i], SS_MIN_STEP_S, SS_MAX_STEP_S);
   ssEnsureOde();
   ssStatus status = SS_OK;
   double start_s = threadCpuSeconds();
@@ -411,8 +411,8 @@ ssStatus ssScene_TimeFrames(ssScene* scene, const double* frames_s, int count, i
 
 void ssScene_Sample(const ssScene* scene, double* out) {
   if (scene == NULL || out == NULL) {
-    ssFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_Sample needs a scene and somewhere to write",
-           scene == NULL ? "scene" : "out");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE, "%s = NULL: ssScene_Sample needs a scene and somewhere to write",
+              scene == NULL ? "scene" : "out");
     return;
   }
   scene->desc->sample(scene->state, out);
@@ -420,7 +420,7 @@ void ssScene_Sample(const ssScene* scene, double* out) {
 
 double ssScene_Time(const ssScene* scene) {
   if (scene == NULL) {
-    ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read the time of");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read the time of");
     return NAN;
   }
   return scene->time_s;
@@ -433,7 +433,7 @@ void ssSceneSetStepObserver(ssScene* scene, ssSceneStepCallback* observer, void*
 
 const char* ssScene_Broken(const ssScene* scene) {
   if (scene == NULL) {
-    ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read the sanity bounds of");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read the sanity bounds of");
     return NULL;
   }
   return scene->broken ? scene->broken_message : NULL;
@@ -441,7 +441,7 @@ const char* ssScene_Broken(const ssScene* scene) {
 
 double ssScene_BoundUse(const ssScene* scene) {
   if (scene == NULL) {
-    ssFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read the sanity bounds of");
+    ssLabFail(SS_ERROR_OUT_OF_RANGE, "scene = NULL: no scene to read the sanity bounds of");
     return NAN;
   }
   return scene->bound_use;

@@ -6,7 +6,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "error.h"
+#include "lab_error.h"
 #include "scene_internal.h"
 
 ssStatus ssBoxesCreate(const ssSceneWorld* world, const ssSceneParams* params, const char* scene, ssBoxes** out) {
@@ -15,7 +15,7 @@ ssStatus ssBoxesCreate(const ssSceneWorld* world, const ssSceneParams* params, c
   if (boxes == NULL || bodies == NULL) {
     free(boxes);
     free(bodies);
-    return ssFail(SS_ERROR_OUT_OF_MEMORY, "%s: out of memory for %d boxes", scene, params->body_count);
+    return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "%s: out of memory for %d boxes", scene, params->body_count);
   }
   boxes->bodies = bodies;
   dWorldSetGravity(world->world, 0, 0, -params->gravity);

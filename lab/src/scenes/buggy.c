@@ -8,7 +8,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "error.h"
+#include "lab_error.h"
 #include "scene_internal.h"
 
 #define BUGGY_LENGTH_M 0.7
@@ -85,7 +85,7 @@ static ssStatus attachWheel(const ssSceneWorld* world, const ssSceneParams* para
 
 static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, void** state) {
   Buggy* buggy = calloc(1, sizeof *buggy);
-  if (buggy == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "buggy: out of memory");
+  if (buggy == NULL) return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "buggy: out of memory");
   dWorldSetGravity(world->world, 0, 0, -params->gravity);
   ssStatus status = ssRegistry_BindWorld(world->registry, buggy_world_spring, params->mass);
 

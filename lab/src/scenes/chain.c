@@ -8,7 +8,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "error.h"
+#include "lab_error.h"
 #include "scene_internal.h"
 
 #define CHAIN_LINK_M 0.25         /* link length along the chain */
@@ -46,7 +46,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
     free(chain);
     free(links);
     free(hinges);
-    return ssFail(SS_ERROR_OUT_OF_MEMORY, "chain: out of memory for %d links", params->body_count);
+    return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "chain: out of memory for %d links", params->body_count);
   }
   chain->count = params->body_count;
   chain->links = links;

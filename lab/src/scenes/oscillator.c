@@ -6,7 +6,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "error.h"
+#include "lab_error.h"
 #include "scene_internal.h"
 
 /* Sanity bound: the energy above the rest state, E = (1/2) m v^2 + (1/2) k (x - x_rest)^2, at most twice its value
@@ -41,7 +41,7 @@ static double energy(const Oscillator* osc, double x_m, double v_m_per_s, double
 
 static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, void** state) {
   Oscillator* osc = calloc(1, sizeof *osc);
-  if (osc == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "oscillator: out of memory");
+  if (osc == NULL) return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "oscillator: out of memory");
   /* "down" is -x, along the slider: gravity then shifts the spring's rest point to -m g / k. */
   dWorldSetGravity(world->world, -params->gravity, 0, 0);
 

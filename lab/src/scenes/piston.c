@@ -13,7 +13,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "error.h"
+#include "lab_error.h"
 #include "scene_internal.h"
 
 #define PISTON_HEIGHT_M 1.0          /* the slider's axis: x, at this height */
@@ -55,7 +55,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
   ssStatus status = ssImplicitEulerSoftness(params->spring, SS_PROGRAM_TUNED_STEP_S, &stop);
   if (status != SS_OK) return status;
   Piston* piston = calloc(1, sizeof *piston);
-  if (piston == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "piston: out of memory");
+  if (piston == NULL) return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "piston: out of memory");
   *state = piston;
   dWorldSetGravity(world->world, 0, 0, -params->gravity);
   dWorldSetERP(world->world, PISTON_WORLD_ERP);

@@ -13,7 +13,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "error.h"
+#include "lab_error.h"
 #include "scene_internal.h"
 
 #define STACK_MAX_CONTACTS 4
@@ -68,7 +68,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
     free(stack);
     free(boxes);
     free(sides);
-    return ssFail(SS_ERROR_OUT_OF_MEMORY, "stack: out of memory for %d boxes", params->body_count);
+    return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "stack: out of memory for %d boxes", params->body_count);
   }
   *stack = (Stack){.count = params->body_count, .boxes = boxes, .sides_m = sides};
   *state = stack;

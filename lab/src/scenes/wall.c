@@ -12,7 +12,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "error.h"
+#include "lab_error.h"
 #include "scene_internal.h"
 
 #define WALL_SIDE_M 0.4           /* bricks are cubes */
@@ -92,7 +92,7 @@ static ssStatus build(const ssSceneWorld* world, const ssSceneParams* params, vo
     free(wall);
     free(bricks);
     free(starts);
-    return ssFail(SS_ERROR_OUT_OF_MEMORY, "wall: out of memory for %d bricks", params->body_count);
+    return ssLabFail(SS_ERROR_OUT_OF_MEMORY, "wall: out of memory for %d bricks", params->body_count);
   }
   *wall = (Wall){.count = params->body_count, .bricks = bricks, .starts = starts, .gravity = params->gravity};
   *state = wall;
