@@ -15,10 +15,12 @@
 #include <ode/ode.h>
 
 #include <cmath>
+#include <string>
 #include <thread>
 #include <vector>
 
 #include "steadystep/spring.h"
+#include "steadystep/status.h"
 
 namespace {
 
@@ -158,3 +160,18 @@ TEST(Threads, TwoQuickStepWorldsOnTwoThreadsComeToRest) {
 }
 
 }  // namespace
+
+// ssSetLastError (status.h): what code built on the library (the lab) reports is what ssLastError reads, on the thread
+// that reported it, cut at 255 bytes; NULL is "".
+TEST(Threads, SetLastErrorIsReadOnItsOwnThreadCutAt255Bytes) {
+  EXPECT_EQ(ssSetLastError(SS_ERROR_IO, "trace.txt: cannot be opened"), SS_ERROR_IO);
+  std::string other_thread;
+  std::thread([&] {
+    ssSetLastError(SS_ERROR_PARSE, std::string(300, 'x').c_str());
+    other_thread = ssLastError();
+  }).join();
+  EXPECT_STREQ(ssLastError(), "trace.txt: cannot be opened");
+  EXPECT_EQ(other_thread, std::string(255, 'x'));
+  EXPECT_EQ(ssSetLastError(SS_OK, nullptr), SS_OK);
+  EXPECT_STREQ(ssLastError(), "");
+}
