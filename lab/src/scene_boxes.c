@@ -71,6 +71,8 @@ double ssBoxDepth(dBodyID box, double side_m) {
 }
 
 double ssBoxesCheck(const ssBoxes* boxes, double side_m, double of_half_side, char* worst, size_t size) {
+  double refused = ssContactRefusedCheck(&boxes->recipe, worst, size);
+  if (refused > 0) return refused;
   const double bound_m = of_half_side * 0.5 * side_m;
   double deepest_m = -INFINITY;
   int deepest = 0;

@@ -1,6 +1,8 @@
 /* The near callback shared by the scenes that touch the ground: every contact is softened by one spring for the
  * step the stepper is about to take, so contact softness follows the policy like every other soft row. */
 
+#include <stdio.h>
+
 #include "scene_internal.h"
 
 typedef struct CollideCall {
@@ -22,11 +24,16 @@ static void nearCallback(void* data, dGeomID geom1, dGeomID geom2) {
     dContact* contact = &contacts[i];
     contact->surface.mode = recipe->surface_mode;
     contact->surface.mu = recipe->mu;
-    /* Only a validated spring gets here, and an accurate mapping that cannot serve a contact hands it to the
-     * implicit-Euler mapping: softening cannot fail, so no contact is dropped. */
+    /* A contact ssContactSoften refuses (a spring ODE cannot take at this step, a collider's non-finite point) is
+     * dropped and counted, never made: left as it is, its surface would be a hard contact, harder than the spring. */
     const ssStepInfo* step = &call->step;
-    ssContactSoften(contact, body1, body2, recipe->spring, step->mapping, step->softness_step_s,
-                    step->previous_step_s);
+    ssStatus status = ssContactSoften(contact, body1, body2, recipe->spring, step->mapping, step->softness_step_s,
+                                      step->previous_step_s);
+    if (status != SS_OK) {
+      if (recipe->refused_count++ == 0)
+        snprintf(recipe->refused_message, sizeof recipe->refused_message, "%s", ssLastError());
+      continue;
+    }
     if (contact->geom.depth > recipe->deepest_m) recipe->deepest_m = contact->geom.depth;
     dJointID joint = dJointCreateContact(recipe->world, recipe->contacts, contact);
     dJointAttach(joint, body1, body2);
@@ -71,4 +78,11 @@ static void tunedNearCallback(void* data, dGeomID geom1, dGeomID geom2) {
 void ssTunedContactsCollide(ssTunedContacts* recipe, ssStepper* stepper) {
   TunedCall call = {recipe, stepper};
   dSpaceCollide(recipe->space, &call, tunedNearCallback);
+}
+
+double ssContactRefusedCheck(const ssContactRecipe* recipe, char* worst, size_t size) {
+  if (recipe->refused_count == 0) return 0;
+  ssBoundMessage(worst, size, "%d contacts refused by ssContactSoften, dropped; the first: %s", recipe->refused_count,
+                 recipe->refused_message);
+  return SS_CONTACT_REFUSED_BOUND_USE;
 }

@@ -93,12 +93,20 @@ typedef struct ssContactRecipe {
   double mu;            /* Coulomb friction coefficient (dContactApprox1: force ratio) */
   double deepest_m;     /* out: the deepest contact of the last collide call (m) */
   int contact_count;    /* out: contacts made by the last collide call */
+  int refused_count;    /* out: contacts ssContactSoften refused since the scene was built (dropped, not made) */
+  char refused_message[128]; /* out: the first refusal's ssLastError */
 } ssContactRecipe;
 
 #define SS_MAX_PAIR_CONTACTS 8
 
 /* Runs dSpaceCollide on recipe->space and softens every contact for the stepper's current step. */
 void ssContactCollide(ssContactRecipe* recipe, const ssStepper* stepper);
+
+/* A sanity bound for the scenes that use a recipe: 0 while ssContactSoften refused no contact, else
+ * SS_CONTACT_REFUSED_BOUND_USE (beyond the bound, finite so that the run's bound_use stays a number in JSON), naming
+ * the count and the first refusal in worst: the run ends broken with the reason. */
+#define SS_CONTACT_REFUSED_BOUND_USE 2.0
+double ssContactRefusedCheck(const ssContactRecipe* recipe, char* worst, size_t size);
 
 /* Contacts as an ODE program tunes them at 60 fps (the scenes written as programs): every contact gets this surface,
  * and ssStepper_SoftenContact turns its soft ERP/CFM (or the world's, where a mode bit is not set) into the softness

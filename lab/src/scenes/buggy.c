@@ -145,6 +145,8 @@ static void sample(const void* state, double* out) {
 /* The largest of the three bounds' ratios; worst names the part that reached it. */
 static double check(const void* state, char* worst, size_t size) {
   const Buggy* buggy = state;
+  double refused = ssContactRefusedCheck(&buggy->recipe, worst, size);
+  if (refused > 0) return refused;
   const dReal* position = dBodyGetPosition(buggy->chassis);
   const dReal* rotation = dBodyGetRotation(buggy->chassis);
   double sink_m = 0.5 * (BUGGY_LENGTH_M * fabs(rotation[8]) + BUGGY_WIDTH_M * fabs(rotation[9]) +
