@@ -108,7 +108,9 @@ another mapping).</p>
 bound joint row counted once per physics step, and every contact softened with ssStepper_SoftenContact. Served by the
 mapping: matched or exact gave the row its softness; handed to matched: exact found no finite softness at that step
 length; handed to implicit Euler: above the step's Nyquist frequency, undamped, no effective mass, a static load, or
-no finite softness. Where the mapping serves nothing, the policy is implicit Euler at its cost. Scenes with nothing
+no finite softness. They serve springs a program binds itself, free or with a declared load (the oscillator; the
+buggy's suspension, its load declared); every adopted row and every contact of the programs measured is handed on.
+Where the mapping serves nothing, the policy is implicit Euler at 1.035 times its instructions. Scenes with nothing
 bound and no contact softened through the stepper are left out.</p>
 {% endif %}
 {% if side_by_side %}
