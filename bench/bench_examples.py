@@ -4,9 +4,10 @@ quantities depend on the frame rate, how far they are from a fine-step reference
 Usage: .venv/bin/python bench/bench_examples.py [BUILD_DIR] [--repeats N] [--boxes N] [--cost-seconds S]
        [--vehicle-seconds S] [--skip-cost | --cost-only] [--instructions] [--executor WHERE]
 
-1-2. Frame-rate spread and accuracy: `steadystep audit` (python/steadystep/audit.py, docs/audit.md) of each adopted
-   program with its *_ode twin as its own stepping, under the profiles fixed:60, fixed:30 and uniform:15:45 (seeds 1,
-   2, 3), 10 s, the policies implicit-euler, matched, exact and fixed (max step 1/60 s), so that the bench's numbers
+1-2. Frame-rate spread and accuracy: `steadystep audit` (python/steadystep/audit/comparison.py, docs/audit.md) of each
+   adopted program with its *_ode twin as its own stepping, under the profiles fixed:60, fixed:30 and uniform:15:45
+   (seeds 1, 2, 3), 10 s, the policies implicit-euler, matched, exact and fixed (max step 1/60 s), so that the bench's
+   numbers
    are the audit's (docs/audit.md, "What it measures"): each quantity over its scale (its range over the own stepping
    runs and the fine-step reference, the adopted program under implicit-euler with 1 ms frames); spread = each run
    against the variant's fixed:60 run, at the simulated times they share when they share most of them, else
@@ -176,12 +177,12 @@ def main() -> None:
     parser.add_argument("--cost-only", action="store_true", help="the cost tables only")
     parser.add_argument("--instructions", action="store_true",
                         help="also count the cost runs' instructions with callgrind (needs valgrind)")
-    parser.add_argument("--executor", default="local", help="where the audit's runs go (study.py; default local)")
+    parser.add_argument("--executor", default="local", help="where the audit's runs go (lab/study.py; default local)")
     args = parser.parse_args()
     build = pathlib.Path(args.build).resolve()
     print(f"bench_examples: {machine()}")
     if not args.cost_only:
-        from steadystep._native import SteadystepError
+        from steadystep.core._native import SteadystepError
 
         try:
             frame_rate_tables(build, args.executor)

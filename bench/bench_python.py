@@ -27,8 +27,8 @@ import sys
 import time
 from pathlib import Path
 
-from steadystep import runs
-from steadystep.profiles import Profile
+from steadystep.lab import runs
+from steadystep.lab.profiles import Profile
 
 PROFILE = "uniform:15:45"
 SEED = 1
@@ -76,7 +76,7 @@ def frame_overhead() -> None:
     import odepy
 
     import steadystep as ss
-    from steadystep._native import check, ffi, lib
+    from steadystep.core._native import check, ffi, lib
 
     odepy.dInitODE2(0)
     stepping = ss.Stepping(solver=ss.Solver.QUICK)
@@ -230,7 +230,7 @@ class OdepyProgram:
 
 def _contact_run(program, variant: str) -> tuple[float, bytes, int]:
     """One run of CONTACT_FRAMES frames from ODE's generator at seed 1: (thread CPU s, the final state, contacts)."""
-    from steadystep import _libode
+    from steadystep.core import _libode
 
     _libode.ode().dRandSetSeed(1)  # naive leaves QuickStep's row order to ODE's generator, as the own loop does
     made, frame, stepper = program.build(variant)

@@ -29,7 +29,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from steadystep import cost, report, study
+from steadystep import report
+from steadystep.lab import cost, study
 
 
 def machine() -> str:

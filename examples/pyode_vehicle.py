@@ -26,7 +26,7 @@ import sys
 import ode
 
 import steadystep as ss
-from steadystep.pyode import Param  # ODE 0.16's joint parameter numbers: Debian's ode.ParamFMax2 is ODE 0.15's
+from steadystep.core.pyode import Param  # ODE 0.16's joint parameter numbers: Debian's ode.ParamFMax2 is ODE 0.15's
 
 TUNED_STEP_S = 1.0 / 60.0  # the frame time the program's ERP/CFM were tuned at
 WHEEL_SPEED_RAD_S = 10.0   # the motors' target: the car rolls toward +x

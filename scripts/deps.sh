@@ -43,7 +43,7 @@ if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
   "$venv/bin/pip" install --quiet --upgrade pip
 fi
-# The build needs cffi itself: it parses the headers into the binding (python/steadystep/_cdef_build.py).
+# The build needs cffi itself: it parses the headers into the binding (python/steadystep/core/_cdef_build.py).
 "$venv/bin/pip" install --quiet scikit-build-core cffi
 # test: pytest and ode-python (the tests' own ODE worlds); report: matplotlib and tqdm (figures, the report);
 # dask: Dask distributed, so that the tests run studies on a real (local) cluster.

@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from steadystep._native import SteadystepError, one_line, printable
-from steadystep.limits import MAX_RUN_STEPS, MIN_MEASURED_DURATION_S
+from steadystep.core._native import SteadystepError, one_line, printable
+from steadystep.lab.limits import MAX_RUN_STEPS, MIN_MEASURED_DURATION_S
 
 EXIT_FAILED_RUN = 1  # the run blew up or broke (its records are still written)
 EXIT_BAD_INPUT = 2
@@ -130,9 +130,9 @@ def _executor_argument(parser: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     # Every list below is the library's (scenes, policies, profiles): no second list here.
-    from steadystep.probe import default_policies
-    from steadystep.profiles import DEFAULT_PROFILES
-    from steadystep.runs import policy_names, scene_names
+    from steadystep.lab.probe import default_policies
+    from steadystep.lab.profiles import DEFAULT_PROFILES
+    from steadystep.lab.runs import policy_names, scene_names
 
     parser = _Parser(prog="steadystep", description="Frame-rate independent constraint softness for ODE: the "
                      "article's figure, comparisons on real ODE scenes, single runs and conversions.",
@@ -162,7 +162,7 @@ def build_parser() -> argparse.ArgumentParser:
     compare.add_argument("--scenes", nargs="+", metavar="SCENE", help="default: every scene")
     compare.add_argument("--profiles", nargs="+", metavar="SPEC", default=list(DEFAULT_PROFILES),
                          help=f"frame-time profiles (default: {' '.join(DEFAULT_PROFILES)})")
-    from steadystep.runs import policy_names  # the library's names: no second list here
+    from steadystep.lab.runs import policy_names  # the library's names: no second list here
     compare.add_argument("--policies", nargs="+", metavar="POLICY",
                          help=f"default: every policy the library names ({' '.join(policy_names())})")
     compare.add_argument("--duration", type=_measured_duration, default=5.0, metavar="S",
@@ -216,7 +216,7 @@ def build_parser() -> argparse.ArgumentParser:
     probe.add_argument("--json", action="store_true", help="strict JSON on stdout")
     _executor_argument(probe)
 
-    from steadystep import audit_cli  # the audit's arguments live with it
+    from steadystep.audit import cli as audit_cli  # the audit's arguments live with it
     audit_cli.add_parser(commands, _seed, _executor_argument)
 
     convert = commands.add_parser("convert", help="springs <-> ERP/CFM <-> frequency and damping ratio",
@@ -302,7 +302,7 @@ def _require_report_extra(command: str, modules: tuple[str, ...] = REPORT_EXTRA)
 @contextlib.contextmanager
 def _executor(command: str, spec: str):
     """study.make_executor(spec), refused in one line (exit 2) when it cannot be had."""
-    from steadystep import study
+    from steadystep.lab import study
 
     try:
         with study.make_executor(spec) as executor:
@@ -313,7 +313,7 @@ def _executor(command: str, spec: str):
 
 def _figure(args, argv) -> int:
     _require_report_extra("figure", ("matplotlib",))
-    from steadystep.figures import article_figure
+    from steadystep.report.figures import article_figure
 
     args.out.mkdir(parents=True, exist_ok=True)
     for path in article_figure(args.out, args.duration, args.seed):
@@ -327,13 +327,15 @@ REPORT_FILES = ("report.html", "index.html", "metrics.json", "metrics.csv")
 
 def _compare(args, argv) -> int:
     _require_report_extra("compare")
-    from steadystep import report, report_progress
-    from steadystep.figures import article_figure
+    from steadystep import report
+    from steadystep.report.validate import validate as report_validate
+    from steadystep.report import progress as report_progress
+    from steadystep.report.figures import article_figure
 
     grid = {axis: values for axis, values in (("stiffness", args.stiffness), ("damping", args.damping),
                                               ("max_step_s", args.max_step)) if values}
     # Everything checked before any directory is made or any worker started.
-    report.validate(args.scenes, args.profiles, args.policies, args.duration, args.seed, grid)
+    report_validate(args.scenes, args.profiles, args.policies, args.duration, args.seed, grid)
     found = [args.out / name for name in REPORT_FILES if os.path.lexists(args.out / name)]
     if found and not args.force:  # a link planted there counts as a file: replaced only when forced, never followed
         raise _UsageError(f"steadystep compare: {found[0]}: an earlier report is there; pass --force to replace it, "
@@ -351,7 +353,7 @@ def _compare(args, argv) -> int:
 
 
 def _run(args, argv) -> int:
-    from steadystep import runs
+    from steadystep.lab import runs
     from steadystep.files import atomic_write_text
 
     stepping = {"max_step_s": args.max_step} if args.max_step else None
@@ -382,7 +384,7 @@ def _run(args, argv) -> int:
 
 
 def _probe(args, argv) -> int:
-    from steadystep import probe, runs
+    from steadystep.lab import probe, runs
 
     runs.scene_info(args.scene)
     for policy in args.policies:
@@ -403,7 +405,7 @@ def _probe(args, argv) -> int:
 
 
 def _conversions(args, given: set[str]) -> dict[str, float]:
-    from steadystep import convert
+    from steadystep.core import convert
 
     out: dict[str, float] = {}
     if {"k", "c"} <= given and not given & {"erp", "cfm", "frequency", "damping_ratio"}:
@@ -464,7 +466,7 @@ def _dispatch(argv: list[str]) -> int:
         args = build_parser().parse_args(argv)
     except SystemExit as done:  # --help: argparse has printed it
         return done.code if isinstance(done.code, int) else 0
-    from steadystep import audit_cli
+    from steadystep.audit import cli as audit_cli
 
     handler = {"figure": _figure, "compare": _compare, "run": _run, "probe": _probe,
                "convert": _convert, "audit": audit_cli.command}[args.command]

@@ -13,7 +13,7 @@ import pytest
 
 import steadystep as ss
 from steadystep import cli
-from steadystep._native import ffi, lib
+from steadystep.core._native import ffi, lib
 
 
 def test_everything_in_all_exists_and_the_package_is_typed():
@@ -100,8 +100,8 @@ def test_every_stepping_field_round_trips_through_c():
 
 
 def test_the_run_bound_is_the_c_librarys():
-    from steadystep.limits import MAX_RUN_FRAMES, MAX_RUN_STEPS
-    header = (Path(ss.__file__).parent / "_native" / "include" / "steadystep" / "lab" / "scene.h").read_text()
+    from steadystep.lab.limits import MAX_RUN_FRAMES, MAX_RUN_STEPS
+    header = (Path(ss.__file__).parent / "core" / "_native" / "include" / "steadystep" / "lab" / "scene.h").read_text()
     assert f"#define SS_MAX_RUN_STEPS {MAX_RUN_STEPS}\n" in header
     assert f"#define SS_MAX_RUN_FRAMES {MAX_RUN_FRAMES}\n" in header
 
@@ -112,7 +112,7 @@ import steadystep
 assert "matplotlib" not in sys.modules and "tqdm" not in sys.modules, "the core imported the report's dependencies"
 import matplotlib
 matplotlib.use("svg")
-import steadystep.figures, steadystep.report
+import steadystep.report.figures, steadystep.report
 assert matplotlib.get_backend() == "svg", matplotlib.get_backend()
 assert matplotlib.rcParams["font.size"] == matplotlib.rcParamsDefault["font.size"]
 print("ok")

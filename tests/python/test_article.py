@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from steadystep import SteadystepError
-from steadystep.article import Oscillator, exact, exact_parameters, integrate
+from steadystep.lab.article import Oscillator, exact, exact_parameters, integrate
 
 OSC = Oscillator(mass=1.0, stiffness=40.0, damping=1.0)
 

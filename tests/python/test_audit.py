@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import audit_claims_check
-from steadystep import snippets
+from steadystep.report import snippets
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILD = ROOT / "build"
@@ -181,7 +181,8 @@ def test_figures_drawn_in_the_pool_are_the_page_figures(tmp_path):
     """audit(draw=True) draws the page's figures in its executor's workers after the runs (so that the process that
     runs the audit need not): they are the very figures this process draws from the same result, and write() puts
     those it finds in the result beside the page instead of drawing them again."""
-    from steadystep import audit, audit_page
+    from steadystep import audit
+    from steadystep.audit import page as audit_page
 
     program = audit.Executable((str(BUILD / "steadystep_example_chain_steadystep"),),
                                own=(str(BUILD / "steadystep_example_chain_ode"),))

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from steadystep.audit_run import BadProgram, parse_csv
+from steadystep.audit.run import BadProgram, parse_csv
 
 SCRIPT = Path(sys.executable).parent / "steadystep"
 COMMAND = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "steadystep.cli"]

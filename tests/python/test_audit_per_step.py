@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from steadystep import audit
-from steadystep.audit_run import STEP_COLUMN, TIME_COLUMN, BadProgram, run
-from steadystep.stepping import policy_names
+from steadystep.audit.run import STEP_COLUMN, TIME_COLUMN, BadProgram, run
+from steadystep.core.stepping import policy_names
 
 PROGRAM = '''
 import ctypes
@@ -117,7 +117,7 @@ def test_the_recommendation_ends_with_the_code_to_write(tmp_path):
     import sys
     from pathlib import Path
 
-    from steadystep import snippets
+    from steadystep.report import snippets
 
     script = Path(sys.executable).parent / "steadystep"
     command = [str(script)] if script.exists() else [sys.executable, "-m", "steadystep.cli"]

@@ -77,7 +77,7 @@ def audit(out: Path, program: Path, *args, own: Path | None = None) -> dict:
 
 def run_csv(program, variant: str, profile: str, seed: int, duration: float) -> dict:
     """One run's columns: program is an audit_run.Executable or PythonProgram, or a path (its own stepping itself)."""
-    from steadystep.audit_run import Executable, run
+    from steadystep.audit.run import Executable, run
 
     if isinstance(program, Path):
         program = Executable((str(program),), (str(program),))
@@ -239,7 +239,7 @@ def test_project_examples(example, tmp_path):
     """The project's game-like example, its program that substeps itself (three dWorldStep a frame, naive its own
     stepping bit for bit), the chaotic pendulum, the chain against its plain-ODE twin, and the Python slider with its
     own_frame."""
-    from steadystep.audit_run import Executable, PythonProgram
+    from steadystep.audit.run import Executable, PythonProgram
 
     name, own = EXAMPLES[example]
     if isinstance(name, Path):

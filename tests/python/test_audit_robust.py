@@ -80,7 +80,7 @@ def test_a_pyode_world_audits_in_processes_of_its_own(tmp_path):
     process of its own that ends without a collection, so none crashes, and imports no other binding than the
     program's (needs the package to take PyODE worlds)."""
     ode = pytest.importorskip("ode")
-    steadystep_pyode = pytest.importorskip("steadystep.pyode")  # noqa: F841 - the binding's support, issue 29
+    steadystep_pyode = pytest.importorskip("steadystep.core.pyode")  # noqa: F841 - the binding's support, issue 29
     del ode
     program = tmp_path / "pyode_ball.py"
     program.write_text(textwrap.dedent('''

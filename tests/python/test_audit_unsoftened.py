@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from steadystep import audit
-from steadystep.audit_run import STEP_COLUMN, UNSOFTENED_COLUMN, run
+from steadystep.audit.run import STEP_COLUMN, UNSOFTENED_COLUMN, run
 
 PROGRAM = '''
 import ctypes

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from steadystep.convert import implicit_euler_softness, spring_from_frequency, spring_from_softness
+from steadystep.core.convert import implicit_euler_softness, spring_from_frequency, spring_from_softness
 
 SCRIPT = Path(sys.executable).parent / "steadystep"
 COMMAND = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "steadystep.cli"]
@@ -36,7 +36,7 @@ def test_every_command_has_help():
 
 def test_help_names_policies_the_library_knows():
     # "spring" was the implicit-Euler policy's name in 0.1.0: help texts must name the policies that exist
-    from steadystep.runs import policy_names
+    from steadystep.lab.runs import policy_names
     known = set(policy_names())
     for command in ("compare", "probe"):
         text = " ".join(steadystep(command, "--help").stdout.split())
@@ -222,7 +222,7 @@ def test_version_is_the_one_in_cmakelists():
 
 
 def test_an_unknown_policy_is_refused_naming_the_known_ones():
-    from steadystep.runs import policy_names
+    from steadystep.lab.runs import policy_names
     result = steadystep("run", "oscillator", "--policy", "smooth", "--profile", "fixed:30", "--duration", "1")
     assert result.returncode == 2 and result.stdout == ""
     assert f'policy "smooth": unknown ({", ".join(policy_names())})' in result.stderr
@@ -230,7 +230,7 @@ def test_an_unknown_policy_is_refused_naming_the_known_ones():
 
 
 def test_the_help_lists_are_the_librarys():
-    from steadystep import probe, runs
+    from steadystep.lab import probe, runs
 
     scenes = ", ".join(runs.scene_names())
     for command in ("compare", "probe", "run"):

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from steadystep import SteadystepError
-from steadystep._native import ffi, lib
-from steadystep.convert import (exact_softness, frequency_from_spring, implicit_euler_softness, matched_softness,
-                                softness_for, spring_from_frequency, spring_from_softness)
+from steadystep.core._native import ffi, lib
+from steadystep.core.convert import (exact_softness, frequency_from_spring, implicit_euler_softness, matched_softness,
+                                     softness_for, spring_from_frequency, spring_from_softness)
 
 
 def test_softness_equals_c_and_the_articles_formula():

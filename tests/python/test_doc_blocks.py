@@ -31,7 +31,7 @@ import pytest
 import steadystep as ss
 
 REPO = Path(__file__).resolve().parents[2]
-INCLUDE = Path(ss.__file__).parent / "_native" / "include"  # the headers the package was built from
+INCLUDE = Path(ss.__file__).parent / "core" / "_native" / "include"  # the headers the package was built from
 NOT_CODE = {"text", "output"}
 CHECKED = {"c", "cpp", "python", "sh", "diff"}
 VARIANTS = {"c fragment", "python compile-only"}  # checked as the module's docstring says

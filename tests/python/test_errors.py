@@ -15,8 +15,8 @@ import odepy
 import pytest
 
 import steadystep as ss
-from steadystep import runs
-from steadystep._native import InvalidValue, SimulationFailure, ffi, lib
+from steadystep.lab import runs
+from steadystep.core._native import InvalidValue, SimulationFailure, ffi, lib
 
 S = ss.Status
 
@@ -111,7 +111,7 @@ def out_of_memory_in_a_child_process():
     script = textwrap.dedent("""
         import resource, sys
         import steadystep as ss
-        from steadystep import runs
+        from steadystep.lab import runs
         size = int(open("/proc/self/statm").read().split()[0]) * resource.getpagesize()
         resource.setrlimit(resource.RLIMIT_AS, (size + 64 * 2**20, resource.RLIM_INFINITY))
         try:

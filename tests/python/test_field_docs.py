@@ -6,7 +6,7 @@ import pydoc
 import pytest
 
 import steadystep
-from steadystep._structs import StructView
+from steadystep.core._structs import StructView
 
 VIEWS = [steadystep.FrameReport, steadystep.StepInfo, steadystep.ContactRuleReport, steadystep.ServedCounts,
          steadystep.ApplyReport, steadystep.AdoptReport]

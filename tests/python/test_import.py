@@ -1,5 +1,5 @@
 """Importing steadystep parses nothing and loads no numpy: the cffi declarations were prepared from the headers when the package was
-built (steadystep/_native_ffi.py, cffi's out-of-line ABI mode), and they are exactly what the installed headers
+built (steadystep/core/_native_ffi.py, cffi's out-of-line ABI mode), and they are exactly what the installed headers
 declare, so the headers stay the one source."""
 
 import subprocess
@@ -9,10 +9,10 @@ from pathlib import Path
 import cffi
 
 import steadystep
-from steadystep import _cdef_build
-from steadystep._native import ffi
+from steadystep.core import _cdef_build
+from steadystep.core._native import ffi
 
-PACKAGE = Path(steadystep.__file__).parent
+PACKAGE = Path(steadystep.__file__).parent / "core"  # the binding: its prepared module, the headers it was built from
 INCLUDE = PACKAGE / "_native" / "include" / "steadystep"
 
 
@@ -30,7 +30,7 @@ def test_the_importtime_of_the_binding_is_the_prepared_module():
     result = subprocess.run([sys.executable, "-X", "importtime", "-c", "import steadystep"], capture_output=True,
                             text=True, timeout=60)
     names = [line.rsplit("|", 1)[1].strip() for line in result.stderr.splitlines() if line.startswith("import time")]
-    assert "steadystep._native_ffi" in names and "steadystep._native" in names
+    assert "steadystep.core._native_ffi" in names and "steadystep.core._native" in names
     assert not [name for name in names if name.startswith("pycparser")]
 
 

@@ -11,7 +11,7 @@ import odepy
 import pytest
 
 import steadystep as ss
-from steadystep.enums import Solver
+from steadystep.core.enums import Solver
 
 
 def multiply(a, b):

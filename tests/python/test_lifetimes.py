@@ -10,7 +10,7 @@ import odepy
 import pytest
 
 import steadystep as ss
-from steadystep._native import ffi, lib
+from steadystep.core._native import ffi, lib
 
 
 @pytest.fixture(scope="module", autouse=True)

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from steadystep import SteadystepError
-from steadystep.article import Oscillator, exact, integrate
-from steadystep.metrics import fit_oscillation, rms_deviation, rms_vs_exact, spread, steps_per_frame
+from steadystep.lab.article import Oscillator, exact, integrate
+from steadystep.lab.metrics import fit_oscillation, rms_deviation, rms_vs_exact, spread, steps_per_frame
 
 OSC = Oscillator(mass=1.0, stiffness=40.0, damping=1.0)
 

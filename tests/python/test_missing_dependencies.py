@@ -44,7 +44,7 @@ def test_importing_without_libode_raises_an_import_error_naming_the_package(no_l
     done = _run([sys.executable, "-c", "import steadystep"], **no_libode)
     assert done.returncode == 1
     assert done.stderr.strip().splitlines()[-1].startswith(
-        "steadystep._native.MissingLibrary: steadystep: cannot load libode.so.8")
+        "steadystep.core._native.MissingLibrary: steadystep: cannot load libode.so.8")
     assert "libode8" in done.stderr
 
 

@@ -121,7 +121,7 @@ def test_the_control_separates_the_cut_from_the_mapping(written):
 def test_markup_is_escaped_unless_marked(written):
     page = written[0].read_text()
     assert "--scenes chain stack &lt;b&gt;&amp;" in page and "stack <b>&" not in page
-    from steadystep import page as page_module, report_html
+    from steadystep.report import recommendation as page_module, html as report_html
 
     assert page_module.bold("<i>") == "<b>&lt;i&gt;</b>"
     assert report_html.policy_cell("a<b").endswith("a&lt;b")
@@ -168,7 +168,7 @@ def test_the_first_screen_ends_with_the_code_for_the_policy_it_recommends(writte
     policy ran), so the code is for the preset most alike across profiles on the most scenes (ties within the spread
     of repeats count for each), the library's order breaking a tie. The lab's control substeps-frozen has no code."""
     import steadystep as ss
-    from steadystep import snippets
+    from steadystep.report import snippets
 
     page, metrics = written[0].read_text(), written[1]
     presets = ss.policy_names()
@@ -192,8 +192,8 @@ def test_the_first_screen_ends_with_the_code_for_the_policy_it_recommends(writte
 
 
 def test_code_for_fixed_when_it_is_the_same_motion_everywhere():
-    from steadystep import page as page_module, report_html, snippets
-    from steadystep.report_model import Report
+    from steadystep.report import recommendation as page_module, html as report_html, snippets
+    from steadystep.report.model import Report
 
     made = Report(scenes=["chain", "stack"], profiles=["fixed:30", "uniform:15:45"],
                   policies={"chain": ["implicit-euler", "fixed-exact", "fixed"], "stack": ["implicit-euler", "fixed",
@@ -231,7 +231,7 @@ def test_the_animation_renders_and_moves(written, tmp_path):
     frame = re.search(r'id="animation-player" data-frame="(\d+)"', dom)
     assert frame and int(frame.group(1)) >= 30, dom[:300]
     lines = re.findall(r'<polyline class="chain" data-panel="\d" [^>]*points="([^"]*)"', dom)
-    from steadystep import animation
+    from steadystep.report import animation
 
     # The reference and each policy, fixed among them (drawn from the interpolated poses): pivot + 8 links.
     assert "fixed" in animation.POLICIES
@@ -258,7 +258,8 @@ def _legend(figure) -> list[str]:
 
 
 def test_a_run_that_leaves_the_axes_is_marked_and_the_legend_says_only_what_is_drawn():
-    from steadystep import figures, runs
+    from steadystep.report import figures
+    from steadystep.lab import runs
 
     reference = runs.reference_run("chain", 3.0)
     results = {(profile, policy): runs.run("chain", profile, policy, 3.0)
@@ -298,8 +299,8 @@ def test_a_run_that_leaves_the_axes_is_marked_and_the_legend_says_only_what_is_d
 
 
 def test_parameters_read_as_names_not_json_with_enum_integers():
-    from steadystep import runs
-    from steadystep.report_html import readable_settings
+    from steadystep.lab import runs
+    from steadystep.report.html import readable_settings
 
     text = readable_settings(runs.reference_stepping())
     assert "cut = substeps" in text and "solver = quick" in text and "mapping = implicit-euler" in text
@@ -311,7 +312,8 @@ def test_the_stable_step_line_says_where_the_best_is_beaten():
     """Ranked on the hardest scene and the geometric mean, the best policy may still be beaten on one scene."""
     import types
 
-    from steadystep import page, probe
+    from steadystep.report import recommendation as page
+    from steadystep.lab import probe
 
     # Both tie on the hardest scene (drop); matched has the larger geometric mean, naive goes further on the chain.
     stable = {"buggy": {"naive": 0.080, "matched": 0.103}, "chain": {"naive": 0.0271, "matched": 0.0265},
@@ -328,7 +330,7 @@ def test_the_stable_step_line_says_where_the_best_is_beaten():
 def test_a_broken_run_in_the_animation_says_so_in_its_panel():
     """The naive chain leaves its sanity bounds at 15-45 fps: its panel is labelled broken, with the time, in red
     (it was animated with no label before)."""
-    from steadystep import animation
+    from steadystep.report import animation
 
     data = animation.record(duration_s=1.0, seed=1)
     naive = next(panel for panel in data["panels"] if panel["policy"] == "naive")
@@ -343,7 +345,8 @@ def test_the_failures_in_a_panels_title_stay_within_the_panel():
     panel): now one status for all reads "broken under every profile", and any list is wrapped to the panel."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    from steadystep import figures, runs
+    from steadystep.report import figures
+    from steadystep.lab import runs
 
     profiles = ["fixed:30", "uniform:15:45", "jitter:30:3", "hitch:60:30:0.1", "vsync:60:30"]
     reference = runs.reference_run("chain", 3.0)
@@ -405,7 +408,7 @@ def test_the_first_screen_answers_in_one_sentence_and_a_picture(written, tmp_pat
 def test_the_first_picture_shows_every_policys_runs_and_consistency():
     """The answer's picture from the report's own numbers: one panel a scene, one tick a policy, one dot a profile's
     run that did not fail, and the consistency above each policy, the recommended policy bold."""
-    from steadystep import page as page_module, report_answer
+    from steadystep.report import recommendation as page_module, answer as report_answer
 
     made = report.Report(scenes=["chain", "stack"], profiles=["fixed:30", "uniform:15:45"],
                          policies={"chain": ["naive", "fixed"], "stack": ["naive", "fixed"]}, duration_s=1.0, seed=1)

@@ -16,7 +16,7 @@ import odepy
 import pytest
 
 import steadystep as ss
-from steadystep.stepper import _takes_the_step
+from steadystep.core.stepper import _takes_the_step
 
 H = 1 / 60  # s: the step the world is tuned for, and the fixed step
 DURATION_S = 2.0

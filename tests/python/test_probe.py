@@ -4,7 +4,8 @@ import math
 
 import pytest
 
-from steadystep import SteadystepError, probe, runs
+from steadystep import SteadystepError
+from steadystep.lab import probe, runs
 
 
 def test_the_bracket_is_tight_and_the_stable_side_is_stable():

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from steadystep import SteadystepError
-from steadystep.profiles import Profile, frame_times
+from steadystep.lab.profiles import Profile, frame_times
 
 
 def test_same_seed_same_frames_other_seed_others():

@@ -28,8 +28,8 @@ except ImportError as error:  # not a silent skip: CI must run these
                       ".venv), or set STEADYSTEP_NO_PYODE=1 to skip these tests on purpose") from error
 
 import steadystep as ss
-from steadystep import _libode, pyode
-from steadystep.enums import Status
+from steadystep.core import _libode, pyode
+from steadystep.core.enums import Status
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "examples"))
@@ -85,7 +85,7 @@ def test_pyode_objects_reach_the_ode_objects_libode_gives():
     other = ode.Body(world)
     hinge = ode.HingeJoint(world)
     hinge.attach(body, other)
-    from steadystep import _handles
+    from steadystep.core import _handles
 
     assert _handles.address("body", "body", body) == LIBODE.dGeomGetBody(geom._id())
     assert _handles.address("world", "world", world) == LIBODE.dBodyGetWorld(LIBODE.dGeomGetBody(geom._id()))

@@ -10,11 +10,13 @@ from pathlib import Path
 
 import pytest
 
-from steadystep import SteadystepError, convert, probe, report, runs
-from steadystep._native import ffi, text
+from steadystep import SteadystepError, report
+from steadystep.core import convert
+from steadystep.lab import probe, runs
+from steadystep.core._native import ffi, text
 from steadystep.cli import EXIT_BAD_INPUT, EXIT_INTERNAL, build_parser, main
-from steadystep.limits import MAX_RUN_STEPS
-from steadystep.profiles import Profile, frame_times
+from steadystep.lab.limits import MAX_RUN_STEPS
+from steadystep.lab.profiles import Profile, frame_times
 
 SCRIPT = Path(sys.executable).parent / "steadystep"
 COMMAND = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "steadystep.cli"]
@@ -220,7 +222,7 @@ def test_the_model_and_the_metrics_raise_only_steadystep_error_whatever_the_numb
 
     import numpy as np
 
-    from steadystep import article, metrics
+    from steadystep.lab import article, metrics
 
     values = [math.nan, math.inf, -math.inf, 1e308, 0.0, 1e-320, -1.0, 40.0, 1e300]
     t = np.linspace(0.0, 1.0, 50)

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from steadystep import cost, study
+from steadystep.lab import cost, study
 
 
 @pytest.mark.parametrize("scene, policy", [("chain", "implicit-euler"), ("drop", "fixed")])

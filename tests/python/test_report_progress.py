@@ -9,7 +9,7 @@ import sys
 import time
 from pathlib import Path
 
-from steadystep import report_progress
+from steadystep.report import progress as report_progress
 
 REPO = Path(__file__).resolve().parents[2]
 STEADYSTEP = Path(sys.executable).with_name("steadystep")

@@ -6,8 +6,10 @@ import math
 import numpy as np
 import pytest
 
-from steadystep import SteadystepError, report, runs
-from steadystep.profiles import Profile
+from steadystep import SteadystepError, report
+from steadystep.lab import runs
+from steadystep.lab.profiles import Profile
+from steadystep.report.aggregate import deviation
 
 
 def test_scenes_and_policies_come_from_the_library():
@@ -113,8 +115,8 @@ def test_statuses_say_how_a_run_ended():
     assert 0 < ok.bound_use < 1
     # The report measures neither: a failed run's deviation is infinite, however close its records were.
     reference = runs.reference_run("chain", 1.0)
-    assert math.isinf(report._deviation(broken, reference, "end x"))
-    assert math.isfinite(report._deviation(ok, reference, "end x"))
+    assert math.isinf(deviation(broken, reference, "end x"))
+    assert math.isfinite(deviation(ok, reference, "end x"))
 
 
 def test_trajectory_starts_at_t0_with_unit_columns():

@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from steadystep import cost, runs
-from steadystep._native import SteadystepError
-from steadystep.profiles import frame_times
+from steadystep.lab import cost, runs
+from steadystep.core._native import SteadystepError
+from steadystep.lab.profiles import frame_times
 
 
 def test_run_counters_count_the_recorded_steps_and_frames():

@@ -1,5 +1,5 @@
-"""The code the audit's recommendation and the report's first screen end with (steadystep.snippets) is real code: each
-C snippet compiles as C and as C++ against the library's headers, each Python snippet runs on an odepy world, for
+"""The code the audit's recommendation and the report's first screen end with (steadystep.report.snippets) is real code:
+each C snippet compiles as C and as C++ against the library's headers, each Python snippet runs on an odepy world, for
 every policy of the library."""
 
 import ctypes
@@ -11,9 +11,9 @@ import odepy
 import pytest
 
 import steadystep as ss
-from steadystep import snippets
+from steadystep.report import snippets
 
-INCLUDE = Path(ss.__file__).parent / "_native" / "include"  # the headers the package was built from
+INCLUDE = Path(ss.__file__).parent / "core" / "_native" / "include"  # the headers the package was built from
 COMPILER = {"c": shutil.which("cc"), "c++": shutil.which("c++")}
 
 C_PROGRAM = """#include <steadystep/steadystep.h>

@@ -11,7 +11,8 @@ import time
 
 import pytest
 
-from steadystep import SteadystepError, probe, runs, study
+from steadystep import SteadystepError
+from steadystep.lab import probe, runs, study
 from test_cli import steadystep
 
 # The issue's command (with the policies at hand on every scene).
@@ -62,7 +63,7 @@ def test_an_unknown_executor_is_refused_naming_it(spec):
 
 
 def test_importing_the_package_imports_no_dask():
-    code = ("import sys, steadystep, steadystep.study, steadystep.report, steadystep.probe, steadystep.cli; "
+    code = ("import sys, steadystep, steadystep.lab.study, steadystep.report, steadystep.lab.probe, steadystep.cli; "
             "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert result.returncode == 0 and result.stdout.strip() == "[]", result.stderr
@@ -167,6 +168,6 @@ def test_the_local_pools_workers_start_with_the_study_modules_already_imported()
     """Forked from a server that preloaded them: a worker's first unit finds steadystep's units and matplotlib
     imported (they are not imported by the unit itself: sys.modules.__contains__ imports nothing)."""
     with study.make_executor("local") as pool:
-        for name in ("steadystep.report_tasks", "matplotlib"):
+        for name in ("steadystep.report.tasks", "matplotlib"):
             assert pool.submit(_imported, name).result(), name
     assert study.capacity(study.SerialExecutor()) == study.usable_cores()
