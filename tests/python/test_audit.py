@@ -5,7 +5,6 @@ Each page's recommendation is checked claim by claim against its own metrics.jso
 (audit_claims_check.py), and the audit's numbers for an example equal those recomputed here from the programs' own
 CSV with the definitions of docs/audit.md."""
 
-import html
 import json
 import subprocess
 import sys
@@ -13,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from markupsafe import escape  # as the page escapes its text (Jinja2, autoescape)
 
 import audit_claims_check
 from steadystep.report import snippets
@@ -69,8 +69,8 @@ def test_example_page_agrees_with_its_tables(examples, program):
     section = page[page.index("<section id='recommendation'>"):]
     section = section[:section.index("</section>")]
     assert section.index(f"<h3 id='code'>The code to write for {policy}</h3>") > section.index("</ul>")
-    assert section.index(html.escape(c.text)) < section.index(html.escape(python.text))
-    assert section.endswith(f"<code>{html.escape(python.text)}</code></pre>")
+    assert section.index(escape(c.text)) < section.index(escape(python.text))
+    assert section.endswith(f"<code>{escape(python.text)}</code></pre>")
     # The adopted programs move alike at every frame rate; their own stepping does not (docs/examples.md).
     spread = metrics["spread"]
     assert max(spread["implicit-euler"].values()) < max(spread["own"].values())

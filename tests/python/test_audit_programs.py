@@ -9,7 +9,6 @@ Every claim is also checked against the tables by an independent reader (audit_c
 link the installed core alone (no lab) and take part through steadystep/audit/protocol.h: built here against an
 install of build/ when the build has not made them."""
 
-import html
 import json
 import math
 import shutil
@@ -19,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from markupsafe import escape  # as the page escapes its text (Jinja2, autoescape)
 
 import audit_claims_check
 
@@ -70,7 +70,7 @@ def audit(out: Path, program: Path, *args, own: Path | None = None) -> dict:
     assert f"<h2>own stepping and {recommended} at every audited frame rate</h2>" in page
     assert page.count("<img ") == min(len(metrics["deciding"]), 4) + 1
     for claim in metrics["claims"]:  # each claim on the page, linked to a table that is there
-        assert html.escape(claim["text"]) in page
+        assert escape(claim["text"]) in page
         assert f"href='#{claim['table']}'" in page and f"id='{claim['table']}'" in page
     return metrics
 

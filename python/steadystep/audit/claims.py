@@ -111,6 +111,11 @@ def _ranked(values: dict) -> str:
                      for v, (x, q) in sorted(values.items(), key=lambda item: (math.isnan(item[1][0]), item[1][0])))
 
 
+def recommended(result) -> str | None:
+    """The policy the recommendation names (its "recommend" claim), or None when it names none."""
+    return next((c["variant"] for c in result.claims if c["kind"] == "recommend"), None)
+
+
 def claims(result) -> list[dict]:
     tables = Tables(result)
     out = [_reference(result), _failed(result)]

@@ -36,6 +36,7 @@ from steadystep.core._native import SteadystepError, printable
 from steadystep.audit.run import (DIAGNOSIS_FLAGS, HALF_STEP, MORE_ITERATIONS, OWN, SERVED_COLUMNS, STEP_COLUMN,
                                   TIME_COLUMN, UNSOFTENED_COLUMN, BadProgram, Executable, PythonProgram, PythonWorld,
                                   Run)
+from steadystep.audit.claims import claims, recommended
 from steadystep.audit.run import run as run_program
 from steadystep.audit.run import supports
 from steadystep.core.enums import Status
@@ -412,7 +413,6 @@ def measure(program, variants: list[str], runs_per_variant, duration_s: float, d
     result.not_measured = dict(not_measured or {})
     result.trajectories = {"reference": reference.columns, "check": check.columns,
                            **{(v, p, s): done[v, p, s].columns for v in variants for p, s in runs_per_variant}}
-    from steadystep.audit.claims import claims
 
     result.claims = claims(result)
     return result
@@ -468,11 +468,6 @@ def _cost(done: dict, variants: list[str], method: str, cost_profile) -> dict:
             out["samples"][v] = samples
             out["noise"][v] = max(samples) - min(samples)
     return out
-
-
-def recommended(result: Audit) -> str | None:
-    """The policy the recommendation names (its "recommend" claim), or None when it names none."""
-    return next((c["variant"] for c in result.claims if c["kind"] == "recommend"), None)
 
 
 def code_to_write(result: Audit) -> str:

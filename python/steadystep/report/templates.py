@@ -238,5 +238,13 @@ in grey behind them, the reference at the same time.</figcaption>
 """
 
 TEMPLATES = {"table.html": _TABLE, "report.html": _REPORT, "animation.html": _ANIMATION}
-ENVIRONMENT = jinja2.Environment(loader=jinja2.DictLoader(TEMPLATES), autoescape=True, trim_blocks=True,
-                                 lstrip_blocks=True, undefined=jinja2.StrictUndefined)
+
+
+def environment(templates: dict[str, str]) -> jinja2.Environment:
+    """The pages' environment over these templates: autoescape on, an undefined name an error rather than an empty
+    string, block tags taking their line with them. The report's and the audit's pages (audit/templates.py)."""
+    return jinja2.Environment(loader=jinja2.DictLoader(templates), autoescape=True, trim_blocks=True,
+                              lstrip_blocks=True, undefined=jinja2.StrictUndefined)
+
+
+ENVIRONMENT = environment(TEMPLATES)
