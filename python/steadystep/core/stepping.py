@@ -12,7 +12,6 @@ SteadystepError naming the field.
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
 from steadystep.core._native import SteadystepError, c_string, check, ffi, integer, lib, number, shown, text
@@ -20,10 +19,15 @@ from steadystep.core.enums import FrameCut, Mapping, Solver, Status
 
 _DEFAULT = lib.ssDefaultStepping()
 _INT_RANGE = (-2**31, 2**31 - 1)
+# The C struct's fields and their C types, from the binding (the headers): the conversions below follow them, so the
+# dataclass spells each field once, with its unit and default (tests/python/test_api.py: the same fields in order).
+_C_FIELDS = {name: field.type.cname for name, field in ffi.typeof("ssStepping").fields}
+_ENUMS = {"cut": FrameCut, "mapping": Mapping, "solver": Solver}  # the enum fields' Python enums (enums.py)
 
 
 def policy_names() -> list[str]:
-    """The library's named presets (naive, implicit-euler, matched, exact, fixed, fixed-matched, fixed-exact)."""
+    """The library's named presets, in its order (stepping.h: ssSteppingPolicyNameAt), read from the library so that
+    no list here goes stale: naive first, the lab's control substeps-frozen among them."""
     return [text(lib.ssSteppingPolicyNameAt(i)) for i in range(lib.ssSteppingPolicyCount())]
 
 
@@ -66,23 +70,16 @@ class Stepping:
 
     @classmethod
     def from_c(cls, cdata) -> "Stepping":
-        """The Stepping of a C ssStepping."""
-        return cls(cut=FrameCut(cdata.cut), mapping=Mapping(cdata.mapping), frozen_step_s=cdata.frozen_step_s,
-                   solver=Solver(cdata.solver), quick_iterations=cdata.quick_iterations, max_step_s=cdata.max_step_s,
-                   fixed_step_s=cdata.fixed_step_s, max_step_slack=cdata.max_step_slack,
-                   step_seed=cdata.step_seed, max_steps_per_frame=cdata.max_steps_per_frame,
-                   max_speed=cdata.max_speed, max_angular_speed=cdata.max_angular_speed)
+        """The Stepping of a C ssStepping: every field of the struct (the binding's), an enum as its Python enum."""
+        return cls(**{name: _ENUMS[name](getattr(cdata, name)) if name in _ENUMS else getattr(cdata, name)
+                      for name in _C_FIELDS})
 
     def as_c_fields(self) -> dict:
-        """The fields as the C struct takes them; SteadystepError naming a field whose value C cannot hold."""
-        out = {}
-        for item in dataclasses.fields(self):
-            value = getattr(self, item.name)
-            if item.type in ("float",):
-                out[item.name] = number(f"stepping.{item.name}", value)
-            else:  # the enums and the counts: C ints; the library names a value outside its range
-                out[item.name] = integer(f"stepping.{item.name}", value, *_INT_RANGE)
-        return out
+        """The fields as the C struct takes them, each checked by its C type (the binding's): a double as a finite
+        or infinite number, an int or enum within C's int; SteadystepError naming a field whose value C cannot
+        hold."""
+        return {name: number(f"stepping.{name}", getattr(self, name)) if _C_FIELDS[name] == "double"
+                else integer(f"stepping.{name}", getattr(self, name), *_INT_RANGE) for name in _C_FIELDS}
 
     def validate(self) -> None:
         """Raises SteadystepError naming the first field out of range (ssValidateStepping)."""
