@@ -2,7 +2,7 @@
 repeats under the next seed, the largest-stable-step probes, the side-by-side table, the animation, the figures and
 the cost benchmark) in one process against a local process pool over every usable core.
 
-For each run it prints the wall time with its phases (report_tasks: runs, figures still drawing after the runs, the
+For each run it prints the wall time with its phases (report/tasks.py: runs, figures still drawing after the runs, the
 cost benchmark's timing, which runs in this process alone either way, with how many of its scene-policy pairs
 stopped before the most blocks because their ranges were tight (cost.TIGHT_RANGE: a quiet machine); "other": the
 rest, in this process: the pool's start-up, the aggregation, the page and the data written), and the CPU time of

@@ -76,7 +76,7 @@ def audit(out: Path, program: Path, *args, own: Path | None = None) -> dict:
 
 
 def run_csv(program, variant: str, profile: str, seed: int, duration: float) -> dict:
-    """One run's columns: program is an audit_run.Executable or PythonProgram, or a path (its own stepping itself)."""
+    """One run's columns: program is an audit.run.Executable or PythonProgram, or a path (its own stepping itself)."""
     from steadystep.audit.run import Executable, run
 
     if isinstance(program, Path):

@@ -399,7 +399,7 @@ def test_the_first_screen_answers_in_one_sentence_and_a_picture(written, tmp_pat
     assert 0 < measured["answer"] <= 900 and 0 < measured["figure"] <= 900, measured
     assert measured["height"] < 15000, measured
     assert "<details id='measured'>" in page and "<details id='parameters'>" in page
-    # The picture is what changes with the frame rate under each policy (report_answer), not one scene's chart; the
+    # The picture is what changes with the frame rate under each policy (report/answer.py), not one scene's chart; the
     # reasons and the code are collapsed below it, one line of summary.
     assert 'id="answer-figure"' in page and "each frame-time profile&#39;s deviation" in page
     assert page.index("<details id='why'>") < page.index("<section id='recommendation'>")

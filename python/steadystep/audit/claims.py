@@ -9,9 +9,9 @@ The rule, in short:
 - a variant's spread (how much its motion changes with the frame rate) is over the whole run, whatever the
   reference does; its deviation (how far from the fine-step reference) only over the time the reference holds, and
   only when the reference is usable (checked by a finer check, physical, held long enough);
-- a variant is summed up by its largest value over the deciding quantities (audit_measure.deciding: error-like
+- a variant is summed up by its largest value over the deciding quantities (measure.deciding: error-like
   quantities of a tiny range do not decide alone), and that quantity is named;
-- one value is better than another only beyond the noise of their difference (audit_measure.noise: the standard
+- one value is better than another only beyond the noise of their difference (measure.noise: the standard
   errors over runs, the repeat's difference, and for deviation the reference's own uncertainty);
 - the recommendation is a policy (never the control substeps-frozen, never a diagnosis variant) none of whose runs
   failed, whose largest spread is within the noise of the smallest; among those, one no worse than the program's

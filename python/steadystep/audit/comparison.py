@@ -94,7 +94,7 @@ class Audit:
     scales: dict = field(default_factory=dict)       # quantity -> the scale every number is divided by
     scale_source: str = "reference"
     deciding: list = field(default_factory=list)      # the quantities that may decide a claim
-    reference: dict = field(default_factory=dict)     # audit_measure.check_reference, sanity and usability
+    reference: dict = field(default_factory=dict)     # measure.check_reference, sanity and usability
     spread: dict = field(default_factory=dict)        # variant -> quantity -> value (whole run)
     spread_runs: dict = field(default_factory=dict)   # variant -> quantity -> per-run values
     spread_error: dict = field(default_factory=dict)  # variant -> quantity -> standard error over its runs
@@ -305,7 +305,7 @@ def audit(program, profiles=DEFAULT_PROFILES, seeds=DEFAULT_SEEDS, policies=None
 
 
 def _draw_figures(result: Audit, executor, progress: bool | None) -> dict:
-    """The page's figures (audit_page.figure_units), drawn through executor: file stem -> PNG bytes."""
+    """The page's figures (page.figure_units), drawn through executor: file stem -> PNG bytes."""
     from steadystep.audit import page as audit_page
     from steadystep.lab import study
 

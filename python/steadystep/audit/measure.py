@@ -2,7 +2,7 @@
 checks (where it holds, whether its check was finer, whether it is physical), the scale of each quantity, which
 quantities decide, spread and deviation with their noise, and the cost.
 
-Plain functions of Run columns (audit_run.Run); no process is started here.
+Plain functions of Run columns (run.Run); no process is started here.
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ not count; the page records the cores and the load beside it (report/html.py: ma
 What the copies step is fixed before any of them is timed, by plan(): the block's length (frames that take about
 BLOCK_TARGET_S plain), the frames, and the stepper's steps over them, counted on a fourth, untimed copy that steps
 the same frames (a third of the benchmark's stepping). Nothing in a plan is timed but the calibration, so a study
-makes the plans in its sweep, wherever its executor runs them, and only the timing runs alone (report_tasks).
+makes the plans in its sweep, wherever its executor runs them, and only the timing runs alone (report/tasks.py).
 """
 
 from __future__ import annotations

@@ -38,7 +38,7 @@ def _row(scene: str, result: runs.RunResult, reference: runs.RunResult, grid: di
 def compare_scene(report: Report, scene: str, done: dict, springs: list[dict], steps: list[dict],
                   probed: bool) -> None:
     """The scene's rows, deviations, consistency, repeat spreads, served counts and probes from its finished runs
-    (done: by task key, report_tasks.tasks)."""
+    (done: by task key, tasks.tasks)."""
     report.params[scene] = done["reference", scene, 0].params
     quantities = runs.motion_quantities(scene)
     policies = report.policies[scene]

@@ -88,7 +88,7 @@ def _status_label(panel: dict) -> str:
 
 def section(data: dict) -> Markup:
     """The HTML of the animation: an SVG with one panel per run and the script that plays them
-    (report_templates: animation.html)."""
+    (templates.py: animation.html)."""
     from steadystep.report.templates import ENVIRONMENT
 
     width, height, pad = 300, 300, 14

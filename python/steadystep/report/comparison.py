@@ -33,11 +33,11 @@ def compare(scenes=None, profiles=DEFAULT_PROFILES, policies=None, duration_s: f
     """Runs every scene under every profile and policy, plus each scene's reference, and measures them.
 
     params: per scene changes to its parameters (default REPORT_PARAMS). progress: on stderr, naming the phase:
-    None, tqdm bars on a terminal and lines off one (a line at least every 10 s with an estimate: report_progress);
+    None, tqdm bars on a terminal and lines off one (a line at least every 10 s with an estimate: progress.py);
     "lines", lines anyway; True, tqdm bars; False, nothing. figure_dir: where to write the figures (None: none drawn). executor: where
     the independent runs, probes, the animation and the figures go, any concurrent.futures.Executor or a name for
     study.make_executor ("local", "dask", ...); None: in this process. The numbers do not depend on it, only the
-    wall times do; the cost benchmark always runs here, alone, after them (report_tasks). grid: values per axis of
+    wall times do; the cost benchmark always runs here, alone, after them (tasks.py). grid: values per axis of
     GRID_AXES (e.g. {"stiffness": [20, 40], "max_step_s": [1/60, 1/30]}): every combination is run, and each row
     carries its values in Row.grid; a scene's spread and consistency are then the largest over the grid's points,
     its figures, parameters, repeats and the animation those of the first point."""

@@ -263,7 +263,7 @@ def answer(report: Report) -> dict | None:
     (the policies whose motion is the same at every frame rate, or the most alike), the recommended policy (the one
     the code is written for) and its cost in one number: the median over the scenes of its CPU time against the
     program's plain loop (one step a frame), with the cores and the load it was measured under; the picture
-    (report_answer): per scene and policy, each profile's deviation from the fine-step reference and the
+    (answer.py): per scene and policy, each profile's deviation from the fine-step reference and the
     consistency, the recommended policy in bold."""
     chosen = page.code_policy(report)
     if chosen is None:

@@ -1,5 +1,5 @@
 """The comparison's results as plain data: one Row per run, and the Report that the aggregation fills and the
-exports (report_export, report_html) read."""
+exports (export.py, html.py) read."""
 
 from __future__ import annotations
 
@@ -55,7 +55,7 @@ class Report:
     costs: list[cost.Cost] = field(default_factory=list)   # one per scene and policy, from one benchmark run
     cost_wall_s: float = 0.0                                # the benchmark's wall time (s)
     animation: dict | None = None                           # animation.record(): the chain to watch
-    # The measured spread of repeats (report_aggregate.repeat_spreads): scene -> policy -> quantity -> how much the
+    # The measured spread of repeats (aggregate.repeat_spreads): scene -> policy -> quantity -> how much the
     # deviation and the consistency moved when the random profiles were run again with the next seed.
     repeat_deviation: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
     repeat_consistency: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
@@ -64,6 +64,6 @@ class Report:
     served: dict[str, dict[str, dict[str, dict[str, int]]]] = field(default_factory=dict)
     not_probed: list[str] = field(default_factory=list)       # scenes the report does not probe (why: NOT_PROBED)
     phases_s: dict[str, float] = field(default_factory=dict)  # wall time of each phase of compare (s)
-    # What the timings ran on (report_tasks.machine_state): cores, the cores this process may use, and the 1-minute
+    # What the timings ran on (tasks.machine_state): cores, the cores this process may use, and the 1-minute
     # load average when compare started and before and after the cost benchmark.
     machine: dict[str, float | None] = field(default_factory=dict)

@@ -19,7 +19,7 @@ profile, else the one most alike across profiles on the most scenes.
 
 A winner is named only where its lead is larger than the measured spread of repeats: for the deviation and the
 consistency, how much each moved when the random profiles were run again with the next seed
-(report_aggregate); for the cost, the ranges over the benchmark's blocks. Otherwise the page says they tie.
+(aggregate.py); for the cost, the ranges over the benchmark's blocks. Otherwise the page says they tie.
 Every piece of markup here is a markupsafe.Markup whose arguments are escaped as they are put in (Markup.format,
 Markup.join): nothing is escaped by hand.
 """

@@ -12,7 +12,7 @@ benchmark, a scene's figures), run wherever the executor puts it. The phases, ea
 3. cost: the benchmark times its plans in this process once every unit is done, so that its timings are taken
    while nothing else of the study runs; the aggregation and the page do not wait for anything else.
 
-Off a terminal every phase writes its progress as lines (report_progress): at least one every 10 s, with an estimate.
+Off a terminal every phase writes its progress as lines (progress.py): at least one every 10 s, with an estimate.
 """
 
 from __future__ import annotations
