@@ -86,13 +86,13 @@ def frame_overhead() -> None:
 
     direct_world, direct_body = _one_body_world()
     definition = ffi.new("ssStepperDef*", lib.ssDefaultStepperDef())
-    definition.world = ffi.cast("dWorldID", ss._handles.address("world", "world", direct_world))
+    definition.world = ffi.cast("dWorldID", ss.core._handles.address("world", "world", direct_world))
     definition.stepping = stepping.as_c_fields()
     definition.tuned_step_s = FRAME_S
     made = ffi.new("ssStepper**")
     check(lib.ssStepper_Create(definition, made))
     direct = made[0]
-    check(lib.ssStepper_WatchBody(direct, ffi.cast("dBodyID", ss._handles.address("body", "body", direct_body))))
+    check(lib.ssStepper_WatchBody(direct, ffi.cast("dBodyID", ss.core._handles.address("body", "body", direct_body))))
     direct_report = ffi.new("ssFrameReport*")
 
     def through_stepper(stepper, frame_s, _):

@@ -173,7 +173,7 @@ def main(argv: list[str] | None = None) -> int:
     print(",".join(["t_s", *names]))
     time_s = 0.0
     print(",".join(repr(v) for v in (time_s, *vehicle.quantities().values())))
-    for frame_s in ss.profiles.frames_within(args.profile, args.duration, args.seed):
+    for frame_s in ss.lab.profiles.frames_within(args.profile, args.duration, args.seed):
         if stepper is None:
             own_step(vehicle, frame_s)
             time_s += frame_s

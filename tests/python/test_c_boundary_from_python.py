@@ -26,7 +26,7 @@ def finishes_cleanly(args, timeout_s=20.0):
 
 
 def python_call(code: str):
-    return finishes_cleanly([sys.executable, "-c", "from steadystep import runs\n" + code])
+    return finishes_cleanly([sys.executable, "-c", "from steadystep.lab import runs\n" + code])
 
 
 @pytest.mark.parametrize("profile", [

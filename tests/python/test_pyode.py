@@ -93,7 +93,7 @@ def test_pyode_objects_reach_the_ode_objects_libode_gives():
     assert _handles.address("space", "space", space) == space._id()
     contact = ode.Contact()
     contact.setMu(0.625)
-    held = _libode.Contact.from_address(int(ss._native.ffi.cast("uintptr_t", _handles.contact("c", contact))))
+    held = _libode.Contact.from_address(int(ss.core._native.ffi.cast("uintptr_t", _handles.contact("c", contact))))
     assert held.surface.mu == 0.625 and held.surface.mode == contact.getMode()
     for name, kind, value, said in (("body", "body", world, "a PyODE World, not a Body"),
                                     ("joint", "joint", geom, "a PyODE GeomBox, not a Joint"),
@@ -184,7 +184,7 @@ def run(profile: str, variant: str, duration_s: float = 2.0) -> bytes:
     vehicle = pyode_vehicle.Vehicle()
     stepper = None if variant == "own" else pyode_vehicle.adopt(vehicle, "naive", variant)
     contacts = 0
-    for frame_s in ss.profiles.frames_within(profile, duration_s, 1):
+    for frame_s in ss.lab.profiles.frames_within(profile, duration_s, 1):
         if stepper is None:
             pyode_vehicle.own_step(vehicle, frame_s)
         else:
