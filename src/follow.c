@@ -14,6 +14,7 @@
 #include "error.h"
 #include "joint_rows.h"
 #include "ode_bounds.h"
+#include "prefetch.h"
 #include "registry_internal.h"
 #include "steadystep/adopt.h"
 
@@ -72,6 +73,16 @@ static ssStatus followRows(ssRegistry* registry, double step_s, FollowedRow** ou
   return SS_OK;
 }
 
+/* A large world's body binding kPrefetchAhead places on asked for: its body's flags, and the auto-disable and damping
+ * numbers ODE 0.16 keeps a few lines past the torque accumulator (dxBody: a hint; another layout costs a load). */
+static void prefetchBinding(const ssBodyBinding* binding) {
+  if (binding->body == 0) return;
+  const char* torque = (const char*)dBodyGetTorque(binding->body);
+  SS_PREFETCH(binding->body);
+  SS_PREFETCH(torque + 64);
+  SS_PREFETCH(torque + 192);
+}
+
 /* Whether the body binding's numbers in ODE are those the registry last wrote. */
 static int bodyAsWritten(dWorldID world, const ssBodyBinding* binding) {
   ssBodyWritten written;
@@ -117,8 +128,9 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
   int body_count = 0;
   const int bound = ssRegistryBodyBindingCount(registry);
   const ssBodyBinding* bindings = bound > 0 ? ssRegistryBodyAt(registry, 0) : NULL; /* not changed before the end */
-  for (int i = 0; i < bound && status == SS_OK; ++i) {
+  for (int i = 0, until = ssPrefetchUntil(bound); i < bound && status == SS_OK; ++i) {
     const ssBodyBinding* binding = &bindings[i];
+    if (i < until) prefetchBinding(&bindings[i + kPrefetchAhead]);
     int adopted = binding->tuned.damping_step_s > 0 || binding->tuned.auto_disable_step_s > 0;
     /* a sleeping body's values are read when it wakes: ODE neither damps it nor counts its idle steps, and Apply
      * writes it no more than this reads it (ssRegistryWriteBodies) */

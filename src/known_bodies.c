@@ -12,6 +12,7 @@
 #include "array.h"
 #include "gears.h"
 #include "pointer_set.h"
+#include "prefetch.h"
 #include "steadystep/limits.h"
 
 void ssKnownFree(ssKnownBodies* known) {
@@ -244,21 +245,6 @@ void ssKnownForget(ssKnownBodies* known, dBodyID body) {
     else if (known->pushed[p] == last) known->pushed[p] = k;
   }
 }
-
-/* A hint that memory is read soon (GCC, clang); nothing elsewhere. */
-#if defined(__GNUC__)
-#define SS_PREFETCH(address) __builtin_prefetch(address)
-#else
-#define SS_PREFETCH(address) ((void)(address))
-#endif
-
-/* How many bodies ahead the passes ask for a body's memory: a large world's bodies are out of cache after ODE's step
- * or the program's frame, and the loads of several bodies then overlap instead of waiting one after the other. */
-enum { kPrefetchAhead = 8, kPrefetchFrom = 256 };
-
-/* Up to which body a pass over count bodies asks for the one kPrefetchAhead ahead: none for a list that stays in
- * cache. */
-static int prefetchUntil(int count) { return count >= kPrefetchFrom ? count - kPrefetchAhead : 0; }
 
 /* The head of a body's first joint (where ODE keeps its joint list): what dBodyGetJoint reads beyond the body. */
 static void prefetchJoints(const ssKnownBodies* known, int k) {
@@ -519,7 +505,7 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
   CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed,
                       bounds->forces};
   const ssBodyValues* values = known->values;
-  const int count = known->count, until = prefetchUntil(count);
+  const int count = known->count, until = ssPrefetchUntil(count);
   const unsigned check_number = ++known->checks;
   /* one pass reads each body once, marks it and checks what ODE steps (the usual case: all pass; the first failure
    * is found after); a sleeping body's values are not read */
@@ -529,6 +515,7 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
     if (markBody(known, k, &asleep, &unseen))
       all &= bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
   }
+  known->asleep = asleep;
   for (int k = 0; !all && k < count; ++k)
     if (known->reached[k] == check_number && !bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces))
       return nameFailure(known, k, bounds, when, step, steps, failed);
@@ -587,7 +574,7 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   /* last frame's pushed bodies are unmarked through their list: only a pushed body's entry is written */
   for (int p = 0; p < known->pushed_count; ++p) known->bodies[known->pushed[p]].pushed = 0;
   known->pushed_count = 0;
-  const int count = known->count, until = prefetchUntil(count);
+  const int count = known->count, until = ssPrefetchUntil(count);
   const unsigned check_number = ++known->checks;
   /* one pass reads each body once: its joints (a sleeping body's joint may be destroyed too, so every body's are read
    * before a failure is told), its mark, and the state and forces of what ODE steps */
@@ -597,6 +584,7 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
     changed |= jointsChangedAt(known, k);
     if (markBody(known, k, &asleep, &unseen)) all &= startBody(known, k, check.max_speed2, check.max_spin2);
   }
+  known->asleep = asleep;
   if (changed) { /* the caller lists the bodies again, each then checked at the next call, and calls again */
     *joints_changed = 1;
     return SS_OK;

@@ -62,6 +62,7 @@ typedef struct ssKnownBodies {
   unsigned* reached;  /* the check that last met the body through joints (ssKnownCheck's walk) */
   int* queue;         /* that walk's bodies still to visit */
   unsigned checks;    /* checks made, numbering them for reached */
+  int asleep;         /* the bodies the last check found asleep (neither enabled nor awake at the check before) */
   ssPointerMap index; /* body -> its place in the arrays above */
   dSpaceID seen_space; /* the space whose heads the stepper looks at (its def.space, with those nested), or 0 */
   int count, capacity;

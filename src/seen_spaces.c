@@ -50,7 +50,7 @@ static ssStatus listInto(ssSeenSpaces* seen, dSpaceID root, ssPointerMap* bodies
   seen->count = 0;
   if (!ssReserveOne((void**)&seen->spaces, 0, &seen->capacity, sizeof *seen->spaces))
     return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
-  seen->spaces[seen->count++] = (ssSeenSpace){root, 0, 0, 0, 0, 1};
+  seen->spaces[seen->count++] = (ssSeenSpace){.space = root};
   for (int walked = 0; walked < seen->count; ++walked) {
     dSpaceID space = seen->spaces[walked].space;
     ssStatus status = ssCheckSpaceListable(walked == 0 ? "def.space" : "nested space", space);
@@ -62,7 +62,7 @@ static ssStatus listInto(ssSeenSpaces* seen, dSpaceID root, ssPointerMap* bodies
         if (spaceListed(seen, (dSpaceID)geom)) continue;
         if (!ssReserveOne((void**)&seen->spaces, seen->count, &seen->capacity, sizeof *seen->spaces))
           return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory listing the adopted spaces");
-        seen->spaces[seen->count++] = (ssSeenSpace){(dSpaceID)geom, 0, 0, 0, 0, 1};
+        seen->spaces[seen->count++] = (ssSeenSpace){.space = (dSpaceID)geom};
         continue;
       }
       dBodyID body = dGeomGetBody(geom);
@@ -91,7 +91,7 @@ ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone) {
   seen->bodies = bodies;
   seen->geoms = geomsNow(seen);
   seen->listed = 1;
-  ssSeenMark(seen);
+  ssSeenMark(seen, 0);
   return SS_OK;
 }
 
@@ -143,15 +143,17 @@ int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved) {
   return 1;
 }
 
-void ssSeenMark(ssSeenSpaces* seen) {
+void ssSeenMark(ssSeenSpaces* seen, int none_asleep) {
   for (int s = 0; s < seen->count; ++s) {
     ssSeenSpace* space = &seen->spaces[s];
     /* a static marker stays put (its pointer is only compared: the program may have destroyed it); a body's may be
      * woken, or destroyed, so it is looked for again */
     if (space->marker != 0 && space->marker_body == 0 && !space->rescan) continue;
+    if (space->awake_only && none_asleep) continue;
     space->rescan = 0;
     space->marker = space->after_marker = 0;
     space->marker_body = 0;
+    space->awake_only = 1;
     for (int i = 0, geoms = dSpaceGetNumGeoms(space->space); i < geoms; ++i) {
       dGeomID geom = dSpaceGetGeom(space->space, i);
       if (dGeomIsSpace(geom)) continue; /* a nested space moves with any geom in it */
@@ -160,6 +162,7 @@ void ssSeenMark(ssSeenSpaces* seen) {
       space->marker = geom;
       space->marker_body = body;
       space->after_marker = i + 1 < geoms ? dSpaceGetGeom(space->space, i + 1) : 0;
+      space->awake_only = 0;
       break;
     }
   }

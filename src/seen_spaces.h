@@ -29,6 +29,7 @@ typedef struct ssSeenSpace {
   dGeomID after_marker; /* the geom behind it then: the marker moved since when another follows it */
   dBodyID marker_body;  /* the marker's body then (0: static) */
   int rescan;           /* the next mark looks for a marker nearer the head: sleeping geoms gathered before this one */
+  int awake_only;       /* the last mark met only awake bodies' geoms, the whole list, and found no marker */
   int sweep_and_prune;
 } ssSeenSpace;
 
@@ -59,8 +60,10 @@ int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved);
 
 /* After a step: each space's marker set to the first geom from the head that the next step cannot move. A static
  * marker is kept (nothing behind it is new), unless the last look met sleeping geoms before it: then one nearer the
- * head is looked for, so that a look walks about as far as the bodies ODE steps. */
-void ssSeenMark(ssSeenSpaces* seen);
+ * head is looked for, so that a look walks about as far as the bodies ODE steps. With none_asleep (no known body
+ * was asleep at the last check), a space whose last mark met only awake bodies is not walked again: it has no
+ * marker still, or one only a later mark finds (a look without a marker walks the whole list: nothing is missed). */
+void ssSeenMark(ssSeenSpaces* seen, int none_asleep);
 
 /* body, about to be destroyed through the stepper: its geoms there leave the count (destroyed before or after). */
 void ssSeenForget(ssSeenSpaces* seen, dBodyID body);
