@@ -8,17 +8,19 @@
  *  - asleep: the boxes disabled by ODE's auto-disable, the level at rest;
  *  - asleep, spawning: both.
  * Projectiles fly up from beside the field and never touch a box, so that a sleeping level stays asleep. The two
- * copies are stepped in alternating blocks, timed by this thread's CPU time; the ratio of adopted to own is printed,
- * median and range over the repeats.
+ * copies are stepped in alternating blocks, timed by this thread's CPU time; the ratio of adopted to own of each
+ * pair of blocks is kept, and their median printed with the middle half's range.
  *
  * Then the library's share of a frame as the world grows (10 to 100,000 boxes, `implicit-euler`, static boxes): the
- * adopted frame's time over the own frame's, less one.
+ * adopted frame's time over the own frame's, less one. There the boxes are kept in hash spaces of 1,000 nested in the
+ * world's, as a large level is kept in chunks: one hash space of n geoms clears n² bits at every collision, which
+ * at 100,000 boxes is most of ODE's own frame and would hide the library's share.
  *
  * Under valgrind, `callgrind --toggle-collect=` on gameFrameOwn and gameFrameAdopted counts the instructions of each
  * copy (docs/measurements.md).
  *
  *   bench_games [frames] [repeats] [largest box count]   (default 120 frames, 5 repeats, 100000: about 10 min on
- *   a 2-core machine; 100,000 boxes take one repeat of 10 frames)
+ *   a 2-core machine; 100,000 boxes take two repeats of 10 frames, one in each building order)
  *   bench_games share [frames] [repeats] [largest box count]   the share alone */
 #include <math.h>
 #include <stdio.h>
@@ -29,12 +31,14 @@
 
 #include "bench_common.h"
 
-enum { kBlock = 10, kLifetime = 60, kMaxContacts = 4 };
+enum { kLifetime = 60, kMaxContacts = 4, kChunk = 1000 };
 static const double kFrame_s = 1.0 / 60.0;
 
 typedef struct Game {
   dWorldID world;
   dSpaceID space;
+  dSpaceID* chunks; /* the hash spaces of kChunk boxes nested in space, or none */
+  int chunk_count;
   dJointGroupID contacts;
   ssStepper* stepper; /* NULL: the program's own loop */
   int spawning;
@@ -46,6 +50,10 @@ static void check(ssStatus status, const char* what) { benchCheck("bench_games",
 
 static void nearCallback(void* data, dGeomID o1, dGeomID o2) {
   Game* game = data;
+  if (dGeomIsSpace(o1) || dGeomIsSpace(o2)) { /* a chunk and the plane: what is inside each chunk comes after */
+    dSpaceCollide2(o1, o2, data, nearCallback);
+    return;
+  }
   dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
   if (b1 != 0 && b2 != 0 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
   dContact contact[kMaxContacts];
@@ -60,17 +68,26 @@ static void nearCallback(void* data, dGeomID o1, dGeomID o2) {
   }
 }
 
-static void collide(void* context, ssStepper* stepper) {
-  (void)stepper;
-  Game* game = context;
+static void collideAll(Game* game) {
   dSpaceCollide(game->space, game, nearCallback);
+  for (int c = 0; c < game->chunk_count; ++c) dSpaceCollide(game->chunks[c], game, nearCallback);
 }
 
-/* boxes of 0.5 m on a square grid 1 m apart, resting on the plane z = 0 */
-static Game* build(int boxes, int asleep, int spawning, const char* policy) {
+static void collide(void* context, ssStepper* stepper) {
+  (void)stepper;
+  collideAll(context);
+}
+
+/* boxes of 0.5 m on a square grid 1 m apart, resting on the plane z = 0; chunked: in hash spaces of kChunk boxes */
+static Game* build(int boxes, int asleep, int spawning, int chunked, const char* policy) {
   Game* game = calloc(1, sizeof *game);
   if (game == NULL) exit(1);
-  *game = (Game){dWorldCreate(), dHashSpaceCreate(0), dJointGroupCreate(0), NULL, spawning, {0}, 0};
+  *game = (Game){dWorldCreate(), dHashSpaceCreate(0), NULL, 0, dJointGroupCreate(0), NULL, spawning, {0}, 0};
+  if (chunked) {
+    game->chunk_count = (boxes + kChunk - 1) / kChunk;
+    if ((game->chunks = calloc((size_t)game->chunk_count, sizeof *game->chunks)) == NULL) exit(1);
+    for (int c = 0; c < game->chunk_count; ++c) game->chunks[c] = dHashSpaceCreate(game->space);
+  }
   dWorldSetGravity(game->world, 0, 0, -9.81);
   dWorldSetQuickStepNumIterations(game->world, 10);
   dWorldSetAutoDisableFlag(game->world, asleep);
@@ -82,11 +99,11 @@ static Game* build(int boxes, int asleep, int spawning, const char* policy) {
     dMassSetBoxTotal(&mass, 1.0, 0.5, 0.5, 0.5);
     dBodySetMass(body, &mass);
     dBodySetPosition(body, i % side, i / side, 0.25);
-    dGeomSetBody(dCreateBox(game->space, 0.5, 0.5, 0.5), body);
+    dGeomSetBody(dCreateBox(chunked ? game->chunks[i / kChunk] : game->space, 0.5, 0.5, 0.5), body);
   }
   /* settled by the program before it is adopted: the boxes sit in their contacts (and fall asleep) */
   for (int i = 0; i < (asleep ? 60 : 5); ++i) {
-    dSpaceCollide(game->space, game, nearCallback);
+    collideAll(game);
     dWorldQuickStep(game->world, kFrame_s);
     dJointGroupEmpty(game->contacts);
   }
@@ -128,7 +145,7 @@ static void spawnAndDespawn(Game* game) {
 /* A frame of the program's own loop. Not inlined: callgrind counts it by name. */
 __attribute__((noinline)) void gameFrameOwn(Game* game) {
   spawnAndDespawn(game);
-  dSpaceCollide(game->space, game, nearCallback);
+  collideAll(game);
   dWorldQuickStep(game->world, kFrame_s);
   dJointGroupEmpty(game->contacts);
 }
@@ -142,53 +159,72 @@ __attribute__((noinline)) void gameFrameAdopted(Game* game) {
 static void destroy(Game* game) {
   ssStepper_Destroy(game->stepper);
   dJointGroupDestroy(game->contacts);
-  dSpaceDestroy(game->space);
+  dSpaceDestroy(game->space); /* and the chunks in it */
   dWorldDestroy(game->world);
+  free(game->chunks);
   free(game);
 }
 
-/* One pair of copies (own, adopted) stepped through frames in alternating blocks; each copy's CPU seconds. */
-static void measure(int boxes, int asleep, int spawning, const char* policy, int frames, double seconds[2]) {
-  Game* games[2] = {build(boxes, asleep, spawning, NULL), build(boxes, asleep, spawning, policy)};
-  seconds[0] = seconds[1] = 0;
-  for (int done = 0, block = 0; done < frames; done += kBlock, ++block) {
+enum { kPairs = 10, kWarmFrames = 2 }; /* blocks of each copy a repeat; frames each copy takes untimed first */
+
+/* One pair of copies (own, adopted), built in the order own_first says (the heap lays them out differently: which
+ * is built first moves a large world's ratio by several per cent either way, so the repeats take turns), each first
+ * stepped kWarmFrames untimed, then through frames in kPairs blocks each, alternating: the ratio adopted / own of
+ * each pair of blocks into ratios[0 .. kPairs), the own copy's CPU seconds returned. */
+static double measure(int boxes, int asleep, int spawning, int chunked, const char* policy, int frames, int own_first,
+                      double* ratios) {
+  Game* games[2];
+  games[!own_first] = build(boxes, asleep, spawning, chunked, own_first ? NULL : policy);
+  games[own_first] = build(boxes, asleep, spawning, chunked, own_first ? policy : NULL);
+  for (int i = 0; i < kWarmFrames; ++i) gameFrameOwn(games[0]), gameFrameAdopted(games[1]);
+  double own_s = 0;
+  const int block = frames / kPairs;
+  for (int pair = 0; pair < kPairs; ++pair) {
+    double seconds[2];
     for (int k = 0; k < 2; ++k) {
-      int g = (k + block) % 2; /* the order alternates: neither is always first */
+      int g = (k + pair) % 2; /* the order alternates: neither is always first */
       double start = benchCpuSeconds();
-      for (int i = 0; i < kBlock; ++i) {
+      for (int i = 0; i < block; ++i) {
         if (g == 0) gameFrameOwn(games[0]);
         else gameFrameAdopted(games[1]);
       }
-      seconds[g] += benchCpuSeconds() - start;
+      seconds[g] = benchCpuSeconds() - start;
     }
+    ratios[pair] = seconds[1] / seconds[0];
+    own_s += seconds[0];
   }
   destroy(games[0]);
   destroy(games[1]);
+  return own_s;
 }
 
-/* The median ratio adopted / own over the repeats, printed with its range and the own frame's time. */
-static double reportScene(const char* name, int boxes, int asleep, int spawning, const char* policy, int frames,
-                          int repeats) {
-  double ratios[64], own_us = 0;
-  for (int r = 0; r < repeats; ++r) {
-    double seconds[2];
-    measure(boxes, asleep, spawning, policy, frames, seconds);
-    ratios[r] = seconds[1] / seconds[0];
-    own_us += 1e6 * seconds[0] / frames / repeats;
-  }
-  benchSort(ratios, repeats);
-  printf("  %-22s %6d boxes  own %9.1f us/frame  adopted/own %.4f  (%.4f to %.4f)\n", name, boxes, own_us,
-         ratios[repeats / 2], ratios[0], ratios[repeats - 1]);
-  return ratios[repeats / 2];
+/* The median ratio adopted / own over every pair of blocks of the repeats (a burst of another process' load spoils a
+ * pair, not the figure), printed with the middle half's range and the own frame's time. */
+static double reportScene(const char* name, int boxes, int asleep, int spawning, int chunked, const char* policy,
+                          int frames, int repeats) {
+  static double ratios[64 * kPairs];
+  double own_us = 0;
+  for (int r = 0; r < repeats; ++r)
+    own_us += 1e6 * measure(boxes, asleep, spawning, chunked, policy, frames, r % 2 == 0, &ratios[r * kPairs]) /
+              frames / repeats;
+  const int count = repeats * kPairs;
+  benchSort(ratios, count);
+  printf("  %-22s %6d boxes  own %9.1f us/frame  adopted/own %.4f  (middle half %.4f to %.4f)\n", name, boxes, own_us,
+         ratios[count / 2], ratios[count / 4], ratios[(3 * count) / 4]);
+  return ratios[count / 2];
 }
 
 static const struct {
   const char* name;
-  int asleep, spawning;
-} kScenes[] = {{"static", 0, 0}, {"spawning", 0, 1}, {"asleep", 1, 0}, {"asleep, spawning", 1, 1}};
-enum { kSceneCount = sizeof kScenes / sizeof kScenes[0] };
+  int asleep, spawning, chunked;
+} kScenes[] = {{"static", 0, 0, 0},
+               {"spawning", 0, 1, 0},
+               {"asleep", 1, 0, 0},
+               {"asleep, spawning", 1, 1, 0},
+               {"static, chunked", 0, 0, 1}}; /* the share's scene, timed under implicit-euler; counted as the others */
+enum { kSceneCount = sizeof kScenes / sizeof kScenes[0], kGameScenes = kSceneCount - 1 };
 
-/* bench_games count <scene 0-3> <boxes> <frames>: both copies stepped, untimed, for callgrind's counts. */
+/* bench_games count <scene 0-4> <boxes> <frames>: both copies stepped, untimed, for callgrind's counts. */
 static int countInstructions(int argc, char** argv) {
   int scene = argc > 2 ? atoi(argv[2]) : -1, boxes = argc > 3 ? atoi(argv[3]) : 0;
   int frames = argc > 4 ? atoi(argv[4]) : 0;
@@ -197,8 +233,8 @@ static int countInstructions(int argc, char** argv) {
     return 2;
   }
   dInitODE2(0);
-  Game* own = build(boxes, kScenes[scene].asleep, kScenes[scene].spawning, NULL);
-  Game* adopted = build(boxes, kScenes[scene].asleep, kScenes[scene].spawning, "naive");
+  Game* own = build(boxes, kScenes[scene].asleep, kScenes[scene].spawning, kScenes[scene].chunked, NULL);
+  Game* adopted = build(boxes, kScenes[scene].asleep, kScenes[scene].spawning, kScenes[scene].chunked, "naive");
   for (int i = 0; i < frames; ++i) gameFrameOwn(own);
   for (int i = 0; i < frames; ++i) gameFrameAdopted(adopted);
   destroy(own);
@@ -217,7 +253,7 @@ int main(int argc, char** argv) {
     fprintf(stderr, "usage: bench_games [share] [frames > 0] [repeats 1..64] [largest box count >= 10]\n");
     return 2;
   }
-  frames = (frames + kBlock - 1) / kBlock * kBlock;
+  frames = (frames + kPairs - 1) / kPairs * kPairs;
   setvbuf(stdout, NULL, _IOLBF, 0); /* each line as it is measured, into a log too */
   dInitODE2(0);
   benchPrintMachine("bench_games", "before");
@@ -225,15 +261,16 @@ int main(int argc, char** argv) {
          frames);
   if (!share_only) printf("adopted under naive against the program's own loop (target: at most 1.02)\n");
   for (int boxes = 1000; !share_only && boxes <= 10000; boxes *= 10)
-    for (int s = 0; s < kSceneCount; ++s)
-      reportScene(kScenes[s].name, boxes, kScenes[s].asleep, kScenes[s].spawning, "naive",
-                  boxes >= 10000 ? (frames / 4 + kBlock - 1) / kBlock * kBlock : frames, repeats);
+    for (int s = 0; s < kGameScenes; ++s)
+      reportScene(kScenes[s].name, boxes, kScenes[s].asleep, kScenes[s].spawning, 0, "naive",
+                  boxes >= 10000 ? (frames / 4 + kPairs - 1) / kPairs * kPairs : frames, repeats);
   printf("the library's share of a frame as the world grows, implicit-euler, static boxes (target: the share at "
          "100,000 at most 1.5 times the share at 1,000)\n");
   for (int boxes = 10; boxes <= largest; boxes *= 10) {
-    int scaled = boxes >= 100000 ? 10 : boxes >= 10000 ? frames / 4 : frames; /* a few seconds a repeat */
-    scaled = (scaled + kBlock - 1) / kBlock * kBlock;
-    double ratio = reportScene("static", boxes, 0, 0, "implicit-euler", scaled, boxes >= 100000 ? 1 : repeats);
+    int scaled = boxes >= 100000 ? kPairs : boxes >= 10000 ? frames / 4 : frames; /* a few seconds a repeat */
+    scaled = (scaled + kPairs - 1) / kPairs * kPairs;
+    double ratio = reportScene("static, chunked", boxes, 0, 0, 1, "implicit-euler", scaled,
+                               boxes >= 100000 ? 2 : repeats);
     printf("    share %.2f %%\n", 100.0 * (ratio - 1.0));
   }
   benchPrintMachine("bench_games", "after");
