@@ -264,8 +264,8 @@ int main(int argc, char** argv) {
     for (int s = 0; s < kGameScenes; ++s)
       reportScene(kScenes[s].name, boxes, kScenes[s].asleep, kScenes[s].spawning, 0, "naive",
                   boxes >= 10000 ? (frames / 4 + kPairs - 1) / kPairs * kPairs : frames, repeats);
-  printf("the library's share of a frame as the world grows, implicit-euler, static boxes (target: the share at "
-         "100,000 at most 1.5 times the share at 1,000)\n");
+  printf("the library's share of a frame as the world grows, implicit-euler, static boxes in hash spaces of %d "
+         "(target: the share at 100,000 at most 1.5 times the share at 1,000)\n", kChunk);
   for (int boxes = 10; boxes <= largest; boxes *= 10) {
     int scaled = boxes >= 100000 ? kPairs : boxes >= 10000 ? frames / 4 : frames; /* a few seconds a repeat */
     scaled = (scaled + kPairs - 1) / kPairs * kPairs;
