@@ -27,7 +27,7 @@ from steadystep.audit.claims import recommended
 from steadystep.audit.run import OWN, SERVED_COLUMNS, TIME_COLUMN
 from steadystep.audit.templates import ENVIRONMENT
 from steadystep.report import palette, snippets
-from steadystep.report.html import bad, embed, number
+from steadystep.report.cells import bad, embed, number
 
 OWN_COLOR = "#000000"
 PROFILE_COLORS = ("#1f5fbf", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf")

@@ -4,7 +4,6 @@ escaped as they go in). The templates are in report/templates.py."""
 
 from __future__ import annotations
 
-import base64
 import math
 import platform
 import time
@@ -15,6 +14,7 @@ import numpy as np
 from markupsafe import Markup
 
 from steadystep.report import animation, figures, recommendation as page, snippets
+from steadystep.report.cells import bad, cell, embed, embed_png, number, status_cell  # noqa: F401
 from steadystep.lab import cost, runs
 from steadystep.report.export import swept_axes
 from steadystep.report.model import Report
@@ -60,42 +60,8 @@ def readable_settings(settings: dict | None) -> str:
     return ", ".join(shown(name, value) for name, value in (settings or {}).items()) or "-"
 
 
-def number(value, digits: int = 3) -> str:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "-"
-    if isinstance(value, float) and math.isinf(value):
-        return "failed"
-    return f"{value:.{digits}g}"
-
-
-def bad(text: str) -> Markup:
-    return Markup("<span class=bad>{}</span>").format(text)
-
-
-def cell(value, status: str = "ok", digits: int = 3):
-    """A number, or the run's status when the run failed (blew up, ran away, broke)."""
-    return bad(status) if status != "ok" else number(value, digits)
-
-
-def status_cell(status: str):
-    """A run's status: ok, or what went wrong (blow-up, speed limit, broken) in red: a failure either way."""
-    return "ok" if status == "ok" else bad(status)
-
-
 def policy_cell(policy: str) -> Markup:
     return Markup('<span class="dot" style="background:{}"></span>{}').format(figures.policy_color(policy), policy)
-
-
-def embed(path: Path, anchor: str | None = None) -> Markup:
-    data = base64.b64encode(Path(path).read_bytes()).decode()
-    return Markup('<img{} src="data:image/png;base64,{}" alt="{}">').format(
-        Markup(" id='{}'").format(anchor) if anchor else "", data, Path(path).name)
-
-
-def embed_png(data: bytes, anchor: str, alt: str) -> Markup:
-    """PNG bytes as an image in the page (a data URI), with its id and alternative text."""
-    return Markup('<img id="{}" src="data:image/png;base64,{}" alt="{}">').format(
-        anchor, base64.b64encode(data).decode(), alt)
 
 
 def _all_policies(report: Report) -> list[str]:
