@@ -279,20 +279,26 @@ def _first_non_finite(data, name: str = ""):
     return None
 
 
-# What figure and compare need beyond the core: pyproject's report extra (jinja2 writes the page).
+# What figure, compare and audit need beyond the core: pyproject's report extra (jinja2 writes the page).
 REPORT_EXTRA = ("matplotlib", "tqdm", "jinja2")
 
 
-def _require_report_extra(command: str, modules: tuple[str, ...] = REPORT_EXTRA) -> None:
+def _require_report_extra(command: str, modules: tuple[str, ...] = REPORT_EXTRA,
+                          looked_up: tuple[str, ...] = ()) -> None:
     """Refuses the command in one line (exit 2) when a module of the report extra it needs cannot be imported,
-    naming it and the pip extra that provides it."""
+    naming it and the pip extra that provides it. A module also in looked_up is only looked for (installed or not),
+    not imported: one that other processes use and this one need not import."""
     import importlib
+    import importlib.util
 
     missing = []
     for name in modules:
         try:
-            importlib.import_module(name)
-        except ImportError:  # absent, or present and broken: either way the extra is what to install again
+            if name not in looked_up:
+                importlib.import_module(name)
+            elif importlib.util.find_spec(name) is None:
+                raise ImportError(name)
+        except (ImportError, ValueError):  # absent, or present and broken: either way the extra is what to install
             missing.append(name)
     if missing:
         raise _UsageError(f"steadystep {command}: needs the report extra, {' and '.join(missing)} not installed: "
@@ -319,6 +325,15 @@ def _figure(args, argv) -> int:
     for path in article_figure(args.out, args.duration, args.seed):
         _say(str(path))
     return 0
+
+
+def _audit(args, argv) -> int:
+    # jinja2 writes the page in this process; matplotlib draws the figures, in the pool's workers when there is one,
+    # so it is looked up, not imported: importing it here would cost the pool's audit 0.2 s for nothing.
+    _require_report_extra("audit", ("matplotlib", "jinja2"), looked_up=("matplotlib",))
+    from steadystep.audit import cli as audit_cli
+
+    return audit_cli.command(args, argv)
 
 
 # The files of a report in --out (report.write), which compare replaces only with --force.
@@ -466,10 +481,8 @@ def _dispatch(argv: list[str]) -> int:
         args = build_parser().parse_args(argv)
     except SystemExit as done:  # --help: argparse has printed it
         return done.code if isinstance(done.code, int) else 0
-    from steadystep.audit import cli as audit_cli
-
     handler = {"figure": _figure, "compare": _compare, "run": _run, "probe": _probe,
-               "convert": _convert, "audit": audit_cli.command}[args.command]
+               "convert": _convert, "audit": _audit}[args.command]
     if sys.stdout is None and not (args.command == "run" and args.csv):
         # Started with its standard output closed (>&-): Python then has no sys.stdout at all.
         raise _UsageError(f"steadystep {args.command}: standard output is closed, so the results have nowhere to go "

@@ -150,7 +150,9 @@ def test_conversions_work_elementwise_on_numpy_arrays():
 
 @pytest.mark.parametrize("command, missing", [(["figure", "--out", "unused"], "matplotlib"),
                                               (["compare", "--out", "unused"], "tqdm"),
-                                              (["compare", "--out", "unused"], "jinja2")])
+                                              (["compare", "--out", "unused"], "jinja2"),
+                                              (["audit", "program", "--out", "unused"], "matplotlib"),
+                                              (["audit", "program", "--out", "unused"], "jinja2")])
 def test_drawing_commands_say_the_extra_is_missing_in_one_line(command, missing, monkeypatch, capsys, tmp_path):
     monkeypatch.setitem(sys.modules, missing, None)  # its import fails, as when it is not installed
     monkeypatch.chdir(tmp_path)

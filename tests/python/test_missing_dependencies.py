@@ -64,6 +64,15 @@ def test_compare_without_a_module_of_the_report_extra_names_the_pip_extra(tmp_pa
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("missing", ["jinja2", "matplotlib"])
+def test_audit_without_a_module_of_the_report_extra_names_the_pip_extra(tmp_path, missing):
+    line = _one_line(_run([str(STEADYSTEP), "audit", "program", "--out", str(tmp_path / "out")],
+                          **_without(tmp_path, missing)))
+    assert line == (f"steadystep audit: needs the report extra, {missing} not installed: "
+                    "pip install 'steadystep[report]'")
+    assert not (tmp_path / "out").exists()
+
+
 def test_figure_needs_matplotlib_only(tmp_path):
     (tmp_path / "a").mkdir()
     (tmp_path / "b").mkdir()
