@@ -93,7 +93,7 @@ def command(args, argv) -> int:
     if args.force:
         comparison.clear_kept_runs(args.out)  # a replaced audit runs everything again
     try:
-        with study.make_executor(args.executor) as executor:
+        with study.make_executor(args.executor, comparison.pool_workers()) as executor:
             result = comparison.audit(program, args.profiles, args.seeds, args.policies, args.duration, executor,
                                  out_dir=args.out, cost=args.cost, diagnosis=not args.no_diagnosis,
                                  draw=True)  # the figures drawn in the executor's workers, after the runs

@@ -219,6 +219,16 @@ def cost_run(runs_per_variant: list[tuple[str, int]]) -> tuple[str, int]:
     return next(((p, s) for p, s in runs_per_variant if not p.startswith(DETERMINISTIC_KINDS)), runs_per_variant[0])
 
 
+def pool_workers() -> int:
+    """The local pool's processes for an audit: one more than the usable cores. A unit is mostly its worker waiting
+    for the program's process; between two runs the worker writes the frames, forks the next one and parses the
+    last one's CSV, and the spare worker's program keeps that core busy meanwhile. The figures likewise: the
+    default three drawn at once on two cores, rather than two and then one."""
+    from steadystep.lab import study
+
+    return study.usable_cores() + 1
+
+
 def _longest_first(key: tuple) -> int:
     """The order units are handed to a pool: it is done when its last unit is, so those that take longest go first
     (counts under valgrind, then the check of the reference and the reference: 4000 and 1000 frames a second), and
@@ -242,7 +252,7 @@ def audit(program, profiles=DEFAULT_PROFILES, seeds=DEFAULT_SEEDS, policies=None
     from steadystep.core.stepping import policy_names
 
     if isinstance(executor, str):  # one pool for the runs and the figures
-        with study.make_executor(executor) as made:
+        with study.make_executor(executor, pool_workers()) as made:
             return audit(program, profiles, seeds, policies, duration_s, made, progress, reference_fps, check_fps,
                          out_dir, cost, diagnosis, draw)
     started = time.perf_counter()
