@@ -198,3 +198,24 @@ def test_figures_drawn_in_the_pool_are_the_page_figures(tmp_path):
     audit.write(result, tmp_path, "steadystep audit (test)")
     for stem, data in result.figures.items():
         assert (tmp_path / f"{stem}.png").read_bytes() == data
+
+
+def test_serial_and_pool_give_the_same_audit(tmp_path):
+    """The same audit in this process and through the local pool: the same numbers, claims and figures; only the
+    runs' times differ (each run is its own process wherever it is started)."""
+    from steadystep import audit
+
+    program = audit.Executable((str(BUILD / "steadystep_example_chain_steadystep"),),
+                               own=(str(BUILD / "steadystep_example_chain_ode"),))
+    results = {executor: audit.audit(program, ["fixed:60", "uniform:15:45"], [1, 2], ["naive", "fixed"], 1.0,
+                                     executor, progress=False, cost="none", draw=True)
+               for executor in ("serial", "local")}
+    pages = {}
+    for executor, result in results.items():
+        data = audit.comparison.as_json(result, "steadystep audit (test)")
+        for run in data["runs"]:
+            del run["cpu_s"], run["wall_s"], run["cpu_ms_per_simulated_s"]
+        del data["elapsed_s"]
+        pages[executor] = data
+    assert pages["serial"] == pages["local"]
+    assert results["serial"].figures == results["local"].figures
