@@ -178,6 +178,12 @@ static Scene buildSprings(void) {
  * stepper's implicit Euler with frames no longer than max_step_s); or through ssStepper_Step. */
 enum { kPlain, kByHand, kStepper };
 
+static void addServed(ssServedCounts* sum, const ssServedCounts* counts) {
+  sum->by_mapping += counts->by_mapping;
+  sum->handed_to_matched += counts->handed_to_matched;
+  sum->handed_to_implicit_euler += counts->handed_to_implicit_euler;
+}
+
 /* Steps a block of frames and returns the seconds it took. */
 static double stepBlock(Scene* scene, int how, const double* frames_s, int count) {
   double start = nowSeconds();
@@ -187,9 +193,7 @@ static double stepBlock(Scene* scene, int how, const double* frames_s, int count
       check(ssStepper_Step(scene->stepper, frames_s[i], &report), "step");
       scene->frames += 1;
       scene->steps += report.steps;
-      scene->rows.by_mapping += report.rows.by_mapping;
-      scene->rows.handed_to_matched += report.rows.handed_to_matched;
-      scene->rows.handed_to_implicit_euler += report.rows.handed_to_implicit_euler;
+      addServed(&scene->rows, &report.rows);
       continue;
     }
     if (how == kByHand) {
@@ -208,6 +212,30 @@ static double stepBlock(Scene* scene, int how, const double* frames_s, int count
   return nowSeconds() - start;
 }
 
+static void destroyScene(Scene* scene) {
+  ssStepper_Destroy(scene->stepper);
+  ssRegistry_Destroy(scene->registry);
+  dWorldDestroy(scene->world);
+}
+
+/* Steps count scenes through the same frames (from profile_spec, or 1/60 s each for NULL) in blocks of kBlock,
+ * scene w the way hows[w] says (NULL: all through the stepper), rotating their order each block so that none is
+ * always first after the frame times change; adds each scene's seconds to seconds[w]. */
+static void stepRotating(Scene* scenes, const int* hows, int count, const char* profile_spec, int frames,
+                         double* seconds) {
+  ssProfile* profile = NULL;
+  if (profile_spec) check(ssProfile_Create(profile_spec, 1, &profile), "profile");
+  double frames_s[kBlock];
+  for (int done = 0, block = 0; done < frames; done += kBlock, ++block) {
+    for (int i = 0; i < kBlock; ++i) frames_s[i] = profile ? ssProfile_Next(profile) : kFrame_s;
+    for (int k = 0; k < count; ++k) {
+      int w = (k + block) % count;
+      seconds[w] += stepBlock(&scenes[w], hows ? hows[w] : kStepper, frames_s, kBlock);
+    }
+  }
+  ssProfile_Destroy(profile);
+}
+
 enum { kWorlds = 5 }; /* plain, by hand, implicit Euler, matched, exact */
 static const char* const kWorldNames[kWorlds] = {"plain dWorldQuickStep", "the article's loop by hand",
                                                  "ssStepper_Step, impl. Euler", "ssStepper_Step, matched",
@@ -224,24 +252,10 @@ static void measure(const char* profile_spec, int frames, double seconds[kWorlds
   check(ssStepper_SetStepping(scenes[3].stepper, &stepping), "matched");
   stepping.mapping = SS_MAPPING_EXACT;
   check(ssStepper_SetStepping(scenes[4].stepper, &stepping), "exact");
-  ssProfile* profile = NULL;
-  if (profile_spec) check(ssProfile_Create(profile_spec, 1, &profile), "profile");
-  double frames_s[kBlock];
   for (int w = 0; w < kWorlds; ++w) seconds[w] = 0;
-  for (int done = 0, block = 0; done < frames; done += kBlock, ++block) {
-    for (int i = 0; i < kBlock; ++i) frames_s[i] = profile ? ssProfile_Next(profile) : kFrame_s;
-    for (int k = 0; k < kWorlds; ++k) {
-      int w = (k + block) % kWorlds; /* rotate the order: none is always first after the frame times change */
-      seconds[w] += stepBlock(&scenes[w], kWorldHow[w], frames_s, kBlock);
-    }
-  }
-  ssProfile_Destroy(profile);
+  stepRotating(scenes, kWorldHow, kWorlds, profile_spec, frames, seconds);
   *steps_per_frame = (double)scenes[2].steps / (double)scenes[2].frames;
-  for (int w = 0; w < kWorlds; ++w) {
-    ssStepper_Destroy(scenes[w].stepper);
-    ssRegistry_Destroy(scenes[w].registry);
-    dWorldDestroy(scenes[w].world);
-  }
+  for (int w = 0; w < kWorlds; ++w) destroyScene(&scenes[w]);
 }
 
 /* Repeats the measurement and prints, for each stepped world, the median ratio to plain ODE and its range. */
@@ -282,23 +296,10 @@ static void reportInterpolation(int frames, int repeats) {
       check(ssStepper_SetStepping(scenes[w].stepper, &stepping), "fixed");
     }
     check(ssStepper_SetInterpolation(scenes[1].stepper, 0), "interpolation off");
-    ssProfile* profile = NULL;
-    check(ssProfile_Create("uniform:40:90", 1, &profile), "profile");
-    double frames_s[kBlock], seconds[2] = {0, 0};
-    for (int done = 0, block = 0; done < frames; done += kBlock, ++block) {
-      for (int i = 0; i < kBlock; ++i) frames_s[i] = ssProfile_Next(profile);
-      for (int k = 0; k < 2; ++k) {
-        int w = (k + block) % 2;
-        seconds[w] += stepBlock(&scenes[w], kStepper, frames_s, kBlock);
-      }
-    }
-    ssProfile_Destroy(profile);
+    double seconds[2] = {0, 0};
+    stepRotating(scenes, NULL, 2, "uniform:40:90", frames, seconds);
     ratios[r] = seconds[0] / seconds[1];
-    for (int w = 0; w < 2; ++w) {
-      ssStepper_Destroy(scenes[w].stepper);
-      ssRegistry_Destroy(scenes[w].registry);
-      dWorldDestroy(scenes[w].world);
-    }
+    for (int w = 0; w < 2; ++w) destroyScene(&scenes[w]);
   }
   benchSort(ratios, repeats);
   printf("fixed steps of 1/60 s, frames of 1/90 to 1/40 s: keeping the poses to draw (target <= 1.01)\n"
@@ -307,7 +308,7 @@ static void reportInterpolation(int frames, int repeats) {
 }
 
 /* The accurate mappings over implicit Euler in one scene: three copies (implicit Euler, matched, exact) stepped
- * through the same frames in rotating blocks, as measure() does; prints each accurate mapping's median time ratio to
+ * through the same frames in rotating blocks (stepRotating); prints each accurate mapping's median time ratio to
  * implicit Euler's and its range over the repeats, beside who served the row-steps (summed over the repeats). */
 static void reportMappings(const char* title, Scene (*buildScene)(void), const char* profile_spec, int frames,
                            int repeats) {
@@ -323,25 +324,12 @@ static void reportMappings(const char* title, Scene (*buildScene)(void), const c
       stepping.mapping = kMappings[w];
       check(ssStepper_SetStepping(scenes[w].stepper, &stepping), "mapping");
     }
-    ssProfile* profile = NULL;
-    if (profile_spec) check(ssProfile_Create(profile_spec, 1, &profile), "profile");
-    double frames_s[kBlock], seconds[kCopies] = {0, 0, 0};
-    for (int done = 0, block = 0; done < frames; done += kBlock, ++block) {
-      for (int i = 0; i < kBlock; ++i) frames_s[i] = profile ? ssProfile_Next(profile) : kFrame_s;
-      for (int k = 0; k < kCopies; ++k) {
-        int w = (k + block) % kCopies;
-        seconds[w] += stepBlock(&scenes[w], kStepper, frames_s, kBlock);
-      }
-    }
-    ssProfile_Destroy(profile);
+    double seconds[kCopies] = {0, 0, 0};
+    stepRotating(scenes, NULL, kCopies, profile_spec, frames, seconds);
     for (int w = 0; w < kCopies; ++w) {
       ratios[w][r] = seconds[w] / seconds[0];
-      served[w].by_mapping += scenes[w].rows.by_mapping;
-      served[w].handed_to_matched += scenes[w].rows.handed_to_matched;
-      served[w].handed_to_implicit_euler += scenes[w].rows.handed_to_implicit_euler;
-      ssStepper_Destroy(scenes[w].stepper);
-      ssRegistry_Destroy(scenes[w].registry);
-      dWorldDestroy(scenes[w].world);
+      addServed(&served[w], &scenes[w].rows);
+      destroyScene(&scenes[w]);
     }
   }
   printf("%s\n", title);
@@ -387,9 +375,7 @@ static int countInstructions(int argc, char** argv) {
          kScenes[scene].name, ssMappingName((ssMapping)mapping), frames, copy.rows.by_mapping,
          copy.rows.handed_to_matched, copy.rows.handed_to_implicit_euler);
   ssProfile_Destroy(profile);
-  ssStepper_Destroy(copy.stepper);
-  ssRegistry_Destroy(copy.registry);
-  dWorldDestroy(copy.world);
+  destroyScene(&copy);
   return 0;
 }
 
@@ -439,9 +425,7 @@ int main(int argc, char** argv) {
             "apply");
     printf("ssRegistry_Apply alone, %-7s 2000 sets: %.1f us\n", ssMappingName((ssMapping)m),
            1e6 * (nowSeconds() - start) / frames);
-    ssStepper_Destroy(scene.stepper);
-    ssRegistry_Destroy(scene.registry);
-    dWorldDestroy(scene.world);
+    destroyScene(&scene);
   }
   benchPrintMachine("bench_stepper", "after");
   return 0;
