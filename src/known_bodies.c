@@ -484,6 +484,16 @@ static int checkUnseen(ssKnownBodies* known, int unseen, const CheckVisit* check
   return -1;
 }
 
+/* The first body this check marked whose state (and with check->forces its accumulators) fails the check, or -1:
+ * looked for only after the pass found that one does. */
+static int firstMarkedFailing(const ssKnownBodies* known, const CheckVisit* check) {
+  for (int k = 0; k < known->count; ++k)
+    if (known->reached[k] == known->checks &&
+        !bodyWithin(&known->values[k], check->max_speed2, check->max_spin2, check->forces))
+      return k;
+  return -1;
+}
+
 /* The bodies marked this check, queued for the wake walk: how many. */
 static int queueMarked(ssKnownBodies* known) {
   int queued = 0;
@@ -506,7 +516,7 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
                       bounds->forces};
   const ssBodyValues* values = known->values;
   const int count = known->count, until = ssPrefetchUntil(count);
-  const unsigned check_number = ++known->checks;
+  ++known->checks;
   /* one pass reads each body once, marks it and checks what ODE steps (the usual case: all pass; the first failure
    * is found after); a sleeping body's values are not read */
   int all = 1, asleep = 0, unseen = 0;
@@ -516,12 +526,10 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
       all &= bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
   }
   known->asleep = asleep;
-  for (int k = 0; !all && k < count; ++k)
-    if (known->reached[k] == check_number && !bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces))
-      return nameFailure(known, k, bounds, when, step, steps, failed);
-  int woken = asleep > 0 ? wakeWalk(known, queueMarked(known), checkVisit, &check) : -1;
-  if (woken < 0) woken = checkUnseen(known, unseen, &check);
-  if (woken >= 0) return nameFailure(known, woken, bounds, when, step, steps, failed);
+  int failing = all ? -1 : firstMarkedFailing(known, &check);
+  if (failing < 0 && asleep > 0) failing = wakeWalk(known, queueMarked(known), checkVisit, &check);
+  if (failing < 0) failing = checkUnseen(known, unseen, &check);
+  if (failing >= 0) return nameFailure(known, failing, bounds, when, step, steps, failed);
   for (int a = 0; a < also_count; ++a) {
     int k = meetAlso(known, also[a]);
     if (k >= 0 && !checkVisit(known, k, &check)) return nameFailure(known, k, bounds, when, step, steps, failed);
@@ -575,7 +583,7 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   for (int p = 0; p < known->pushed_count; ++p) known->bodies[known->pushed[p]].pushed = 0;
   known->pushed_count = 0;
   const int count = known->count, until = ssPrefetchUntil(count);
-  const unsigned check_number = ++known->checks;
+  ++known->checks;
   /* one pass reads each body once: its joints (a sleeping body's joint may be destroyed too, so every body's are read
    * before a failure is told), its mark, and the state and forces of what ODE steps */
   int all = 1, changed = 0, asleep = 0, unseen = 0;
@@ -589,18 +597,14 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
     *joints_changed = 1;
     return SS_OK;
   }
-  for (int k = 0; !all && k < count; ++k)
-    if (known->reached[k] == check_number && !bodyWithin(&known->values[k], check.max_speed2, check.max_spin2, 1)) {
-      *failed = known->ids[k];
-      return describe(*failed, bounds, "before the frame");
-    }
-  int woken = asleep > 0 ? wakeWalk(known, queueMarked(known), startVisit, &check) : -1;
-  if (woken < 0) woken = checkUnseen(known, unseen, &check); /* checked only: a sleeping body's force waits */
-  for (int a = 0; woken < 0 && a < also_count; ++a) {
+  int failing = all ? -1 : firstMarkedFailing(known, &check);
+  if (failing < 0 && asleep > 0) failing = wakeWalk(known, queueMarked(known), startVisit, &check);
+  if (failing < 0) failing = checkUnseen(known, unseen, &check); /* checked only: a sleeping body's force waits */
+  for (int a = 0; failing < 0 && a < also_count; ++a) {
     int k = meetAlso(known, also[a]);
-    if (k >= 0 && !startVisit(known, k, &check)) woken = k;
+    if (k >= 0 && !startVisit(known, k, &check)) failing = k;
   }
-  if (woken < 0) return SS_OK;
-  *failed = known->ids[woken];
+  if (failing < 0) return SS_OK;
+  *failed = known->ids[failing];
   return describe(*failed, bounds, "before the frame");
 }
