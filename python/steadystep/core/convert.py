@@ -37,7 +37,8 @@ class Softness(NamedTuple):
     cfm: float
 
 
-def _spring(spring: Spring | tuple[float, float]) -> dict:
+def spring_fields(spring: Spring | tuple[float, float]) -> dict:
+    """The C ssSpring's fields of a (k N/m, c N·s/m) pair, each checked as a number; the binding's one reading."""
     try:
         k, c = spring
     except (TypeError, ValueError):
@@ -66,7 +67,7 @@ def _checked(what: str, inputs: dict, status: int, outputs) -> None:
 
 def _implicit_euler_softness(spring: Spring | tuple[float, float], step_s: float) -> Softness:
     """The article's mapping at step step_s (s): erp = hk/(hk+c), cfm = 1/(hk+c)."""
-    spring, step_s = _spring(spring), number("step_s", step_s, "s")
+    spring, step_s = spring_fields(spring), number("step_s", step_s, "s")
     out = ffi.new("ssSoftness*")
     _checked("implicit_euler_softness", {"k": spring["stiffness"], "c": spring["damping"], "step_s": step_s},
              lib.ssImplicitEulerSoftness(spring, step_s, out), lambda: {"erp": out.erp, "cfm": out.cfm})
@@ -99,7 +100,7 @@ def _spring_from_frequency(frequency_hz: float, damping_ratio: float, mass: floa
 
 def _frequency_from_spring(spring: Spring | tuple[float, float], mass: float) -> tuple[float, float]:
     """The undamped natural frequency (Hz) and damping ratio of a spring on mass (kg)."""
-    spring, mass = _spring(spring), number("mass", mass, "kg")
+    spring, mass = spring_fields(spring), number("mass", mass, "kg")
     frequency = ffi.new("double*")
     ratio = ffi.new("double*")
     _checked("frequency_from_spring", {"k": spring["stiffness"], "c": spring["damping"], "mass": mass},
@@ -110,7 +111,7 @@ def _frequency_from_spring(spring: Spring | tuple[float, float], mass: float) ->
 
 def _matched_softness(spring: Spring | tuple[float, float], mass: float, step_s: float) -> Softness:
     """The matched mapping: erp, cfm whose discrete poles are exp(s·h) of the spring's exact poles (needs c > 0)."""
-    spring, mass, step_s = _spring(spring), number("mass", mass, "kg"), number("step_s", step_s, "s")
+    spring, mass, step_s = spring_fields(spring), number("mass", mass, "kg"), number("step_s", step_s, "s")
     out = ffi.new("ssSoftness*")
     _checked("matched_softness", {"k": spring["stiffness"], "c": spring["damping"], "mass": mass, "step_s": step_s},
              lib.ssMatchedSoftness(spring, mass, step_s, out), lambda: {"erp": out.erp, "cfm": out.cfm})
@@ -133,7 +134,7 @@ def _softness_for(mapping: str, spring: Spring | tuple[float, float], mass: floa
 
 
 def _mapped(what: str, function, spring, mass, step_s, previous_step_s) -> Softness:
-    spring = _spring(spring)
+    spring = spring_fields(spring)
     inputs = {"k": spring["stiffness"], "c": spring["damping"], "mass": number("mass", mass, "kg"),
               "step_s": number("step_s", step_s, "s"), "previous_step_s": number("previous_step_s", previous_step_s,
                                                                                  "s")}

@@ -16,9 +16,9 @@ from __future__ import annotations
 import weakref
 
 from steadystep.core import _handles
-from steadystep.core._native import SteadystepError, check, ffi, integer, last_error, lib, number, shown
+from steadystep.core._native import SteadystepError, check, ffi, integer, last_error, lib, number
 from steadystep.core._structs import StructView
-from steadystep.core.convert import Spring
+from steadystep.core.convert import Spring, spring_fields
 from steadystep.core.enums import JointParam, Mapping, Status
 
 
@@ -62,15 +62,6 @@ class AdoptReport(StructView, c_type="ssAdoptReport", docs={
     and any field adopt.h adds (FIELDS lists them)."""
 
     __slots__ = ()
-
-
-def _spring(spring) -> dict:
-    try:
-        k, c = spring
-    except (TypeError, ValueError):
-        raise SteadystepError(Status.OUT_OF_RANGE,
-                              f"spring = {shown(spring)}: must be a Spring(k N/m, c N·s/m)") from None
-    return {"stiffness": number("k", k, "N/m"), "damping": number("c", c, "N·s/m")}
 
 
 def _param(param) -> int:
@@ -168,7 +159,7 @@ class Registry:
     def bind_world(self, spring: Spring | tuple[float, float], effective_mass: float = 0.0) -> None:
         """Binds the world's ERP/CFM to spring (k N/m, c N·s/m); effective_mass (kg, >= 0; 0 = 1 kg) is what the
         matched and exact mappings need."""
-        check(lib.ssRegistry_BindWorld(self._handle(), _spring(spring),
+        check(lib.ssRegistry_BindWorld(self._handle(), spring_fields(spring),
                                        number("effective_mass", effective_mass, "kg")))
 
     def bind_joint(self, joint, param: JointParam | int, axis: int, spring: Spring | tuple[float, float],
@@ -178,7 +169,8 @@ class Registry:
         bodies at each step. Binding the same joint, param and axis again replaces the binding. Raises
         SteadystepError ("unsupported") when the joint's type has no such parameter on that axis."""
         check(lib.ssRegistry_BindJoint(self._handle(), _handles.handle("joint", "joint", joint), _param(param),
-                                       _axis(axis), _spring(spring), number("effective_mass", effective_mass, "kg")))
+                                       _axis(axis), spring_fields(spring),
+                                       number("effective_mass", effective_mass, "kg")))
 
     def set_joint_load(self, joint, param: JointParam | int, axis: int, load: float) -> None:
         """Declares the steady load of a bound row: a force (N) or torque (N·m) on the joint's first body along the
@@ -246,5 +238,5 @@ def contact_soften(contact, body1, body2, spring: Spring | tuple[float, float], 
     With a Stepper, use Stepper.soften_contact instead, which knows the step."""
     pointer = _handles.contact("contact", contact)
     check(lib.ssContactSoften(pointer, _handles.handle("body1", "body", body1),
-                              _handles.handle("body2", "body", body2), _spring(spring), _mapping(mapping),
+                              _handles.handle("body2", "body", body2), spring_fields(spring), _mapping(mapping),
                               number("step_s", step_s, "s"), number("previous_step_s", previous_step_s, "s")))
