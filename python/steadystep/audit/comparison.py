@@ -41,6 +41,7 @@ from steadystep.audit.run import run as run_program
 from steadystep.audit.run import supports
 from steadystep.core.enums import Status
 from steadystep.lab.profiles import Profile, seed_value
+from steadystep.report.export import strict_json
 
 __all__ = ["Audit", "BadProgram", "Executable", "PythonProgram", "PythonWorld", "audit", "write",
            "DEFAULT_PROFILES", "DEFAULT_SEEDS"]
@@ -522,20 +523,7 @@ def as_json(result: Audit, command: str) -> dict:
             "repeat": result.repeat, "runs": result.runs, "cost": result.cost, "served": result.served,
             "not_measured": result.not_measured, "claims": result.claims, "elapsed_s": result.elapsed_s,
             "reused_runs": result.reused_runs, "machine": platform.node()}
-    return _strict(data)
-
-
-def _strict(value):
-    """value with every non-finite float as None (JSON has no inf or nan; docs/audit.md: null = failed or none)."""
-    if isinstance(value, dict):
-        return {k: _strict(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_strict(v) for v in value]
-    if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
-    if isinstance(value, (np.integer, np.bool_)):
-        return value.item()
-    return value
+    return strict_json(data)
 
 
 CSV_COLUMNS = ("variant", "role", "quantity", "scale", "spread", "spread_error", "deviation_in_window",

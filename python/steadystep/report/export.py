@@ -24,7 +24,7 @@ SERVED_COLUMNS = ("by_mapping", "handed_to_matched", "handed_to_implicit_euler")
 
 def as_json_text(report: Report, command: str) -> str:
     """metrics.json's text: every float that is not finite as null."""
-    return json.dumps(_finite_json(as_json(report, command)), indent=1, default=_json_default, allow_nan=False)
+    return json.dumps(strict_json(as_json(report, command)), indent=1, default=_json_default, allow_nan=False)
 
 
 def _json_default(value):
@@ -35,15 +35,18 @@ def _json_default(value):
     raise TypeError(type(value))
 
 
-def _finite_json(value):
-    """value with every float that is not finite (a blow-up's inf, a rate with no frames) as None: metrics.json is
-    strict JSON, which has no NaN or Infinity."""
+def strict_json(value):
+    """value with every float that is not finite (a blow-up's inf, a rate with no frames) as None, and numpy's
+    numbers as Python's: metrics.json and the audit's JSON are strict JSON, which has no NaN or Infinity (null: failed
+    or none)."""
     if isinstance(value, dict):
-        return {key: _finite_json(item) for key, item in value.items()}
+        return {key: strict_json(item) for key, item in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_finite_json(item) for item in value]
+        return [strict_json(item) for item in value]
     if isinstance(value, (float, np.floating)):
         return float(value) if math.isfinite(value) else None
+    if isinstance(value, (np.integer, np.bool_)):
+        return value.item()
     return value
 
 
