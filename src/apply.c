@@ -15,7 +15,10 @@
  *    not change keeps its softness (constant steps, masses a motion leaves unchanged);
  *  - shared: within one Apply, rows of one law and one mass (identical links, wheels) share one softness;
  *  - sure fallback: a row that ssSurelyFailsStaticResponse says the accurate mappings hand on gets implicit Euler's
- *    softness without their arithmetic (row_law.h; test_apply.cpp checks it against ssRowSoftness).
+ *    softness without their arithmetic (row_law.h; test_apply.cpp checks it against ssRowSoftness);
+ *  - handed on (apply_handed.c): under an accurate mapping, when ssSurelyFailsUpToMass hands every law on at every
+ *    mass its rows can have (bounded from their bodies' masses and inertias, which no rotation changes), implicit
+ *    Euler's by-law pass serves the Apply, no row measured (a program tuned near-rigid, adopted: nothing served).
  * The plain reference Apply (tests/c/apply_reference.c) computes every row with none of them; the differential test
  * and fuzz_apply require both to write the same values into ODE, with every cache on, off, or some of them. */
 #include <math.h>
@@ -291,8 +294,9 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     if (status != SS_OK) return failBinding(status, NULL);
     countRow(fallback, &counts);
   }
-  const int by_law = mapping == SS_MAPPING_IMPLICIT_EULER && APPLY_CACHE_ON(state, SS_APPLY_BY_LAW) &&
-                     state->rows_outside_laws == 0;
+  const int accurate = mapping != SS_MAPPING_IMPLICIT_EULER;
+  const int by_law = APPLY_CACHE_ON(state, SS_APPLY_BY_LAW) && state->rows_outside_laws == 0 &&
+                     (!accurate || (APPLY_CACHE_ON(state, SS_APPLY_HANDED_ON) && ssApplyEveryLawHandedOn(state, step_s)));
   ssSoftness law_softness[kLawTableSize];
   if (!by_law) ssApplyMaterializeRows(state); /* computeRows and writeRows compare each row's own */
   int unwritten = 0; /* rows whose pending differs from what ODE holds: with none (constant steps), no second pass */
@@ -310,7 +314,9 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   }
   if (world_bound) state->world_written = world;
   if (by_law) {
-    counts.rows.by_mapping += state->row_count; /* implicit Euler serves every row */
+    /* implicit Euler serves every row; under an accurate mapping it was handed all but the hard ones */
+    counts.rows.by_mapping += accurate ? state->hard_rows : state->row_count;
+    counts.rows.handed_to_implicit_euler += accurate ? state->row_count - state->hard_rows : 0;
     counts.row_writes += writeRowsByLaw(state, law_softness);
   } else if (unwritten > 0 || (mapping != SS_MAPPING_IMPLICIT_EULER && state->loaded_rows > 0)) {
     counts.row_writes += writeRows(state, mapping);

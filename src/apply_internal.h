@@ -27,7 +27,8 @@ enum {
   SS_APPLY_REUSE = 1 << 4,     /* accurate mappings: a row's softness kept while its inputs are the same */
   SS_APPLY_SAME_AXIS = 1 << 5, /* a stop and a motor on one axis share the mass measured for the first */
   SS_APPLY_SURE_FALLBACK = 1 << 6, /* accurate mappings: a row the rule surely hands on, without the arithmetic */
-  SS_APPLY_ALL = (1 << 7) - 1
+  SS_APPLY_HANDED_ON = 1 << 7, /* accurate mappings: laws the rule hands on at any mass their rows can have, by law */
+  SS_APPLY_ALL = (1 << 8) - 1
 };
 /* Turns off the caches in mask (and on the others). */
 void ssApplyDisableCaches(ssRegistry* registry, unsigned mask);

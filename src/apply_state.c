@@ -15,6 +15,7 @@ static void freeState(void* pointer) {
   free(state->rows);
   free(state->hot_rows);
   free(state->bodies);
+  free(state->bound_rows);
   free(state);
 }
 
@@ -72,6 +73,24 @@ void ssApplyRebuildBodies(ApplyState* state) {
     }
   state->bodies = cache;
   state->body_count = count;
+  state->bound_row_count = 0;
+  for (int i = 0; i < state->row_count && state->bound_rows != NULL; ++i) {
+    const ApplyRow* row = &state->rows[i];
+    const ssJointRowBinding* binding = &row->binding;
+    if (row->law_slot < 0 || binding->law.hard || binding->effective_mass > 0) continue;
+    const uint8_t angular = (uint8_t)ssJointRowIsAngular(binding->joint_type, binding->param, binding->axis);
+    BoundRow* last = state->bound_row_count > 0 ? &state->bound_rows[state->bound_row_count - 1] : NULL;
+    if (last != NULL && last->joint == row->joint && last->angular == angular && last->law_slot[1] < 0) {
+      last->law_slot[1] = (int16_t)row->law_slot;
+      continue;
+    }
+    BoundRow* bound = &state->bound_rows[state->bound_row_count++];
+    *bound = (BoundRow){.joint = row->joint, .law_slot = {(int16_t)row->law_slot, -1}, .angular = angular};
+    for (int side = 0; side < 2; ++side) {
+      bound->body[side] = dJointGetBody(row->joint, side);
+      bound->bound[side] = row->body_slot[side] >= 0 ? &state->bodies[row->body_slot[side]].bound : NULL;
+    }
+  }
 }
 
 const ssBodyInverse* ssApplyBodyInverse(ApplyState* state, int slot, dBodyID body, ssBodyInverse* local) {
@@ -92,6 +111,9 @@ const ssBodyInverse* ssApplyBodyInverse(ApplyState* state, int slot, dBodyID bod
 static void buildLaws(ApplyState* state) {
   state->law_count = 0;
   state->rows_outside_laws = 0;
+  state->hard_rows = 0;
+  memset(state->law_unsure, 0, sizeof state->law_unsure);
+  memset(state->law_given_mass, 0, sizeof state->law_given_mass);
   for (int i = 0; i < state->row_count; ++i) {
     ApplyRow* row = &state->rows[i];
     row->law_slot = -1;
@@ -102,6 +124,16 @@ static void buildLaws(ApplyState* state) {
       row->law_slot = state->law_count++;
     }
     state->rows_outside_laws += row->law_slot < 0;
+    const ssJointRowBinding* binding = &row->binding;
+    if (row->law_slot < 0 || binding->law.hard) {
+      state->hard_rows += row->law_slot >= 0;
+      continue;
+    }
+    const int given = binding->effective_mass > 0;
+    state->law_unsure[row->law_slot] |= (binding->load != 0 && binding->law.spring.stiffness > 0) ||
+                                        (!given && binding->joint_type == dJointTypeAMotor);
+    if (given && binding->effective_mass > state->law_given_mass[row->law_slot])
+      state->law_given_mass[row->law_slot] = binding->effective_mass;
   }
   int* next = state->law_rows;
   memset(next, 0, sizeof state->law_rows);
@@ -129,9 +161,11 @@ static int rebuild(ApplyState* state, ssRegistry* registry) {
   size_t rows_size = (size_t)(count > 0 ? count : 1);
   ApplyRow* rows = malloc(rows_size * sizeof *rows);
   HotRow* hot = malloc(rows_size * sizeof *hot);
-  if (rows == NULL || hot == NULL) {
+  BoundRow* bound = malloc(rows_size * sizeof *bound);
+  if (rows == NULL || hot == NULL || bound == NULL) {
     free(rows);
     free(hot);
+    free(bound);
     return 0;
   }
   ssApplyMaterializeRows(state);
@@ -166,14 +200,17 @@ static int rebuild(ApplyState* state, ssRegistry* registry) {
   }
   free(state->rows);
   free(state->hot_rows);
+  free(state->bound_rows);
   state->rows = rows;
   state->hot_rows = hot;
+  state->bound_rows = bound;
   state->row_count = count;
   state->loaded_rows = 0;
   for (int i = 0; i < count; ++i) state->loaded_rows += rows[i].binding.load != 0;
   state->revision = ssRegistryRevision(registry);
   state->stamp = ssRegistryLastStamp(registry);
   buildLaws(state);
+  state->handed_wait = state->handed_failed = 0;
   ssApplyRebuildBodies(state);
   return 1;
 }

@@ -12,6 +12,11 @@
  *  - laws[0..law_count) are distinct; rows[i].law_slot is the slot of a law equal to rows[i].law, or -1 (the table
  *    was full; rows_outside_laws counts those). hot_rows[law_rows[j] .. law_rows[j + 1]) are the joint and writer of
  *    law j's rows that have a writer, with each row's position. loaded_rows counts the rows with a load.
+ *  - hard_rows counts the rows in the table whose law is hard. For each spring law j: law_unsure[j], some row of it
+ *    cannot be handed on by law (a declared load on a spring, which the accurate mappings serve whatever the rule;
+ *    an angular motor's measured mass, whose Euler axes are no unit vectors for its bodies' bounds to hold);
+ *    law_given_mass[j], the largest mass given at binding among its rows (0: none). bound_rows: the spring rows in the
+ *    table whose mass is measured, by joint and kind of axis, built with the body cache.
  *  - The body cache, valid while !bodies_stale: bodies lists the rows' joints' bodies once each (sorted by address);
  *    rows[i].body_slot[side] is the slot of the body the joint had there, or -1. A row that finds its joint attached
  *    elsewhere computes that body itself and sets bodies_stale. A slot's inverse is the body's for this Apply when
@@ -59,11 +64,23 @@ typedef struct HotRow {
   int row;                        /* the row's position in rows */
 } HotRow;
 
+/* What bounds the mass of a joint's measured rows on one kind of axis (apply.c's lawMassBounds), packed apart: the
+ * bodies the joint had when the body cache was built, with where the cache keeps their bounds (the static world's
+ * and a body's that the cache could not hold: NULL), and the laws of up to two rows (a stop and its motor; -1: none). */
+typedef struct BoundRow {
+  dJointID joint;
+  dBodyID body[2];
+  const ssBodyInverseBound* bound[2];
+  int16_t law_slot[2];
+  uint8_t angular; /* ssJointRowIsAngular */
+} BoundRow;
+
 /* A body's inverse mass and inertia, computed at most once per Apply for all the rows on it. */
 typedef struct BodyCache {
   dBodyID body;
   unsigned stamp; /* the Apply it was computed for */
   ssBodyInverse inverse;
+  ssBodyInverseBound bound; /* read at each Apply that bounds the laws' masses (apply.c) */
 } BodyCache;
 
 typedef struct ApplyState {
@@ -77,6 +94,13 @@ typedef struct ApplyState {
   int law_count;
   int law_rows[kLawTableSize + 1];
   int rows_outside_laws;
+  int hard_rows;
+  unsigned char law_unsure[kLawTableSize];
+  double law_given_mass[kLawTableSize];
+  BoundRow* bound_rows;
+  int bound_row_count;
+  int handed_wait;   /* Applies before the laws' masses are bounded again (apply.c's everyLawHandedOn) */
+  int handed_failed; /* the last bounds found a law served */
   int written_by_law;
   ssSoftness law_written[kLawTableSize];
   ssSoftness world_written;
@@ -104,6 +128,11 @@ ApplyState* ssApplyStateOf(ssRegistry* registry);
 
 /* Gives every row in the law table its written back from law_written (before a row's own is read). */
 void ssApplyMaterializeRows(ApplyState* state);
+
+/* Under an accurate mapping: whether every row in the table is surely handed to implicit Euler at every mass it can
+ * have (apply_handed.c). Bounding the masses reads every body: after a law was found served, the next Applies do not
+ * try for a while, and the one after probes a few rows first. */
+int ssApplyEveryLawHandedOn(ApplyState* state, double step_s);
 
 /* The body cache again, after a row found its joint attached elsewhere. */
 void ssApplyRebuildBodies(ApplyState* state);

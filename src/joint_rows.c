@@ -255,6 +255,34 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out) {
           r_inverse[i][0] * R[4 * j] + r_inverse[i][1] * R[4 * j + 1] + r_inverse[i][2] * R[4 * j + 2];
 }
 
+ssBodyInverseBound ssBodyInverseBoundOf(dBodyID body) {
+  if (!isDynamic(body)) return (ssBodyInverseBound){0, 0};
+  dMass mass;
+  dBodyGetMass(body, &mass);
+  ssBodyInverseBound out = {mass.mass > 0 && mass.mass < INFINITY ? 1.0 / mass.mass : NAN, 0};
+  const dReal* I = mass.I; /* rows of 4 */
+  double a00 = I[0], a01 = I[1], a02 = I[2], a10 = I[4], a11 = I[5], a12 = I[6], a20 = I[8], a21 = I[9],
+         a22 = I[10];
+  if (offDiagonalZero(a01, a02, a10, a12, a20, a21)) {
+    /* ssBodyInverseOf's Σ b_k²/I_k with |b| = 1 is at least 1/max I_k; an inertia it counts 0 is 0 here too */
+    const double most = a00 > a11 ? (a00 > a22 ? a00 : a22) : (a11 > a22 ? a11 : a22);
+    if (a00 > 0 && a11 > 0 && a22 > 0) out.angular = 1.0 / most;
+    return out;
+  }
+  /* Turned axes: a symmetric inertia whose leading minors are surely positive is positive definite, its largest
+   * eigenvalue is at most its largest Gershgorin row sum `high`, and its smallest at least det/high²: above
+   * high/10⁴, ssBodyInverseOf's adjugate is within roundings far below the callers' margin */
+  double high = fmax(fabs(a00) + fabs(a01) + fabs(a02), fmax(fabs(a10) + fabs(a11) + fabs(a12),
+                                                            fabs(a20) + fabs(a21) + fabs(a22)));
+  double minor = a00 * a11 - a01 * a10, det = a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) +
+                                              a02 * (a10 * a21 - a11 * a20);
+  int symmetric = a01 == a10 && a02 == a20 && a12 == a21;
+  out.angular = symmetric && high < INFINITY && a00 > 0 && minor > 1e-12 * high * high && det > 1e-4 * high * high * high
+                    ? 1.0 / high
+                    : NAN;
+  return out;
+}
+
 double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, const dReal* point, int angular) {
   ssRowGeometry row = {{direction[0], direction[1], direction[2]}, {0, 0, 0}, angular, point != NULL};
   if (point != NULL) row.point[0] = point[0], row.point[1] = point[1], row.point[2] = point[2];
@@ -266,6 +294,21 @@ double ssRowEffectiveMass(dBodyID body1, dBodyID body2, const dReal* direction, 
     inverse += ssRowInverseMass(&body, &row);
   }
   return inverse > 0 ? 1.0 / inverse : 0;
+}
+
+/* As rowGeometry's *angular, known without ODE's getters (test_apply.cpp compares the two for every row). */
+int ssJointRowIsAngular(int type, ssJointParam param, int axis) {
+  switch (type) {
+    case dJointTypeHinge:
+    case dJointTypeUniversal:
+    case dJointTypeAMotor: return 1;
+    case dJointTypeHinge2: return param != SS_PARAM_SUSPENSION;
+    case dJointTypePR: return axis == 2;
+    case dJointTypePU: return axis == 1 || axis == 2;
+    case dJointTypePiston: return axis == 2;
+    case dJointTypePlane2D: return axis == 3;
+    default: return 0;
+  }
 }
 
 /* The row's direction, whether it is angular, and (for a linear row whose point matters) its point. */

@@ -67,6 +67,21 @@ typedef struct ssBodyInverse {
 
 void ssBodyInverseOf(dBodyID body, ssBodyInverse* out);
 
+/* Lower bounds of what a body opposes to a row whatever the row's unit direction and the body's rotation:
+ * ssRowInverseMass of a linear row is at least `linear` (1/kg), of an angular row at least `angular` (1/(kg·m²)),
+ * within roundings far below 1e-9 of either. Both 0 for the static world and kinematic bodies, which oppose nothing;
+ * NAN where no bound is sure: a mass that is not positive and finite, an inertia with off-diagonal terms that is not
+ * symmetric, or not surely positive definite with its eigenvalues within a factor 10⁴. Apply bounds the masses of
+ * a law's rows with them, reading no axis (ssSurelyFailsUpToMass). */
+typedef struct ssBodyInverseBound {
+  double linear, angular;
+} ssBodyInverseBound;
+
+ssBodyInverseBound ssBodyInverseBoundOf(dBodyID body);
+
+/* Whether the row of a joint of ODE type `type` is angular (its geometry's `angular`), known without ODE's getters. */
+int ssJointRowIsAngular(int type, ssJointParam param, int axis);
+
 /* A row's unit direction (world frame), whether it is angular, and for a linear row whose point matters (hinge-2
  * suspension) that point (m). */
 typedef struct ssRowGeometry {

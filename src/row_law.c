@@ -139,3 +139,42 @@ ssStatus ssRowSoftness(const ssRowLaw* law, ssMapping mapping, double mass, doub
   }
   return implicitEuler(law, step_s, out);
 }
+
+/* Whether k'/k = g(x) = N/(r·x) > limit on every x of [from, to] along the under-damped part of the ray (0 < from,
+ * to <= r, w = x·(r - x) in [0, π²]). With N = (e^x - 1)² + 4·e^x·sin²(√w/2),
+ *     g = (e^x - 1)²/(r·x) + 4·e^x·S(w)·(r - x)/r,   S(w) = sin²(√w/2)/w,
+ * whose first term grows with x and whose S falls as w grows (sinc² up to √w = 2π): on an interval g is at least
+ * the first term at its left end plus e^x there times S at the interval's largest w (w is concave in x, largest at
+ * r/2) times (r - x)/r at its right end. Intervals that do not decide are halved (geometrically: g moves with the
+ * ratio of the ends), to depth levels. */
+static int stifferOnRay(double from, double to, double r, double limit, int depth) {
+  double w = r / 2 >= from && r / 2 <= to ? r * r / 4 : fmax(from * (r - from), to * (r - to));
+  double s = sin(0.5 * sqrt(w));
+  double sinc2 = w > 1e-12 ? s * s / w : 0.25 - w / 48.0; /* below S(w) = 1/4 - w/48 + w²/1440 - ... */
+  double e = expm1(from);
+  if (e * e / (r * from) + 4.0 * (1.0 + e) * sinc2 * (r - to) / r > limit) return 1;
+  if (depth == 0) return 0;
+  double middle = sqrt(from * to);
+  return stifferOnRay(from, middle, r, limit, depth - 1) && stifferOnRay(middle, to, r, limit, depth - 1);
+}
+
+int ssSurelyFailsUpToMass(ssSpring spring, double mass_bound, double step_s) {
+  const double k = spring.stiffness, c = spring.damping, h = step_s;
+  if (mass_bound == 0 || c == 0) return 1;
+  if (!(k >= 0 && k <= 1e150 && c >= 1e-150 && c <= 1e150 && mass_bound >= 1e-150 && mass_bound <= 1e150 &&
+        h >= SS_MIN_STEP_S && h <= SS_MAX_STEP_S))
+    return 0;
+  const double x0 = 0.5 * c * h / mass_bound; /* the least x: at the largest mass */
+  if (k == 0) return x0 >= 0.06;                /* ssSurelyFailsStaticResponse's damper bound */
+  if (ssOverNyquist(spring, mass_bound, h)) return 1; /* and every lighter mass is (the comparison is monotone) */
+  /* the matched softness loses up to about 1e-15/r of its digits to cancellation where over-damped (matched.c):
+   * far below the margin for r >= 1e-3 */
+  const double r = 2.0 * k * h / c, margin = 1e-6;
+  if (!(r >= 1e-3)) return 0;
+  const double limit = (1.0 + margin) / (1.0 - SS_STATIC_RESPONSE_TOLERANCE); /* k'/k above it fails the rule */
+  const double nyquist_x = 9.869604401089358 / r * (1.0 + 1e-9); /* D = π², where the masses stop being served */
+  /* over-damped, x > r: N = (e^a - 1)(e^b - 1) with a, b = x ± √(x² - D), so N >= a·b·(1 + a/2)(1 + b/2) >= D·(1 + x) */
+  if (nyquist_x > r && !(1.0 + fmax(x0, r) > limit)) return 0;
+  const double top = fmin(r, nyquist_x);
+  return x0 >= top || stifferOnRay(x0, top, r, limit, 6);
+}

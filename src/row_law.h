@@ -114,6 +114,16 @@ static inline int ssSurelyFailsStaticResponse(ssSpring spring, double mass, doub
   return n_high < kh2_over_m * ((1.0 - margin) / (1.0 + SS_STATIC_RESPONSE_TOLERANCE)) || n_low > upper;
 }
 
+/* Whether ssRowSoftness hands the row to implicit Euler under an accurate mapping (load not declared) at every mass
+ * in (0, mass_bound] (kg or kg·m²), for every row of a law at once: no row's mass is then measured. 1 for c = 0
+ * (never servable) and for mass_bound 0 (no row with a mass); 0 (undecided) for a NAN bound, outside the ranges
+ * below, and where some mass may be served. Masses below k·h²/π² are above Nyquist; above it, along the ray that
+ * the masses trace in the rule's coordinates (x = c·h/2m, D = k·h²/m = r·x with r = 2k·h/c), the static stiffness
+ * k'/k = N/D is bounded below: by 1 + x where the spring is over-damped (x > r), and on the under-damped part by
+ * intervals of x, each with N's least value there (row_law.c). A damper is handed on from x = 0.06 up, as in
+ * ssSurelyFailsStaticResponse, and x only grows as the mass falls. */
+int ssSurelyFailsUpToMass(ssSpring spring, double mass_bound, double step_s);
+
 /* w·h > π, i.e. k·h² > π²·m: the spring's natural frequency is above half the step rate. False for a NAN
  * mass. Inline: the registry asks it of every row at every Apply. */
 static inline int ssOverNyquist(ssSpring spring, double mass, double step_s) {
