@@ -9,10 +9,10 @@
 #include "apply_state.h"
 
 /* A bound on the effective mass of a BoundRow's rows from lower bounds of what its two sides oppose: rowMass' sum
- * is at least theirs; a margin for its roundings. 0: nothing opposes the row (it has no mass); NAN: no bound. */
+ * is at least theirs, within SS_MASS_BOUND_MARGIN. 0: nothing opposes the row (it has no mass); NAN: no bound. */
 static double boundedMass(const BoundRow* row, const ssBodyInverseBound* first, const ssBodyInverseBound* second) {
   const double inverse = row->angular ? first->angular + second->angular : first->linear + second->linear;
-  return inverse > 0 ? (1.0 + 1e-9) / inverse : inverse == 0 ? 0 : NAN;
+  return inverse > 0 ? (1.0 + SS_MASS_BOUND_MARGIN) / inverse : inverse == 0 ? 0 : NAN;
 }
 
 static void raiseBound(const BoundRow* row, double mass, double* bound) {

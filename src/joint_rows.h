@@ -69,7 +69,7 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out);
 
 /* Lower bounds of what a body opposes to a row whatever the row's unit direction and the body's rotation:
  * ssRowInverseMass of a linear row is at least `linear` (1/kg), of an angular row at least `angular` (1/(kg·m²)),
- * within roundings far below 1e-9 of either. Both 0 for the static world and kinematic bodies, which oppose nothing;
+ * within roundings below SS_MASS_BOUND_MARGIN of either. Both 0 for the static world and kinematic bodies, which oppose nothing;
  * NAN where no bound is sure: a mass that is not positive and finite, an inertia with off-diagonal terms that is not
  * symmetric, or not surely positive definite with its eigenvalues within a factor 10⁴. Apply bounds the masses of
  * a law's rows with them, reading no axis (ssSurelyFailsUpToMass). */
@@ -78,6 +78,14 @@ typedef struct ssBodyInverseBound {
 } ssBodyInverseBound;
 
 ssBodyInverseBound ssBodyInverseBoundOf(dBodyID body);
+
+/* How much above 1/(the sum of its bodies' bounds) a row's measured mass can be: the roundings of ODE's axes and
+ * rotations, which are unit and orthonormal to a few units in the last place of dReal (hundreds of times below). */
+#if defined(dDOUBLE)
+#define SS_MASS_BOUND_MARGIN 1e-9
+#else
+#define SS_MASS_BOUND_MARGIN 1e-4
+#endif
 
 /* Whether the row of a joint of ODE type `type` is angular (its geometry's `angular`), known without ODE's getters. */
 int ssJointRowIsAngular(int type, ssJointParam param, int axis);

@@ -232,7 +232,8 @@ TEST(ApplyTest, BodyBoundsBoundTheMassOfEveryRow) {
           unbounded += 1;
           continue;
         }
-        ASSERT_LE(mass, (1 + 1e-9) / inverse) << "joint type " << type << " param " << param << " axis " << a;
+        ASSERT_LE(mass, (1 + SS_MASS_BOUND_MARGIN) / inverse)
+            << "joint type " << type << " param " << param << " axis " << a;
         tight += mass > 0.1 / inverse;
       }
   }
