@@ -309,34 +309,6 @@ ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body) {
   return SS_OK;
 }
 
-/* ODE counts steps: a count of seconds in steps of h, where a whole number of steps computed with rounding error
- * (10·(1/60)/(1/60) = 10.000000000000002) must not become one more. */
-static double stepsIn(double seconds, double step_s) { return ceil(seconds / step_s - 1e-9); }
-
-void ssBodyWrittenFor(const ssBodyBinding* binding, double step_s, ssBodyWritten* out) {
-  const ssBodyTuned* tuned = &binding->tuned;
-  *out = (ssBodyWritten){0, 0, 0, 0, 0};
-  if (binding->has_damping) {
-    /* ODE scales velocity by (1 - scale) once per step: this scale removes the same fraction per second */
-    int as_tuned = step_s == tuned->damping_step_s;
-    out->linear_scale = as_tuned ? tuned->linear_scale : -expm1(-binding->linear_rate_per_s * step_s);
-    out->angular_scale = as_tuned ? tuned->angular_scale : -expm1(-binding->angular_rate_per_s * step_s);
-  }
-  if (!binding->has_auto_disable) return;
-  if (step_s == tuned->auto_disable_step_s) {
-    out->idle_steps = tuned->idle_steps;
-    out->idle_time_s = tuned->idle_time_s;
-    out->average_samples = tuned->average_samples;
-    return;
-  }
-  double steps = stepsIn(binding->idle_time_s, step_s);
-  out->idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
-  out->idle_time_s = binding->idle_time_s;
-  /* ODE allocates two vectors a sample for every body: bounded, see SS_MAX_AVERAGE_SAMPLES */
-  double samples = fmax(1.0, stepsIn(binding->average_window_s, step_s));
-  out->average_samples = samples < SS_MAX_AVERAGE_SAMPLES ? (int)samples : SS_MAX_AVERAGE_SAMPLES;
-}
-
 /* The body's numbers for a step of step_s: at the step adoption read them for, the program's own; otherwise what the
  * rates and seconds stand for at this step. */
 static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {

@@ -3,8 +3,12 @@
 #ifndef STEADYSTEP_REGISTRY_INTERNAL_H
 #define STEADYSTEP_REGISTRY_INTERNAL_H
 
+#include <math.h>
+#include <stdint.h>
+
 #include "pointer_set.h"
 #include "row_law.h"
+#include "steadystep/limits.h"
 #include "steadystep/registry.h"
 
 #define REQUIRE_REGISTRY(registry) \
@@ -46,7 +50,36 @@ typedef struct ssBodyWritten {
   double idle_time_s;
   int average_samples;
 } ssBodyWritten;
-void ssBodyWrittenFor(const ssBodyBinding* binding, double step_s, ssBodyWritten* out);
+
+/* ODE counts steps: a count of seconds in steps of h, where a whole number of steps computed with rounding error
+ * (10·(1/60)/(1/60) = 10.000000000000002) must not become one more. */
+static inline double ssStepsIn(double seconds, double step_s) { return ceil(seconds / step_s - 1e-9); }
+
+/* Inline: Apply writes, and follow.c compares, every awake body's at every frame; at the tuned step they are the
+ * tuned numbers. */
+static inline void ssBodyWrittenFor(const ssBodyBinding* binding, double step_s, ssBodyWritten* out) {
+  const ssBodyTuned* tuned = &binding->tuned;
+  *out = (ssBodyWritten){0, 0, 0, 0, 0};
+  if (binding->has_damping) {
+    /* ODE scales velocity by (1 - scale) once per step: this scale removes the same fraction per second */
+    int as_tuned = step_s == tuned->damping_step_s;
+    out->linear_scale = as_tuned ? tuned->linear_scale : -expm1(-binding->linear_rate_per_s * step_s);
+    out->angular_scale = as_tuned ? tuned->angular_scale : -expm1(-binding->angular_rate_per_s * step_s);
+  }
+  if (!binding->has_auto_disable) return;
+  if (step_s == tuned->auto_disable_step_s) {
+    out->idle_steps = tuned->idle_steps;
+    out->idle_time_s = tuned->idle_time_s;
+    out->average_samples = tuned->average_samples;
+    return;
+  }
+  double steps = ssStepsIn(binding->idle_time_s, step_s);
+  out->idle_steps = steps < INT32_MAX ? (int)steps : INT32_MAX;
+  out->idle_time_s = binding->idle_time_s;
+  /* ODE allocates two vectors a sample for every body: bounded, see SS_MAX_AVERAGE_SAMPLES */
+  double samples = fmax(1.0, ssStepsIn(binding->average_window_s, step_s));
+  out->average_samples = samples < SS_MAX_AVERAGE_SAMPLES ? (int)samples : SS_MAX_AVERAGE_SAMPLES;
+}
 
 /* The program stays in charge (follow.c): every adopted value the registry writes for each step (the world's
  * ERP/CFM, each joint row, each body's damping and auto-disable, as adoption read them or as followed since) that ODE

@@ -25,12 +25,25 @@ static const double kStepCountSlack = 1e-9;
 /* A contact's surface as the program gave it and as ssStepper_SoftenContact wrote it, within one step: a near
  * callback gives most contacts the same surface, and the softness depends on nothing else (contact.c), so the next
  * such contact is written from here. */
+#if defined(dDOUBLE)
+typedef uint64_t RealBits;
+#else
+typedef uint32_t RealBits;
+#endif
 typedef struct ContactMemo {
   int valid; /* 0 from the start of every step: the step's length, the mapping or the tuned world changed */
   int mode_in, mode_out;
-  dReal erp_in, cfm_in, erp_out, cfm_out;
-  ssRowFallback handed_on;
+  RealBits erp_in, cfm_in;     /* the given soft_erp and soft_cfm, as bits */
+  RealBits erp_mask, cfm_mask; /* all ones where mode_in uses the value, 0 where any value is the same surface */
+  dReal erp_out, cfm_out;
+  int* counter; /* the frame report's count of contacts served as this one, or one nobody reads (no frame) */
 } ContactMemo;
+
+static RealBits bitsOf(dReal value) {
+  RealBits bits;
+  memcpy(&bits, &value, sizeof bits);
+  return bits;
+}
 
 struct ssStepper {
   ssStepperDef def;            /* def.registry: the registry in use, the given one or owned_registry */
@@ -61,6 +74,7 @@ struct ssStepper {
   ssStepInfo current;
   ssContactCache contact_cache; /* a program softens many contacts with the same numbers */
   ContactMemo contact_memo;     /* the last contact softened in this step, as given and as written */
+  int contacts_outside_frames;  /* softened between frames: counted where no report reads them */
   ssFrameReport* report; /* the frame being stepped, for ssStepper_SoftenContact's counts */
   ssPoseHistory* poses;  /* SS_CUT_FIXED: the known bodies' last two states, to draw (interpolation.c) */
   /* the first failure, latched until ssStepper_Reset */
@@ -412,18 +426,20 @@ static int contactSurelyFinite(const dContactGeom* geom) {
   return sum - sum == 0.0;
 }
 
-static void countContact(ssStepper* stepper, ssRowFallback handed_on) {
-  if (stepper->report == NULL) return;
+/* Where a contact served as handed_on says is counted: the frame report's (a contact is never handed to matched),
+ * or, outside a frame, a count nobody reads. */
+static int* contactCounter(ssStepper* stepper, ssRowFallback handed_on) {
+  if (stepper->report == NULL) return &stepper->contacts_outside_frames;
   ssServedCounts* contacts = &stepper->report->contacts;
-  if (handed_on.to_implicit_euler) contacts->handed_to_implicit_euler += 1; /* a contact is never handed to matched */
-  else contacts->by_mapping += 1;
+  return handed_on.to_implicit_euler ? &contacts->handed_to_implicit_euler : &contacts->by_mapping;
 }
 
-/* Whether the contact's surface is the one the memo was written from (the values its mode uses). */
+/* Whether the contact's surface is the one the memo was written from: the values its mode uses, bit for bit (a
+ * memo is made only from values the slow path took, so no NaN matches; -0 for 0 takes the slow path). */
 static int sameSurface(const ContactMemo* memo, const dSurfaceParameters* surface) {
-  return memo->valid && surface->mode == memo->mode_in &&
-         (!(surface->mode & dContactSoftERP) || surface->soft_erp == memo->erp_in) &&
-         (!(surface->mode & dContactSoftCFM) || surface->soft_cfm == memo->cfm_in);
+  RealBits differ = ((bitsOf(surface->soft_erp) ^ memo->erp_in) & memo->erp_mask) |
+                    ((bitsOf(surface->soft_cfm) ^ memo->cfm_in) & memo->cfm_mask);
+  return memo->valid & (surface->mode == memo->mode_in) & (differ == 0);
 }
 
 /* Kept out of line: the usual contact's path (ssStepper_SoftenContact) then needs no frame of its own. */
@@ -443,18 +459,25 @@ static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* co
                                          "with a spring of your own (ssContactSoften)");
   dSurfaceParameters* surface = &contact->surface;
   ssSoftness world = ssRegistryTunedWorld(stepper->def.registry);
-  ContactMemo given = {1, surface->mode, 0, surface->soft_erp, surface->soft_cfm, 0, 0, {0, 0}};
+  ContactMemo given = {.valid = 1,
+                       .mode_in = surface->mode,
+                       .erp_in = bitsOf(surface->soft_erp),
+                       .cfm_in = bitsOf(surface->soft_cfm),
+                       .erp_mask = (surface->mode & dContactSoftERP) ? ~(RealBits)0 : 0,
+                       .cfm_mask = (surface->mode & dContactSoftCFM) ? ~(RealBits)0 : 0};
+  ssRowFallback handed_on = {0, 0};
   double erp = (surface->mode & dContactSoftERP) ? surface->soft_erp : world.erp;
   double cfm = (surface->mode & dContactSoftCFM) ? surface->soft_cfm : world.cfm;
   const ssStepInfo* step = &stepper->current;
   ssStatus status = ssContactSoftenCached(&stepper->contact_cache, contact, erp, cfm, tuned_step_s, step->mapping,
-                                          step->softness_step_s, &given.handed_on);
+                                          step->softness_step_s, &handed_on);
   if (status != SS_OK) return status;
   given.mode_out = surface->mode;
   given.erp_out = surface->soft_erp;
   given.cfm_out = surface->soft_cfm;
+  given.counter = contactCounter(stepper, handed_on);
   stepper->contact_memo = given;
-  countContact(stepper, given.handed_on);
+  *given.counter += 1;
   return SS_OK;
 }
 
@@ -467,7 +490,7 @@ ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID 
   contact->surface.mode = memo->mode_out;
   contact->surface.soft_erp = memo->erp_out;
   contact->surface.soft_cfm = memo->cfm_out;
-  countContact(stepper, memo->handed_on);
+  *memo->counter += 1;
   return SS_OK;
 }
 
