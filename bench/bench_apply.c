@@ -90,7 +90,8 @@ static Scene build(int adopted, int distinct, int config) {
   }
   if (adopted) { /* the world, then each chain through one of its links */
     check(ssRegistry_AdoptWorld(scene.registry, kFrame_s, NULL), "adopt the world");
-    for (int chain = 0; chain < kChains; ++chain) check(ssRegistry_AdoptBody(scene.registry, heads[chain], NULL), "adopt");
+    for (int chain = 0; chain < kChains; ++chain)
+      check(ssRegistry_AdoptBody(scene.registry, heads[chain], NULL), "adopt the chain");
   }
   ssApplyDisableCaches(scene.registry, kDisabled[config]);
   return scene;
@@ -145,7 +146,8 @@ static void report(ssMapping mapping, int adopted, int varying, int distinct, in
   }
   double apply_us = 1e6 * benchMedian(seconds[0], repeats);
   printf("  %-14s %-8s %-8s %-8s %8.2f %6.2f%%", ssMappingName(mapping), adopted ? "adopted" : "bound",
-         varying ? "varying" : "1/60 s", distinct ? "distinct" : "shared", apply_us, 100 * apply_us / (1e6 * benchMedian(step_s, repeats)));
+         varying ? "varying" : "1/60 s", distinct ? "distinct" : "shared", apply_us,
+         100 * apply_us / (1e6 * benchMedian(step_s, repeats)));
   for (int c = 1; c < kConfigs; ++c) printf(" %10.2f", benchMedian(ratios[c], repeats));
   printf("\n");
 }

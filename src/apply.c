@@ -295,8 +295,9 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
     countRow(fallback, &counts);
   }
   const int accurate = mapping != SS_MAPPING_IMPLICIT_EULER;
+  const int handed_on = accurate && APPLY_CACHE_ON(state, SS_APPLY_HANDED_ON);
   const int by_law = APPLY_CACHE_ON(state, SS_APPLY_BY_LAW) && state->rows_outside_laws == 0 &&
-                     (!accurate || (APPLY_CACHE_ON(state, SS_APPLY_HANDED_ON) && ssApplyEveryLawHandedOn(state, step_s)));
+                     (!accurate || (handed_on && ssApplyEveryLawHandedOn(state, step_s)));
   ssSoftness law_softness[kLawTableSize];
   if (!by_law) ssApplyMaterializeRows(state); /* computeRows and writeRows compare each row's own */
   int unwritten = 0; /* rows whose pending differs from what ODE holds: with none (constant steps), no second pass */

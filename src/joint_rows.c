@@ -277,9 +277,8 @@ ssBodyInverseBound ssBodyInverseBoundOf(dBodyID body) {
   double minor = a00 * a11 - a01 * a10, det = a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) +
                                               a02 * (a10 * a21 - a11 * a20);
   int symmetric = a01 == a10 && a02 == a20 && a12 == a21;
-  out.angular = symmetric && high < INFINITY && a00 > 0 && minor > 1e-12 * high * high && det > 1e-4 * high * high * high
-                    ? 1.0 / high
-                    : NAN;
+  int definite = a00 > 0 && minor > 1e-12 * high * high && det > 1e-4 * high * high * high;
+  out.angular = symmetric && high < INFINITY && definite ? 1.0 / high : NAN;
   return out;
 }
 

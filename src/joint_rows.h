@@ -69,8 +69,8 @@ void ssBodyInverseOf(dBodyID body, ssBodyInverse* out);
 
 /* Lower bounds of what a body opposes to a row whatever the row's unit direction and the body's rotation:
  * ssRowInverseMass of a linear row is at least `linear` (1/kg), of an angular row at least `angular` (1/(kg·m²)),
- * within roundings below SS_MASS_BOUND_MARGIN of either. Both 0 for the static world and kinematic bodies, which oppose nothing;
- * NAN where no bound is sure: a mass that is not positive and finite, an inertia with off-diagonal terms that is not
+ * within roundings below SS_MASS_BOUND_MARGIN of either. Both 0 for the static world and kinematic bodies, which
+ * oppose nothing; NAN where no bound is sure: a mass that is not positive and finite, an inertia with off-diagonal terms that is not
  * symmetric, or not surely positive definite with its eigenvalues within a factor 10⁴. Apply bounds the masses of
  * a law's rows with them, reading no axis (ssSurelyFailsUpToMass). */
 typedef struct ssBodyInverseBound {
