@@ -142,6 +142,7 @@ static void describeNextStep(ssStepper* stepper) {
   stepper->current = (ssStepInfo){stepping->mapping, step_s,           softnessStep(stepping, step_s),
                                    stepper->previous_step_s, 0, 1, stepper->time_s};
   stepper->contact_memo.valid = 0;
+  stepper->contacts_outside_frames = 0; /* read by nobody: kept from growing without end */
 }
 
 /* A seed of its own for ODE's generator (splitmix64's finalizer): nearby seeds give unrelated row orders. */
