@@ -86,9 +86,10 @@ void ssApplyRebuildBodies(ApplyState* state) {
     }
     BoundRow* bound = &state->bound_rows[state->bound_row_count++];
     *bound = (BoundRow){.joint = row->joint, .law_slot = {(int16_t)row->law_slot, -1}, .angular = angular};
-    for (int side = 0; side < 2; ++side) {
-      bound->body[side] = dJointGetBody(row->joint, side);
-      bound->bound[side] = row->body_slot[side] >= 0 ? &state->bodies[row->body_slot[side]].bound : NULL;
+    for (int side = 0; side < 2; ++side) { /* the slots just found: no joint read again */
+      const int slot = row->body_slot[side];
+      bound->body[side] = slot >= 0 ? cache[slot].body : 0;
+      bound->bound[side] = slot >= 0 ? &cache[slot].bound : NULL;
     }
   }
 }

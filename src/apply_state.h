@@ -65,8 +65,9 @@ typedef struct HotRow {
 } HotRow;
 
 /* What bounds the mass of a joint's measured rows on one kind of axis (apply_handed.c), packed apart: the bodies
- * the joint had when the body cache was built, with where the cache keeps their bounds (the static world's and a
- * body's that the cache could not hold: NULL), and the laws of up to two rows (a stop and its motor; -1: none). */
+ * the joint had in the body cache when it was built, with where the cache keeps their bounds (0 and NULL for the
+ * static world and for a body the cache could not hold: read then), and the laws of up to two rows (a stop and its
+ * motor; -1: none). */
 typedef struct BoundRow {
   dJointID joint;
   dBodyID body[2];
