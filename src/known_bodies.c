@@ -153,6 +153,7 @@ static int append(ssKnownBodies* known, dBodyID body) {
   known->moves_unseen[k] = !hasGeomIn(body, known->seen_space);
   known->reached[k] = 0;
   known->count += 1;
+  known->stepped_valid = 0;
   return 1;
 }
 
@@ -213,6 +214,7 @@ ssStatus ssKnownAdd(ssKnownBodies* known, dBodyID body) {
 }
 
 void ssKnownCheckAllOnce(ssKnownBodies* known) {
+  known->stepped_valid = 0;
   if (known->count > 0) memset(known->awake, 1, (size_t)known->count);
 }
 
@@ -237,6 +239,7 @@ void ssKnownForget(ssKnownBodies* known, dBodyID body) {
     ssPointerMapPut(&known->index, known->ids[k], k); /* replaces a value: allocates nothing */
   }
   known->count = last;
+  known->stepped_valid = 0; /* the queue names places */
   for (int g = 0; g < known->geared_count; ++g)
     if (known->geared[g] == body) known->geared[g--] = known->geared[--known->geared_count];
   /* the pushed list names places: the forgotten body's goes, the moved body's follows it */
@@ -418,8 +421,10 @@ static int bodyWithin(const ssBodyValues* v, double max_speed2, double max_spin2
 /* The walk from the bodies ODE steps to the sleeping ones it wakes through their joints (contacts too): ODE's island
  * takes a disabled body joined to an enabled one, and every disabled body joined to that. Visits each listed body
  * it reaches once (reached[] holds this check's number); visit returns 0 to stop the walk at a failing body, which
- * the walk returns (else -1). The queue starts with the bodies [0, queued) of known->queue. */
-static int wakeWalk(ssKnownBodies* known, int queued, int (*visit)(ssKnownBodies*, int, void*), void* context) {
+ * the walk returns (else -1). The queue starts with the bodies ODE steps as the pass found them (stepped_count), and
+ * ends with every body it steps. */
+static int wakeWalk(ssKnownBodies* known, int (*visit)(ssKnownBodies*, int, void*), void* context) {
+  int queued = known->stepped_count;
   for (int head = 0; head < queued; ++head) {
     dBodyID body = known->ids[known->queue[head]];
     for (int j = 0, joints = dBodyGetNumJoints(body); j < joints; ++j) {
@@ -430,8 +435,9 @@ static int wakeWalk(ssKnownBodies* known, int queued, int (*visit)(ssKnownBodies
         if (k < 0 || known->reached[k] == known->checks) continue;
         known->reached[k] = known->checks;
         known->awake[k] = 1;
+        known->queue[queued] = k;
+        known->stepped_count = ++queued;
         if (!visit(known, k, context)) return k;
-        known->queue[queued++] = k;
       }
     }
   }
@@ -449,7 +455,8 @@ static int checkVisit(ssKnownBodies* known, int k, void* context) {
 }
 
 /* A check's mark of body k, in the pass that reads it: whether ODE steps it (enabled, or awake at the last check:
- * ODE stepped it before it disabled it), then reached[] is this check's number; a sleeping body is counted in
+ * ODE stepped it before it disabled it), then reached[] is this check's number and it is queued (stepped_count); a
+ * sleeping body is counted in
  * *asleep, and in *unseen when the program could move it unseen (moves_unseen). awake[] becomes whether it is
  * enabled. */
 static inline int markBody(ssKnownBodies* known, int k, int* asleep, int* unseen) {
@@ -457,6 +464,7 @@ static inline int markBody(ssKnownBodies* known, int k, int* asleep, int* unseen
   known->awake[k] = (unsigned char)enabled;
   if (due) {
     known->reached[k] = known->checks;
+    known->queue[known->stepped_count++] = k;
   } else {
     *asleep += 1;
     *unseen += known->moves_unseen[k];
@@ -464,10 +472,11 @@ static inline int markBody(ssKnownBodies* known, int k, int* asleep, int* unseen
   return due;
 }
 
-/* A large world's next body asked for: the flags and joints at its head, and the values a pass reads. */
+/* A large world's next body asked for: the flags and joints at its head, and, awake, the values a pass reads. */
 static void prefetchBody(const ssKnownBodies* known, int k, int forces) {
   const ssBodyValues* v = &known->values[k];
   SS_PREFETCH(known->ids[k]);
+  if (!known->awake[k]) return; /* asleep at the last check: most likely its values are not read */
   prefetchState(v);
   if (forces) SS_PREFETCH(v->force), SS_PREFETCH(v->torque);
 }
@@ -487,19 +496,27 @@ static int checkUnseen(ssKnownBodies* known, int unseen, const CheckVisit* check
 /* The first body this check marked whose state (and with check->forces its accumulators) fails the check, or -1:
  * looked for only after the pass found that one does. */
 static int firstMarkedFailing(const ssKnownBodies* known, const CheckVisit* check) {
-  for (int k = 0; k < known->count; ++k)
-    if (known->reached[k] == known->checks &&
-        !bodyWithin(&known->values[k], check->max_speed2, check->max_spin2, check->forces))
-      return k;
+  for (int q = 0; q < known->stepped_count; ++q) {
+    int k = known->queue[q];
+    if (!bodyWithin(&known->values[k], check->max_speed2, check->max_spin2, check->forces)) return k;
+  }
   return -1;
 }
 
-/* The bodies marked this check, queued for the wake walk: how many. */
-static int queueMarked(ssKnownBodies* known) {
-  int queued = 0;
-  for (int k = 0; k < known->count; ++k)
-    if (known->reached[k] == known->checks) known->queue[queued++] = k;
-  return queued;
+/* The pass over the bodies ODE stepped, when nothing but ODE's step ran since the last check (stepped_valid): a body
+ * asleep then is asleep now unless the step woke it through a joint (the wake walk finds it), so only those are read,
+ * each marked as markBody marks it. Whether all passed. */
+static int checkStepped(ssKnownBodies* known, const CheckVisit* check) {
+  int all = 1;
+  const int stepped = known->stepped_count, until = ssPrefetchUntil(stepped);
+  for (int q = 0; q < stepped; ++q) {
+    int k = known->queue[q];
+    if (q < until) prefetchBody(known, known->queue[q + kPrefetchAhead], check->forces);
+    known->awake[k] = (unsigned char)(dBodyIsEnabled(known->ids[k]) != 0);
+    known->reached[k] = known->checks;
+    all &= bodyWithin(&known->values[k], check->max_speed2, check->max_spin2, check->forces);
+  }
+  return all;
 }
 
 /* The place of body on the list, marked as met by this check (-1: not listed, or met already). */
@@ -511,23 +528,30 @@ static int meetAlso(ssKnownBodies* known, dBodyID body) {
 }
 
 ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
-                      const dBodyID* also, int also_count, dBodyID* failed) {
+                      const dBodyID* also, int also_count, int only_stepped, dBodyID* failed) {
   CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed,
                       bounds->forces};
   const ssBodyValues* values = known->values;
   const int count = known->count, until = ssPrefetchUntil(count);
   ++known->checks;
-  /* one pass reads each body once, marks it and checks what ODE steps (the usual case: all pass; the first failure
-   * is found after); a sleeping body's values are not read */
-  int all = 1, asleep = 0, unseen = 0;
-  for (int k = 0; k < count; ++k) {
-    if (k < until) prefetchBody(known, k + kPrefetchAhead, check.forces);
-    if (markBody(known, k, &asleep, &unseen))
-      all &= bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
+  int all = 1, unseen = 0;
+  if (only_stepped && known->stepped_valid) {
+    all = checkStepped(known, &check);
+  } else {
+    /* one pass reads each body once, marks it and checks what ODE steps (the usual case: all pass; the first
+     * failure is found after); a sleeping body's values are not read */
+    int asleep = 0;
+    known->stepped_count = 0;
+    for (int k = 0; k < count; ++k) {
+      if (k < until) prefetchBody(known, k + kPrefetchAhead, check.forces);
+      if (markBody(known, k, &asleep, &unseen))
+        all &= bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
+    }
+    known->stepped_valid = 1;
   }
-  known->asleep = asleep;
   int failing = all ? -1 : firstMarkedFailing(known, &check);
-  if (failing < 0 && asleep > 0) failing = wakeWalk(known, queueMarked(known), checkVisit, &check);
+  if (failing < 0 && known->stepped_count < count) failing = wakeWalk(known, checkVisit, &check);
+  known->asleep = count - known->stepped_count;
   if (failing < 0) failing = checkUnseen(known, unseen, &check);
   if (failing >= 0) return nameFailure(known, failing, bounds, when, step, steps, failed);
   for (int a = 0; a < also_count; ++a) {
@@ -587,18 +611,20 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   /* one pass reads each body once: its joints (a sleeping body's joint may be destroyed too, so every body's are read
    * before a failure is told), its mark, and the state and forces of what ODE steps */
   int all = 1, changed = 0, asleep = 0, unseen = 0;
+  known->stepped_count = 0;
   for (int k = 0; k < count; ++k) {
     if (k < until) prefetchBody(known, k + kPrefetchAhead, 1), prefetchJoints(known, k + kPrefetchAhead);
     changed |= jointsChangedAt(known, k);
     if (markBody(known, k, &asleep, &unseen)) all &= startBody(known, k, check.max_speed2, check.max_spin2);
   }
-  known->asleep = asleep;
+  known->stepped_valid = 1;
   if (changed) { /* the caller lists the bodies again, each then checked at the next call, and calls again */
     *joints_changed = 1;
     return SS_OK;
   }
   int failing = all ? -1 : firstMarkedFailing(known, &check);
-  if (failing < 0 && asleep > 0) failing = wakeWalk(known, queueMarked(known), startVisit, &check);
+  if (failing < 0 && asleep > 0) failing = wakeWalk(known, startVisit, &check);
+  known->asleep = count - known->stepped_count;
   if (failing < 0) failing = checkUnseen(known, unseen, &check); /* checked only: a sleeping body's force waits */
   for (int a = 0; failing < 0 && a < also_count; ++a) {
     int k = meetAlso(known, also[a]);

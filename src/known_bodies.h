@@ -60,7 +60,11 @@ typedef struct ssKnownBodies {
    * seen_space, where ODE puts a moved geom at the head): such a body is checked asleep too */
   unsigned char* moves_unseen;
   unsigned* reached;  /* the check that last met the body through joints (ssKnownCheck's walk) */
-  int* queue;         /* that walk's bodies still to visit */
+  /* the bodies ODE steps, as the last check found them: [0, stepped_count) of queue, marked first, then those the
+   * wake walk reached. While stepped_valid (no body listed or forgotten since, none told to be checked once more),
+   * a check after ODE's step alone reads these and what the walk reaches from them, and no sleeping body */
+  int* queue;
+  int stepped_count, stepped_valid;
   unsigned checks;    /* checks made, numbering them for reached */
   int asleep;         /* the bodies the last check found asleep (neither enabled nor awake at the check before) */
   ssPointerMap index; /* body -> its place in the arrays above */
@@ -132,9 +136,11 @@ typedef struct ssBodyBounds {
  * (bounds->gear_step_s), and with bounds->forces its accumulators. On the first failure records the message (the body,
  * the quantity, its value, "`when` step `step` of `steps`", formatted then only), sets *failed to the body and returns
  * SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a force or
- * torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). */
+ * torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). only_stepped says that nothing but ODE's step ran
+ * since the last check (no program code could enable or move a body): then the bodies that check found ODE stepping
+ * are read, and the walk from them, not every body (stepped_valid). */
 ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
-                      const dBodyID* also, int also_count, dBodyID* failed);
+                      const dBodyID* also, int also_count, int only_stepped, dBodyID* failed);
 
 /* Before a frame, one pass: *joints_changed says whether a body's joints changed (then nothing is checked: the caller
  * lists the bodies again and calls again, and the marks and forces read are made again); else the bodies ODE steps are

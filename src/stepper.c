@@ -718,14 +718,15 @@ static ssStatus latch(ssStepper* stepper, ssStatus status) {
   return status;
 }
 
-/* Every known body's state and forces (as asked) within limits.h and the stepping's speeds. */
-static ssStatus checkKnown(ssStepper* stepper, int forces, const char* when, int index, int steps, double step_s,
-                           ssFrameReport* report) {
+/* Every known body ODE steps: its state and forces (as asked) within limits.h and the stepping's speeds. only_stepped:
+ * nothing but ODE's step ran since the last check, and the bodies it stepped are read, no sleeping one. */
+static ssStatus checkKnown(ssStepper* stepper, int forces, int only_stepped, const char* when, int index, int steps,
+                           double step_s, ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
   ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, forces, step_s};
   dBodyID failed = 0;
   ssStatus status = ssKnownCheck(&stepper->known, &bounds, when, index + 1, steps, stepper->moved.list,
-                                 stepper->moved.count, &failed);
+                                 stepper->moved.count, only_stepped, &failed);
   if (status != SS_OK) report->failed_body = failed;
   return status;
 }
@@ -825,7 +826,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
     int acted = def->before_step || (i > 0 && def->step_done);
     if (acted && def->collide && !stepper->destroy_requested &&
         ((status = refreshKnown(stepper)) != SS_OK ||
-         (status = checkKnown(stepper, 0, "before the collision of", i, steps, step_s, report)) != SS_OK))
+         (status = checkKnown(stepper, 0, 0, "before the collision of", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     if (!stepper->destroy_requested && def->collide) {
       int softened_before = softenedContacts(report);
@@ -844,7 +845,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
      * after the last step's check */
     if ((acted || def->collide) &&
         ((status = refreshKnown(stepper)) != SS_OK || /* what the callbacks bound or watched */
-         (status = checkKnown(stepper, 1, "before", i, steps, step_s, report)) != SS_OK))
+         (status = checkKnown(stepper, 1, 0, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistoryBeforeLastStep(stepper->poses);
     int stepped = odeStep(stepper, step_s);
@@ -859,7 +860,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
     report->simulated_s += step_s;
     stepper->time_s += step_s;
     report->time_s = stepper->time_s;
-    if ((status = checkKnown(stepper, 0, "after", i, steps, step_s, report)) != SS_OK) return latch(stepper, status);
+    if ((status = checkKnown(stepper, 0, 1, "after", i, steps, step_s, report)) != SS_OK) return latch(stepper, status);
     stepper->previous_step_s = use_history ? step_s : 0;
     if (def->step_done) def->step_done(def->step_done_context, step_s);
     if (stepper->destroy_requested) return SS_OK;
