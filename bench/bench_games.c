@@ -57,15 +57,15 @@ static void nearCallback(void* data, dGeomID o1, dGeomID o2) {
   dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
   if (b1 != 0 && b2 != 0 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
   dContact contact[kMaxContacts];
-  int count = dCollide(o1, o2, kMaxContacts, &contact[0].geom, sizeof(dContact));
-  for (int i = 0; i < count; ++i) {
+  for (int i = 0; i < kMaxContacts; ++i) {
     contact[i].surface.mode = dContactSoftCFM | dContactSoftERP | dContactApprox1;
     contact[i].surface.mu = 0.8;
     contact[i].surface.soft_erp = 0.2;
     contact[i].surface.soft_cfm = 1e-4;
-    if (game->stepper != NULL) ssStepper_SoftenContact(game->stepper, &contact[i], b1, b2);
-    dJointAttach(dJointCreateContact(game->world, game->contacts, &contact[i]), b1, b2);
   }
+  int count = dCollide(o1, o2, kMaxContacts, &contact[0].geom, sizeof(dContact));
+  if (game->stepper != NULL) ssStepper_SoftenContacts(game->stepper, contact, count);
+  for (int i = 0; i < count; ++i) dJointAttach(dJointCreateContact(game->world, game->contacts, &contact[i]), b1, b2);
 }
 
 static void collideAll(Game* game) {

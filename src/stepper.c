@@ -36,6 +36,7 @@ typedef struct ContactMemo {
   RealBits erp_in, cfm_in;     /* the given soft_erp and soft_cfm, as bits */
   RealBits erp_mask, cfm_mask; /* all ones where mode_in uses the value, 0 where any value is the same surface */
   dReal erp_out, cfm_out;
+  int rewrites; /* whether the written surface differs from the given one (naive's does not) */
   int* counter; /* the frame report's count of contacts served as this one, or one nobody reads (no frame) */
 } ContactMemo;
 
@@ -418,13 +419,12 @@ ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper) {
   return (ssStepInfo){SS_MAPPING_IMPLICIT_EULER, 0, 0, 0, 0, 0, 0};
 }
 
-/* Whether a contact's position, normal and depth are surely finite: their sum less itself is 0 only then (a NaN or
- * an infinity makes it NaN). A sum that overflows says no for finite values, and the contact then takes the slow
- * path, which checks each value (contact.c). */
-static int contactSurelyFinite(const dContactGeom* geom) {
-  double sum = (double)geom->depth + geom->pos[0] + geom->pos[1] + geom->pos[2] + geom->normal[0] + geom->normal[1] +
-               geom->normal[2];
-  return sum - sum == 0.0;
+/* A contact's position, normal and depth summed: the sum less itself is 0 only when each is finite (a NaN or an
+ * infinity makes it NaN). A sum that overflows says no for finite values, and the contacts then take the slow path,
+ * which checks each value (contact.c). Summed over a batch, one comparison tells every contact of it. */
+static double geometrySum(const dContactGeom* geom) {
+  return (double)geom->depth + geom->pos[0] + geom->pos[1] + geom->pos[2] + geom->normal[0] + geom->normal[1] +
+         geom->normal[2];
 }
 
 /* Where a contact served as handed_on says is counted: the frame report's (a contact is never handed to matched),
@@ -435,25 +435,30 @@ static int* contactCounter(ssStepper* stepper, ssRowFallback handed_on) {
   return handed_on.to_implicit_euler ? &contacts->handed_to_implicit_euler : &contacts->by_mapping;
 }
 
-/* Whether the contact's surface is the one the memo was written from: the values its mode uses, bit for bit (a
- * memo is made only from values the slow path took, so no NaN matches; -0 for 0 takes the slow path). */
-static int sameSurface(const ContactMemo* memo, const dSurfaceParameters* surface) {
-  RealBits differ = ((bitsOf(surface->soft_erp) ^ memo->erp_in) & memo->erp_mask) |
-                    ((bitsOf(surface->soft_cfm) ^ memo->cfm_in) & memo->cfm_mask);
-  return memo->valid & (surface->mode == memo->mode_in) & (differ == 0);
+/* 0 when the surface is the one the memo was written from (the values its mode uses, bit for bit), else not 0. A
+ * memo is made only from values the slow path took, so no NaN matches; -0 for 0 takes the slow path. */
+static RealBits surfaceDiffers(const ContactMemo* memo, const dSurfaceParameters* surface) {
+  RealBits mode = (RealBits)(unsigned)(surface->mode ^ memo->mode_in);
+  return ((bitsOf(surface->soft_erp) ^ memo->erp_in) & memo->erp_mask) |
+         ((bitsOf(surface->soft_cfm) ^ memo->cfm_in) & memo->cfm_mask) | mode;
 }
 
-/* Kept out of line: the usual contact's path (ssStepper_SoftenContact) then needs no frame of its own. */
+/* Writes the memo's softness into a contact like the one it was made from. */
+static void writeMemo(const ContactMemo* memo, dSurfaceParameters* surface) {
+  surface->mode = memo->mode_out;
+  surface->soft_erp = memo->erp_out;
+  surface->soft_cfm = memo->cfm_out;
+}
+
+/* Kept out of line: the usual contact's path then needs no frame of its own. */
 #if defined(__GNUC__)
 #define SS_OUT_OF_LINE __attribute__((noinline, cold))
 #else
 #define SS_OUT_OF_LINE
 #endif
 
-/* A contact not like the last one: softened by its law (contact.c), and remembered. */
+/* A contact not like the last one: softened by its law (contact.c) and remembered, not counted. */
 static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* contact) {
-  REQUIRE_STEPPER(stepper);
-  if (contact == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "contact = NULL: a contact is required");
   double tuned_step_s = ssRegistry_TunedStep(stepper->def.registry);
   if (tuned_step_s == 0)
     return ssFail(SS_ERROR_OUT_OF_RANGE, "tuned step = 0 s: adopt the world first (ssRegistry_Adopt), or soften "
@@ -476,22 +481,74 @@ static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* co
   given.mode_out = surface->mode;
   given.erp_out = surface->soft_erp;
   given.cfm_out = surface->soft_cfm;
+  given.rewrites = given.mode_out != given.mode_in || bitsOf(given.erp_out) != given.erp_in ||
+                   bitsOf(given.cfm_out) != given.cfm_in;
   given.counter = contactCounter(stepper, handed_on);
   stepper->contact_memo = given;
-  *given.counter += 1;
   return SS_OK;
+}
+
+/* One contact, as the last one or by its law; the memo then describes it (and its count). */
+static ssStatus softenOne(ssStepper* stepper, dContact* contact) {
+  const ContactMemo* memo = &stepper->contact_memo;
+  double sum = geometrySum(&contact->geom);
+  if (!memo->valid || surfaceDiffers(memo, &contact->surface) != 0 || sum - sum != 0.0) {
+    ssStatus status = softenNewContact(stepper, contact);
+    if (status != SS_OK) return status;
+  } else {
+    writeMemo(memo, &contact->surface);
+  }
+  return SS_OK;
+}
+
+/* One contact softened and counted. */
+static ssStatus softenCounted(ssStepper* stepper, dContact* contact) {
+  ssStatus status = softenOne(stepper, contact);
+  if (status == SS_OK) *stepper->contact_memo.counter += 1;
+  return status;
+}
+
+static SS_OUT_OF_LINE ssStatus softenContactSlowly(ssStepper* stepper, dContact* contact) {
+  REQUIRE_STEPPER(stepper);
+  if (contact == NULL) return ssFail(SS_ERROR_OUT_OF_RANGE, "contact = NULL: a contact is required");
+  return softenCounted(stepper, contact);
 }
 
 ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
   (void)body1, (void)body2; /* no contact's softness depends on its bodies (contact.c) */
-  if (stepper == NULL || contact == NULL || !sameSurface(&stepper->contact_memo, &contact->surface) ||
-      !contactSurelyFinite(&contact->geom))
-    return softenNewContact(stepper, contact);
-  const ContactMemo* memo = &stepper->contact_memo; /* the usual contact: as the last one */
-  contact->surface.mode = memo->mode_out;
-  contact->surface.soft_erp = memo->erp_out;
-  contact->surface.soft_cfm = memo->cfm_out;
-  *memo->counter += 1;
+  if (stepper == NULL || contact == NULL) return softenContactSlowly(stepper, contact);
+  return softenCounted(stepper, contact);
+}
+
+/* A batch not every contact of which is like the last one: each checked on a copy first, so that an error leaves
+ * every contact as given, then softened. */
+static SS_OUT_OF_LINE ssStatus softenContactsSlowly(ssStepper* stepper, dContact* contacts, int count) {
+  REQUIRE_STEPPER(stepper);
+  if (count < 0) return ssFail(SS_ERROR_OUT_OF_RANGE, "count = %d contacts: must not be negative", count);
+  if (count > 0 && contacts == NULL)
+    return ssFail(SS_ERROR_OUT_OF_RANGE, "contacts = NULL with count = %d: the contacts are required", count);
+  for (int i = 0; i < count; ++i) {
+    dContact copy = contacts[i];
+    ssStatus status = softenOne(stepper, &copy);
+    if (status != SS_OK) return status;
+  }
+  for (int i = 0; i < count; ++i) softenCounted(stepper, &contacts[i]); /* as checked: cannot fail */
+  return SS_OK;
+}
+
+ssStatus ssStepper_SoftenContacts(ssStepper* stepper, dContact* contacts, int count) {
+  if (stepper == NULL || contacts == NULL || count <= 0) return softenContactsSlowly(stepper, contacts, count);
+  const ContactMemo* memo = &stepper->contact_memo;
+  RealBits differs = (RealBits)(unsigned)(memo->valid ^ 1);
+  double sum = 0;
+  for (int i = 0; i < count; ++i) {
+    differs |= surfaceDiffers(memo, &contacts[i].surface);
+    sum += geometrySum(&contacts[i].geom);
+  }
+  if (differs != 0 || sum - sum != 0.0) return softenContactsSlowly(stepper, contacts, count);
+  if (memo->rewrites)
+    for (int i = 0; i < count; ++i) writeMemo(memo, &contacts[i].surface);
+  *memo->counter += count;
   return SS_OK;
 }
 

@@ -79,7 +79,7 @@
  * nothing stepped, until the program sets another.
  *
  * Callbacks (before_step, collide, step_done) may call, on their own stepper:
- *  - ssStepper_CurrentStep, ssStepper_SoftenContact, ssStepper_Stepping, ssStepper_ResetHistory, WatchBody,
+ *  - ssStepper_CurrentStep, ssStepper_SoftenContact(s), ssStepper_Stepping, ssStepper_ResetHistory, WatchBody,
  *    UnwatchBody: as between frames; the known list follows before the next check.
  *  - ssStepper_DestroyBody, ssStepper_DestroyJoint: the body or joint leaves the stepper and the registry at once
  *    (no later part of the frame reads it), then ODE destroys it.
@@ -151,7 +151,8 @@ typedef struct ssStepperDef {
   ssStepCallback* before_step;
   void* before_step_context;
   /* Before each step, after before_step: run collision detection, e.g. dSpaceCollide(space, stepper, near), create
-   * contacts in contact_group and soften each with ssStepper_SoftenContact. May be NULL. */
+   * contacts in contact_group and soften them with ssStepper_SoftenContacts (or each with ssStepper_SoftenContact).
+   * May be NULL. */
   ssStepCallback* collide;
   void* collide_context;
   ssStepDoneCallback* step_done; /* may be NULL */
@@ -173,7 +174,7 @@ typedef struct ssFrameReport {
   double interpolation;       /* FIXED: accumulator / fixed_step_s in [0, 1), to blend the last two states */
   ssServedCounts rows;        /* row-steps: every bound row (the world's included) counted once per physics step,
                                * by who served it (registry.h) */
-  ssServedCounts contacts;    /* contacts softened with ssStepper_SoftenContact, by who served them */
+  ssServedCounts contacts;    /* contacts softened with ssStepper_SoftenContact(s), by who served them */
   int row_writes;             /* parameter sets written into ODE, summed over the frame's Applies (implicit Euler
                                * applies once a frame of equal substeps, and writes only what changed) */
   int unsoftened_contact_steps; /* steps whose collision made contacts on known bodies but softened none with
@@ -272,6 +273,16 @@ SS_API ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper);
  *  normal or depth as the collider made it: ODE 0.16's sphere-cylinder collider makes such contacts; drop it instead
  *  of creating its joint). */
 SS_API ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2);
+
+/** ssStepper_SoftenContact for the count contacts one dCollide call made, in the array it filled (&contacts[0].geom,
+ *  stride sizeof(dContact)): one call a pair of geoms, where ODE's demos fill every contact's surface before
+ *  dCollide and create the joints after it. Each contact is softened as ssStepper_SoftenContact softens it and
+ *  counted the same way; count = 0 does nothing (contacts may then be NULL). A batch whose contacts all have the
+ *  surface the last contact softened in this step had costs one comparison a contact and nothing else.
+ *  Errors, with every contact of the batch unchanged: SS_ERROR_OUT_OF_RANGE (stepper NULL, contacts NULL with
+ *  count > 0, count < 0, and ssStepper_SoftenContact's), SS_ERROR_NOT_FINITE (as ssStepper_SoftenContact, for the
+ *  first contact that has one). */
+SS_API ssStatus ssStepper_SoftenContacts(ssStepper* stepper, dContact* contacts, int count);
 
 /** The most contacts ssStepper_CollideByRule asks dCollide for per pair of geoms. */
 #define SS_MAX_RULE_CONTACTS 4096

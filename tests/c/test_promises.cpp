@@ -90,6 +90,11 @@ class PromiseTest : public OdeTest {
   }
   ssStatus Make(ssStepperDef def) { return ssStepper_Create(&def, &stepper); }
 
+  // The program's contact joint for a contact between a and b, in the contact group.
+  void Attach(const dContact* contact, dGeomID a, dGeomID b) {
+    dJointAttach(dJointCreateContact(world, contacts, contact), dGeomGetBody(a), dGeomGetBody(b));
+  }
+
   // Two gears (boxes) on hinges about y to the static world, 0.6 m apart at z = 1, geared 2:1 by a transmission.
   dJointID Gears(dBodyID gears[2]) {
     gears[0] = Box(0, 0, 1);
@@ -296,6 +301,146 @@ TEST_F(PromiseTest, AContactWithANonFiniteNormalIsRefusedByNameNotSoftened) {
   // stepped with them, the world is safe: Near drops what is refused
   ssFrameReport report;
   EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 60, &report), SS_OK) << ssLastError();
+}
+
+// ssStepper_SoftenContacts softens a batch as ssStepper_SoftenContact softens each contact alone, bit for bit, over
+// many random batches: surfaces alike and unlike, modes with and without ERP and CFM, values the mode does not use
+// left as garbage, steps of several lengths under every mapping.
+TEST_F(PromiseTest, ABatchIsSoftenedAsEachContactAlone) {
+  ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
+  unsigned seed = 12345;
+  auto uniform = [&seed]() { return (seed = seed * 1103515245u + 12345u) / 4294967296.0; };
+  const int modes[] = {dContactSoftCFM, dContactSoftERP, dContactSoftERP | dContactSoftCFM, dContactApprox1};
+  const char* policies[] = {"naive", "implicit-euler", "matched", "exact"};
+  for (int round = 0; round < 400; ++round) {
+    if (round % 50 == 0) {
+      ssStepping stepping = ssStepper_Stepping(stepper);
+      ASSERT_EQ(ssSteppingForPolicy(policies[round / 100], 1.0 / 60, &stepping), SS_OK);
+      ASSERT_EQ(ssStepper_SetStepping(stepper, &stepping), SS_OK) << ssLastError();
+    }
+    dContact batch[6], alone[6];
+    const int count = 1 + round % 6;
+    for (int i = 0; i < count; ++i) {
+      std::memset(&batch[i], 0, sizeof batch[i]);
+      for (int j = 0; j < 3; ++j) batch[i].geom.pos[j] = uniform() - 0.5, batch[i].geom.normal[j] = uniform();
+      batch[i].geom.depth = 0.01 * uniform();
+      const bool like_first = i > 0 && uniform() < 0.7;  // most contacts of a pair share one surface
+      batch[i].surface = like_first ? batch[0].surface : dSurfaceParameters{};
+      if (!like_first) {
+        batch[i].surface.mode = modes[static_cast<int>(uniform() * 4)];
+        batch[i].surface.soft_erp = uniform() < 0.5 ? 0.2 : uniform();
+        batch[i].surface.soft_cfm = uniform() < 0.5 ? 1e-4 : 1e-6 + uniform() * 1e-3;
+      }
+      if (!(batch[i].surface.mode & dContactSoftERP)) batch[i].surface.soft_erp = uniform() * 1e300;  // unused
+      alone[i] = batch[i];
+    }
+    ASSERT_EQ(ssStepper_SoftenContacts(stepper, batch, count), SS_OK) << ssLastError();
+    for (int i = 0; i < count; ++i) ASSERT_EQ(ssStepper_SoftenContact(stepper, &alone[i], 0, 0), SS_OK);
+    ASSERT_EQ(std::memcmp(batch, alone, count * sizeof batch[0]), 0) << "round " << round;
+  }
+}
+
+// A batch in the program's near callback serves and counts what one call a contact does: the same motion, bit for
+// bit, and the same counts in the frame's report.
+TEST_F(PromiseTest, ABatchInTheNearCallbackCountsAndMovesAsOneCallAContact) {
+  dWorldSetGravity(world, 0, 0, -9.81);
+  dCreatePlane(space, 0, 0, 1, 0);
+  dBodyID box = Box(0, 0, 0.06);
+  dBodySetLinearVel(box, 0.3, 0, 0);
+  std::vector<double> path[2];
+  ssServedCounts counted[2] = {};
+  for (int batched = 0; batched < 2; ++batched) {
+    dBodySetPosition(box, 0, 0, 0.06);
+    dBodySetLinearVel(box, 0.3, 0, 0);
+    dBodySetAngularVel(box, 0, 0, 0);
+    const dReal upright[4] = {1, 0, 0, 0};
+    dBodySetQuaternion(box, upright);
+    dRandSetSeed(1);  // QuickStep's row order: the same for both runs
+    ssStepperDef def = Def();
+    def.collide_context = this;
+    def.collide = batched ? [](void* context, ssStepper*) {
+      dSpaceCollide(static_cast<PromiseTest*>(context)->space, context, [](void* data, dGeomID a, dGeomID b) {
+        auto* t = static_cast<PromiseTest*>(data);
+        dContact contact[4];
+        std::memset(contact, 0, sizeof contact);
+        for (dContact& c : contact) c.surface.mode = dContactSoftCFM, c.surface.mu = 1, c.surface.soft_cfm = 1e-4;
+        int n = dCollide(a, b, 4, &contact[0].geom, sizeof(dContact));
+        EXPECT_EQ(ssStepper_SoftenContacts(t->stepper, contact, n), SS_OK);
+        for (int i = 0; i < n; ++i) t->Attach(&contact[i], a, b);
+      });
+    } : [](void* context, ssStepper*) {
+      dSpaceCollide(static_cast<PromiseTest*>(context)->space, context, [](void* data, dGeomID a, dGeomID b) {
+        auto* t = static_cast<PromiseTest*>(data);
+        dContact contact[4];
+        std::memset(contact, 0, sizeof contact);
+        for (dContact& c : contact) c.surface.mode = dContactSoftCFM, c.surface.mu = 1, c.surface.soft_cfm = 1e-4;
+        int n = dCollide(a, b, 4, &contact[0].geom, sizeof(dContact));
+        for (int i = 0; i < n; ++i) {
+          EXPECT_EQ(ssStepper_SoftenContact(t->stepper, &contact[i], dGeomGetBody(a), dGeomGetBody(b)), SS_OK);
+          t->Attach(&contact[i], a, b);
+        }
+      });
+    };
+    ASSERT_EQ(Make(def), SS_OK) << ssLastError();
+    for (int frame = 0; frame < 30; ++frame) {
+      ssFrameReport report;
+      ASSERT_EQ(ssStepper_Step(stepper, frame % 2 ? 1.0 / 30 : 1.0 / 90, &report), SS_OK) << ssLastError();
+      counted[batched].by_mapping += report.contacts.by_mapping;
+      counted[batched].handed_to_implicit_euler += report.contacts.handed_to_implicit_euler;
+      EXPECT_EQ(report.unsoftened_contact_steps, 0);
+      const dReal* p = dBodyGetPosition(box);
+      path[batched].insert(path[batched].end(), {p[0], p[1], p[2]});
+    }
+    ssStepper_Destroy(stepper);
+    stepper = nullptr;
+  }
+  EXPECT_GT(counted[0].by_mapping, 30);
+  EXPECT_EQ(counted[1].by_mapping, counted[0].by_mapping);
+  EXPECT_EQ(counted[1].handed_to_implicit_euler, counted[0].handed_to_implicit_euler);
+  EXPECT_EQ(path[1], path[0]);
+}
+
+// One bad contact in a batch refuses the batch by name, and every contact of it is left as given: the program's
+// near callback drops the batch (or softens its contacts one by one) instead of stepping with what it was not told.
+TEST_F(PromiseTest, ABatchWithOneBadContactIsRefusedByNameAndLeftAsGiven) {
+  dGeomID cylinder = dCreateCylinder(space, 0.5, 1.0);
+  dGeomID sphere = dCreateSphere(space, 0.2);
+  ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
+  dContact batch[4];
+  std::memset(batch, 0, sizeof batch);
+  for (dContact& c : batch) {
+    c.geom.normal[2] = 1, c.geom.depth = 0.001;
+    c.surface.mode = dContactSoftCFM, c.surface.soft_cfm = 1e-4;
+  }
+  ASSERT_EQ(ssStepper_SoftenContacts(stepper, batch, 4), SS_OK);  // the memo: the fast path's surface
+  for (dContact& c : batch) c.surface.mode = dContactSoftCFM, c.surface.soft_cfm = 1e-4;
+  ASSERT_EQ(dCollide(sphere, cylinder, 1, &batch[2].geom, sizeof(dContact)), 1);  // ODE's own NaN normal
+  dContact before[4];
+  std::memcpy(before, batch, sizeof batch);
+  EXPECT_EQ(ssStepper_SoftenContacts(stepper, batch, 4), SS_ERROR_NOT_FINITE);
+  EXPECT_TRUE(Names("normal not finite")) << ssLastError();
+  EXPECT_EQ(std::memcmp(before, batch, sizeof batch), 0);
+  batch[2] = batch[1];
+  batch[3].surface.soft_cfm = -1e-4;  // a tuned value ODE would take as negative compliance
+  std::memcpy(before, batch, sizeof batch);
+  EXPECT_EQ(ssStepper_SoftenContacts(stepper, batch, 4), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(Names("-0.0001")) << ssLastError();
+  EXPECT_EQ(std::memcmp(before, batch, sizeof batch), 0);
+  batch[3].surface.soft_cfm = 1e-4;
+  EXPECT_EQ(ssStepper_SoftenContacts(stepper, batch, 4), SS_OK) << ssLastError();
+}
+
+TEST_F(PromiseTest, ABatchRefusesANullStepperANullArrayAndANegativeCount) {
+  ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
+  dContact contact;
+  std::memset(&contact, 0, sizeof contact);
+  EXPECT_EQ(ssStepper_SoftenContacts(nullptr, &contact, 1), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(Names("stepper = NULL")) << ssLastError();
+  EXPECT_EQ(ssStepper_SoftenContacts(stepper, nullptr, 2), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(Names("contacts = NULL with count = 2")) << ssLastError();
+  EXPECT_EQ(ssStepper_SoftenContacts(stepper, &contact, -1), SS_ERROR_OUT_OF_RANGE);
+  EXPECT_TRUE(Names("count = -1")) << ssLastError();
+  EXPECT_EQ(ssStepper_SoftenContacts(stepper, nullptr, 0), SS_OK);  // dCollide found nothing
 }
 
 // A geom set far from its body (dGeomSetOffsetPosition) lies beyond the bound before its body does: the body's bound
