@@ -2,6 +2,7 @@
  * forces put back before each one, and the known bodies checked before and after it. A failure is latched: a broken
  * world is never stepped again until the program says it has repaired it. */
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,6 +19,10 @@
 #include "seen_spaces.h"
 #include "steadystep/adopt.h"
 #include "steadystep/stepper.h"
+
+#if defined(__SSE2__) && defined(dDOUBLE)
+#include <emmintrin.h>
+#endif
 
 /* Frame times are sums of floating-point parts: a frame of exactly 2·max_step_s must not become 3 substeps. */
 static const double kStepCountSlack = 1e-9;
@@ -536,16 +541,49 @@ static SS_OUT_OF_LINE ssStatus softenContactsSlowly(ssStepper* stepper, dContact
   return SS_OK;
 }
 
-ssStatus ssStepper_SoftenContacts(ssStepper* stepper, dContact* contacts, int count) {
-  if (stepper == NULL || contacts == NULL || count <= 0) return softenContactsSlowly(stepper, contacts, count);
-  const ContactMemo* memo = &stepper->contact_memo;
-  RealBits differs = (RealBits)(unsigned)(memo->valid ^ 1);
+/* Whether every contact of a batch has the memo's surface and a finite geometry: one pass, no branch a contact. With
+ * SSE2 and double precision the given soft_erp and soft_cfm (one after the other in dSurfaceParameters) are compared
+ * in one register, and the geometry's x and y summed in another. */
+#if defined(__SSE2__) && defined(dDOUBLE)
+_Static_assert(offsetof(dSurfaceParameters, soft_cfm) == offsetof(dSurfaceParameters, soft_erp) + sizeof(dReal),
+               "soft_erp and soft_cfm are read as one pair");
+static int batchAsMemo(const ContactMemo* memo, const dContact* contacts, int count) {
+  const __m128i soft_in = _mm_set_epi64x((long long)memo->cfm_in, (long long)memo->erp_in);
+  const __m128i soft_mask = _mm_set_epi64x((long long)memo->cfm_mask, (long long)memo->erp_mask);
+  __m128i soft_differs = _mm_setzero_si128();
+  __m128d sum_xy = _mm_setzero_pd();
+  double sum_z = 0;
+  unsigned mode_differs = 0;
+  for (int i = 0; i < count; ++i) {
+    const dSurfaceParameters* surface = &contacts[i].surface;
+    const dContactGeom* geom = &contacts[i].geom;
+    __m128i soft = _mm_loadu_si128((const __m128i*)(const void*)&surface->soft_erp);
+    soft_differs = _mm_or_si128(soft_differs, _mm_and_si128(_mm_xor_si128(soft, soft_in), soft_mask));
+    mode_differs |= (unsigned)(surface->mode ^ memo->mode_in);
+    sum_xy = _mm_add_pd(sum_xy, _mm_add_pd(_mm_loadu_pd(geom->pos), _mm_loadu_pd(geom->normal)));
+    sum_z += geom->pos[2] + geom->normal[2] + geom->depth;
+  }
+  double sum = _mm_cvtsd_f64(_mm_add_sd(sum_xy, _mm_unpackhi_pd(sum_xy, sum_xy))) + sum_z;
+  soft_differs = _mm_or_si128(soft_differs, _mm_cvtsi32_si128((int)mode_differs));
+  if (_mm_movemask_epi8(_mm_cmpeq_epi32(soft_differs, _mm_setzero_si128())) != 0xffff) return 0;
+  return memo->valid && sum - sum == 0.0;
+}
+#else
+static int batchAsMemo(const ContactMemo* memo, const dContact* contacts, int count) {
+  RealBits differs = 0;
   double sum = 0;
   for (int i = 0; i < count; ++i) {
     differs |= surfaceDiffers(memo, &contacts[i].surface);
     sum += geometrySum(&contacts[i].geom);
   }
-  if (differs != 0 || sum - sum != 0.0) return softenContactsSlowly(stepper, contacts, count);
+  return memo->valid & (differs == 0) & (sum - sum == 0.0);
+}
+#endif
+
+ssStatus ssStepper_SoftenContacts(ssStepper* stepper, dContact* contacts, int count) {
+  if (stepper == NULL || contacts == NULL || count <= 0 || !batchAsMemo(&stepper->contact_memo, contacts, count))
+    return count == 0 && stepper != NULL ? SS_OK : softenContactsSlowly(stepper, contacts, count);
+  const ContactMemo* memo = &stepper->contact_memo;
   if (memo->rewrites)
     for (int i = 0; i < count; ++i) writeMemo(memo, &contacts[i].surface);
   *memo->counter += count;
