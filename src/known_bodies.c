@@ -26,6 +26,7 @@ void ssKnownFree(ssKnownBodies* known) {
   free(known->queue);
   free(known->pushed);
   free(known->geared);
+  free(known->woken);
   ssPointerMapFree(&known->index);
   memset(known, 0, sizeof *known);
 }
@@ -197,6 +198,9 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
     rebuilt.bodies[k] = known->bodies[old];
     rebuilt.joints[k] = known->joints[old];
   }
+  rebuilt.woken = known->woken, rebuilt.woken_count = known->woken_count; /* still to be written */
+  rebuilt.woken_capacity = known->woken_capacity;
+  known->woken = NULL;
   ssKnownFree(known);
   *known = rebuilt;
   listPushed(known);
@@ -240,6 +244,8 @@ void ssKnownForget(ssKnownBodies* known, dBodyID body) {
   }
   known->count = last;
   known->stepped_valid = 0; /* the queue names places */
+  for (int w = 0; w < known->woken_count; ++w)
+    if (known->woken[w] == body) known->woken[w--] = known->woken[--known->woken_count];
   for (int g = 0; g < known->geared_count; ++g)
     if (known->geared[g] == body) known->geared[g--] = known->geared[--known->geared_count];
   /* the pushed list names places: the forgotten body's goes, the moved body's follows it */
@@ -418,6 +424,19 @@ static int bodyWithin(const ssBodyValues* v, double max_speed2, double max_spin2
   return stateWithin(v, max_speed2, max_spin2) & (!forces || forcesWithin(v));
 }
 
+/* A body found awake that was asleep, kept for ssKnownTakeWoken (out of memory: not kept; its numbers are written at
+ * the next change of step, as before it woke). */
+static void noteWoken(ssKnownBodies* known, dBodyID body) {
+  if (ssReserveOne((void**)&known->woken, known->woken_count, &known->woken_capacity, sizeof *known->woken))
+    known->woken[known->woken_count++] = body;
+}
+
+const dBodyID* ssKnownTakeWoken(ssKnownBodies* known, int* count) {
+  *count = known->woken_count;
+  known->woken_count = 0;
+  return known->woken;
+}
+
 /* The walk from the bodies ODE steps to the sleeping ones it wakes through their joints (contacts too): ODE's island
  * takes a disabled body joined to an enabled one, and every disabled body joined to that. Visits each listed body
  * it reaches once (reached[] holds this check's number); visit returns 0 to stop the walk at a failing body, which
@@ -434,6 +453,7 @@ static int wakeWalk(ssKnownBodies* known, int (*visit)(ssKnownBodies*, int, void
         int k = other != 0 && other != body ? placeOf(known, other) : -1;
         if (k < 0 || known->reached[k] == known->checks) continue;
         known->reached[k] = known->checks;
+        if (!known->awake[k]) noteWoken(known, other);
         known->awake[k] = 1;
         known->queue[queued] = k;
         known->stepped_count = ++queued;
@@ -461,6 +481,7 @@ static int checkVisit(ssKnownBodies* known, int k, void* context) {
  * enabled. */
 static inline int markBody(ssKnownBodies* known, int k, int* asleep, int* unseen) {
   int enabled = dBodyIsEnabled(known->ids[k]) != 0, due = enabled | known->awake[k];
+  if (enabled > known->awake[k]) noteWoken(known, known->ids[k]);
   known->awake[k] = (unsigned char)enabled;
   if (due) {
     known->reached[k] = known->checks;

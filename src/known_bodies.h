@@ -67,6 +67,10 @@ typedef struct ssKnownBodies {
   int stepped_count, stepped_valid;
   unsigned checks;    /* checks made, numbering them for reached */
   int asleep;         /* the bodies the last check found asleep (neither enabled nor awake at the check before) */
+  /* bodies found awake that were asleep at the check before (woken by the program, or by ODE through a joint), not
+   * yet taken (ssKnownTakeWoken): their damping and auto-disable are written for the step when they wake */
+  dBodyID* woken;
+  int woken_count, woken_capacity;
   ssPointerMap index; /* body -> its place in the arrays above */
   dSpaceID seen_space; /* the space whose heads the stepper looks at (its def.space, with those nested), or 0 */
   int count, capacity;
@@ -117,6 +121,10 @@ void ssKnownTakeJointsOf(ssKnownBodies* known, dBodyID body);
 /* Sets the force and torque accumulators of every listed body ODE steps (pushed or awake) to its frame force
  * (with_frame_forces) or to zero; a sleeping body's are left for the step that wakes it. */
 void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces);
+
+/* The bodies that woke since the last call (known->woken), the list emptied: *count of them, valid until the next
+ * check. */
+const dBodyID* ssKnownTakeWoken(ssKnownBodies* known, int* count);
 
 /* What a check reads of a body, and its bounds. */
 typedef struct ssBodyBounds {

@@ -341,6 +341,14 @@ static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
   binding->written_step_s = step_s;
 }
 
+void ssRegistryWriteWoken(ssRegistry* registry, const dBodyID* bodies, int count, double step_s) {
+  for (int i = 0; i < count; ++i) {
+    ssBodyBinding* binding = ssRegistryFindBody(registry, bodies[i]);
+    if (binding != NULL && binding->written_step_s != step_s)
+      writeBody(binding, registry->world, step_s);
+  }
+}
+
 void ssRegistryWriteBodies(ssRegistry* registry, double step_s) {
   for (int i = 0; i < registry->body_count; ++i) {
     ssBodyBinding* binding = &registry->bodies[i];

@@ -171,6 +171,12 @@ double ssRegistryWorldMass(const ssRegistry* registry);
 /* Writes every body binding whose values were written for another step than step_s (Apply's last part). */
 void ssRegistryWriteBodies(ssRegistry* registry, double step_s);
 
+/* Writes, for a step of step_s, the bindings of those of bodies[count] that are bound and written for another step:
+ * bodies that woke since Apply last wrote, or that ODE wakes in this step through a joint (ssRegistryWriteBodies
+ * leaves a sleeping body as it is, and Apply writes nothing at a step it wrote already). A body not bound is passed
+ * over. */
+void ssRegistryWriteWoken(ssRegistry* registry, const dBodyID* bodies, int count, double step_s);
+
 /* What another room derives from the bindings and keeps with the registry (Apply's state, apply.c): the registry
  * holds it, frees it with free_state when it is destroyed, and never reads it. */
 typedef struct ssRegistryAttachment {

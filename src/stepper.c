@@ -867,6 +867,16 @@ static int knownBodyTouches(const ssStepper* stepper) {
   return 0;
 }
 
+/* The damping and auto-disable of the bodies that woke since the last step, for this step: Apply wrote every awake
+ * body, and leaves a sleeping one as the program set it until it wakes (ssRegistryWriteBodies). A body ODE woke
+ * through a joint in its step is written before the next one. */
+static void writeWoken(ssStepper* stepper, double softness_step_s) {
+  int count;
+  const dBodyID* woken = ssKnownTakeWoken(&stepper->known, &count);
+  if (count > 0 && stepper->def.registry != NULL)
+    ssRegistryWriteWoken(stepper->def.registry, woken, count, softness_step_s);
+}
+
 /* ODE's step, with its generator set to the stepping's seed for it and put back after it (stepping.step_seed). */
 static int odeStep(ssStepper* stepper, double step_s) {
   const ssStepping* stepping = &stepper->def.stepping;
@@ -943,6 +953,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
          (status = checkKnown(stepper, 1, 0, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistoryBeforeLastStep(stepper->poses);
+    writeWoken(stepper, softness_step_s);
     int stepped = odeStep(stepper, step_s);
     if (def->contact_group) dJointGroupEmpty(def->contact_group);
     /* the step moved what it stepped to the spaces' heads: what the program adds or moves next lands before the

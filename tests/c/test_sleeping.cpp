@@ -212,6 +212,27 @@ TEST_F(Sleeping, ASleepingBodyTheProgramWakesIsCheckedBeforeItSteps) {
   EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 60, nullptr), SS_OK) << ssLastError();
 }
 
+// A body adopted asleep is written when it wakes, whatever the frames: at steps of constant length as well, where
+// Apply has nothing else to write. Its idle time stays the program's (10 steps of 1/60 s are 20 of 1/120 s).
+TEST_F(Sleeping, ABodyAdoptedAsleepIsWrittenForTheStepWhenItWakes) {
+  for (dBodyID box : boxes) dBodySetAutoDisableSteps(box, 10);
+  Adopt("implicit-euler", 1.0 / 120);
+  for (int frame = 0; frame < 5; ++frame)
+    ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 120, nullptr), SS_OK) << ssLastError();
+  EXPECT_EQ(dBodyGetAutoDisableSteps(boxes[7]), 10);  // asleep: left as the program set it
+  dBodyEnable(boxes[7]);
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 120, nullptr), SS_OK) << ssLastError();
+  EXPECT_EQ(dBodyGetAutoDisableSteps(boxes[7]), 20);
+  // woken by ODE, through a ball's contact in its step: written before the step after
+  Ball(0, 0, 0.2);
+  int frames = 0;
+  while (!dBodyIsEnabled(boxes[0]) && frames++ < 120)
+    ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 120, nullptr), SS_OK) << ssLastError();
+  ASSERT_TRUE(dBodyIsEnabled(boxes[0]));
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 120, nullptr), SS_OK) << ssLastError();
+  EXPECT_EQ(dBodyGetAutoDisableSteps(boxes[0]), 20);
+}
+
 TEST_F(Sleeping, BodiesMadeAndDestroyedEveryFrameAreFollowed) {
   Adopt("implicit-euler", 1.0 / 240);  // four substeps a frame of 1/60 s
   const int first_known = ssStepper_KnownBodyCount(stepper);
