@@ -572,7 +572,6 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
   }
   int failing = all ? -1 : firstMarkedFailing(known, &check);
   if (failing < 0 && known->stepped_count < count) failing = wakeWalk(known, checkVisit, &check);
-  known->asleep = count - known->stepped_count;
   if (failing < 0) failing = checkUnseen(known, unseen, &check);
   if (failing >= 0) return nameFailure(known, failing, bounds, when, step, steps, failed);
   for (int a = 0; a < also_count; ++a) {
@@ -645,7 +644,6 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   }
   int failing = all ? -1 : firstMarkedFailing(known, &check);
   if (failing < 0 && asleep > 0) failing = wakeWalk(known, startVisit, &check);
-  known->asleep = count - known->stepped_count;
   if (failing < 0) failing = checkUnseen(known, unseen, &check); /* checked only: a sleeping body's force waits */
   for (int a = 0; failing < 0 && a < also_count; ++a) {
     int k = meetAlso(known, also[a]);

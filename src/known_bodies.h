@@ -66,7 +66,6 @@ typedef struct ssKnownBodies {
   int* queue;
   int stepped_count, stepped_valid;
   unsigned checks;    /* checks made, numbering them for reached */
-  int asleep;         /* the bodies the last check found asleep (neither enabled nor awake at the check before) */
   /* bodies found awake that were asleep at the check before (woken by the program, or by ODE through a joint), not
    * yet taken (ssKnownTakeWoken): their damping and auto-disable are written for the step when they wake */
   dBodyID* woken;

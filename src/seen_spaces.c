@@ -1,5 +1,5 @@
 /* The adopted spaces as last seen (seen_spaces.h): a full listing when the counts require it, otherwise a walk of
- * each space's head, up to the first geom the last step could not move. */
+ * each space's head, up to the geom that was first after the last step. */
 #include "seen_spaces.h"
 
 #include <stdlib.h>
@@ -91,7 +91,7 @@ ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone) {
   seen->bodies = bodies;
   seen->geoms = geomsNow(seen);
   seen->listed = 1;
-  ssSeenMark(seen, 0);
+  ssSeenMark(seen);
   return SS_OK;
 }
 
@@ -99,8 +99,6 @@ ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone) {
  * listed (a new nested space, a static geom moved or added, the marker moved), -1 when out of memory. *added counts
  * the geoms of the bodies met that the listing does not account for. */
 static int walkHead(ssSeenSpaces* seen, ssSeenSpace* space, ssBodyList* found, ssBodyList* moved, long* added) {
-  enum { kSleepingWorthAMark = 16 }; /* sleeping geoms met before the marker that make the next mark look again */
-  int sleeping = 0;
   for (int i = 0, geoms = dSpaceGetNumGeoms(space->space); i < geoms; ++i) {
     dGeomID geom = dSpaceGetGeom(space->space, i);
     /* what lies behind the marker was there at the mark, unless it moved: then another follows it. The marker's own
@@ -111,14 +109,13 @@ static int walkHead(ssSeenSpaces* seen, ssSeenSpace* space, ssBodyList* found, s
       return 0;
     if (dGeomIsSpace(geom)) {
       if (!spaceListed(seen, (dSpaceID)geom)) return 0;
+      if (marker) return 1;
       continue;
     }
     dBodyID body = dGeomGetBody(geom);
     if (body == 0) return marker; /* a static geom added or moved, or one whose body was taken from it */
     if (ssPointerMapGet(&seen->bodies, body, 0) > 0) { /* listed: moved (a geom added to it shows in the count) */
-      int asleep = !dBodyIsEnabled(body);
-      if (asleep && !marker && ++sleeping == kSleepingWorthAMark) space->rescan = 1;
-      if (asleep && !ssBodyListPush(moved, body)) return -1;
+      if (!dBodyIsEnabled(body) && !ssBodyListPush(moved, body)) return -1;
     } else { /* new: all its geoms there counted at its first (its next ones find it listed) */
       int held = geomsHeld(seen, body);
       *added += held;
@@ -143,32 +140,21 @@ int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved) {
   return 1;
 }
 
-void ssSeenMark(ssSeenSpaces* seen, int none_asleep) {
+void ssSeenMark(ssSeenSpaces* seen) {
   for (int s = 0; s < seen->count; ++s) {
     ssSeenSpace* space = &seen->spaces[s];
-    /* a static marker stays put (its pointer is only compared: the program may have destroyed it); a body's may be
-     * woken, or destroyed, so it is looked for again */
-    if (space->marker != 0 && space->marker_body == 0 && !space->rescan) continue;
-    if (space->awake_only && none_asleep) continue;
-    space->rescan = 0;
-    space->marker = space->after_marker = 0;
-    space->marker_body = 0;
-    space->awake_only = 1;
-    for (int i = 0, geoms = dSpaceGetNumGeoms(space->space); i < geoms; ++i) {
-      dGeomID geom = dSpaceGetGeom(space->space, i);
-      if (dGeomIsSpace(geom)) continue; /* a nested space moves with any geom in it */
-      dBodyID body = dGeomGetBody(geom);
-      if (body != 0 && dBodyIsEnabled(body)) continue;
-      space->marker = geom;
-      space->marker_body = body;
-      space->after_marker = i + 1 < geoms ? dSpaceGetGeom(space->space, i + 1) : 0;
-      space->awake_only = 0;
-      break;
-    }
+    if (space->sweep_and_prune) continue; /* listed at every look */
+    int geoms = dSpaceGetNumGeoms(space->space);
+    space->marker = geoms > 0 ? dSpaceGetGeom(space->space, 0) : 0;
+    space->after_marker = geoms > 1 ? dSpaceGetGeom(space->space, 1) : 0;
+    space->marker_body = space->marker != 0 && !dGeomIsSpace(space->marker) ? dGeomGetBody(space->marker) : 0;
   }
 }
 
 void ssSeenForget(ssSeenSpaces* seen, dBodyID body) {
+  /* a marker of the body's may be destroyed before the next look meets it: that space's next look walks it whole */
+  for (int s = 0; s < seen->count; ++s)
+    if (seen->spaces[s].marker_body == body) seen->spaces[s].marker = seen->spaces[s].after_marker = 0;
   int held = ssPointerMapGet(&seen->bodies, body, 0);
   if (held == 0) return;
   seen->geoms -= held;

@@ -2,13 +2,12 @@
  * the cost of the change.
  *
  * ODE keeps a simple or hash space's geoms in a list and puts a geom at its head when it is added, and again when it
- * moves (dGeomMoved: a body stepped or set). So after a step every geom ODE did not move (a static geom, a sleeping
- * body's) lies behind the geoms it moved, and whatever the program adds or moves later lands in front of them: the
- * first geom ODE's step cannot move, the marker, divides the list into a head that holds everything new and a tail
- * that holds nothing new. A look walks the heads only. What no walk sees, a geom the program destroyed, shows in the
- * count: the spaces hold as many geoms as at the last listing, plus those found since, less those the stepper
- * removed, or something was destroyed with ODE's own calls, and the spaces are listed in full. A sweep-and-prune space
- * reorders its geoms as they move (dSpaceGetGeom lists the moved ones first) and is listed at every look. */
+ * moves (dGeomMoved: a body stepped or set). After a step the stepper marks each space's first geom, the marker:
+ * whatever the program adds or moves before the next step lands in front of it, and nothing behind it is new. A look
+ * walks the heads only, as far as what changed. What no walk sees, a geom the program destroyed, shows in the count:
+ * the spaces hold as many geoms as at the last listing, plus those found since, less those the stepper removed, or
+ * something was destroyed with ODE's own calls, and the spaces are listed in full. A sweep-and-prune space reorders
+ * its geoms as they move (dSpaceGetGeom lists the moved ones first) and is listed at every look. */
 #ifndef STEADYSTEP_SEEN_SPACES_H
 #define STEADYSTEP_SEEN_SPACES_H
 
@@ -25,11 +24,9 @@ typedef struct ssBodyList {
 
 typedef struct ssSeenSpace {
   dSpaceID space;
-  dGeomID marker;       /* a geom ODE's step does not move, when last marked; 0: none (the whole list is head) */
+  dGeomID marker;       /* the first geom after the last step; 0: none (the whole list is head) */
   dGeomID after_marker; /* the geom behind it then: the marker moved since when another follows it */
-  dBodyID marker_body;  /* the marker's body then (0: static) */
-  int rescan;           /* the next mark looks for a marker nearer the head: sleeping geoms gathered before this one */
-  int awake_only;       /* the last mark met only awake bodies' geoms, the whole list, and found no marker */
+  dBodyID marker_body;  /* the marker's body then (0: static, or a nested space) */
   int sweep_and_prune;
 } ssSeenSpace;
 
@@ -58,14 +55,11 @@ ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone);
  * bodies then belong to the listing), 0 when the spaces must be listed in full (ssSeenList), -1 when out of memory. */
 int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved);
 
-/* After a step: each space's marker set to the first geom from the head that the next step cannot move. A static
- * marker is kept (nothing behind it is new), unless the last look met sleeping geoms before it: then one nearer the
- * head is looked for, so that a look walks about as far as the bodies ODE steps. With none_asleep (no known body
- * was asleep at the last check), a space whose last mark met only awake bodies is not walked again: it has no
- * marker still, or one only a later mark finds (a look without a marker walks the whole list: nothing is missed). */
-void ssSeenMark(ssSeenSpaces* seen, int none_asleep);
+/* After a step: each space's marker set to its first geom, and the one behind it. Four reads a space. */
+void ssSeenMark(ssSeenSpaces* seen);
 
-/* body, about to be destroyed through the stepper: its geoms there leave the count (destroyed before or after). */
+/* body, about to be destroyed through the stepper: its geoms there leave the count (destroyed before or after), and a
+ * space whose marker it held is walked whole at the next look. */
 void ssSeenForget(ssSeenSpaces* seen, dBodyID body);
 
 #endif

@@ -956,9 +956,8 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
     writeWoken(stepper, softness_step_s);
     int stepped = odeStep(stepper, step_s);
     if (def->contact_group) dJointGroupEmpty(def->contact_group);
-    /* the step moved what it stepped to the spaces' heads: what the program adds or moves next lands before the
-     * first geom it could not move */
-    ssSeenMark(&stepper->seen, stepper->known.asleep == 0);
+    /* what the program adds or moves next lands before the spaces' first geoms now */
+    ssSeenMark(&stepper->seen);
     if (!stepped) return latch(stepper, ssFail(SS_ERROR_OUT_OF_MEMORY, "ODE ran out of memory in its step"));
     report->steps += 1;
     addServed(&report->rows, &applied.rows);
