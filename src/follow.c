@@ -7,6 +7,7 @@
  * Two passes, as Apply's: every changed value is read and turned into its law first, and the bindings change only
  * when all of them passed, so that an error leaves the registry as it was. */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -74,19 +75,19 @@ static ssStatus followRows(ssRegistry* registry, double step_s, FollowedRow** ou
 }
 
 /* A large world's body binding kPrefetchAhead places on asked for: its body's flags, and the auto-disable and damping
- * numbers ODE 0.16 keeps a few lines past the torque accumulator (dxBody: a hint; another layout costs a load). */
-static void prefetchBinding(const ssBodyBinding* binding) {
-  if (binding->body == 0) return;
-  const char* torque = (const char*)dBodyGetTorque(binding->body);
-  SS_PREFETCH(binding->body);
-  SS_PREFETCH(torque + 64);
-  SS_PREFETCH(torque + 192);
+ * numbers ODE 0.16 keeps a few lines past the torque accumulator, torque_at bytes into every body (dxBody: a hint;
+ * another layout costs a load). */
+static void prefetchBinding(const ssBodyBinding* binding, ptrdiff_t torque_at) {
+  const char* body = (const char*)binding->body;
+  if (body == NULL) return;
+  SS_PREFETCH(body);
+  SS_PREFETCH(body + torque_at + 64);
+  SS_PREFETCH(body + torque_at + 192);
 }
 
 /* Whether the body binding's numbers in ODE are those the registry last wrote. */
 static int bodyAsWritten(dWorldID world, const ssBodyBinding* binding) {
-  ssBodyWritten written;
-  ssBodyWrittenFor(binding, binding->written_step_s, &written);
+  const ssBodyWritten written = binding->written;
   dBodyID body = binding->body;
   if (binding->has_damping &&
       (!ssSameInOde(written.linear_scale, body ? dBodyGetLinearDamping(body) : dWorldGetLinearDamping(world)) ||
@@ -128,9 +129,15 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
   int body_count = 0;
   const int bound = ssRegistryBodyBindingCount(registry);
   const ssBodyBinding* bindings = bound > 0 ? ssRegistryBodyAt(registry, 0) : NULL; /* not changed before the end */
-  for (int i = 0, until = ssPrefetchUntil(bound); i < bound && status == SS_OK; ++i) {
+  const int until = ssPrefetchUntil(bound);
+  ptrdiff_t torque_at = 0; /* the same in every body: read once */
+  for (int i = 0; i < until && torque_at == 0; ++i) {
+    const char* body = (const char*)bindings[i].body;
+    if (body != NULL) torque_at = (const char*)dBodyGetTorque(bindings[i].body) - body;
+  }
+  for (int i = 0; i < bound && status == SS_OK; ++i) {
     const ssBodyBinding* binding = &bindings[i];
-    if (i < until) prefetchBinding(&bindings[i + kPrefetchAhead]);
+    if (i < until) prefetchBinding(&bindings[i + kPrefetchAhead], torque_at);
     int adopted = binding->tuned.damping_step_s > 0 || binding->tuned.auto_disable_step_s > 0;
     /* a sleeping body's values are read when it wakes: ODE neither damps it nor counts its idle steps, and Apply
      * writes it no more than this reads it (ssRegistryWriteBodies) */

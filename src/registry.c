@@ -339,6 +339,7 @@ static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
     binding->average_samples_written = values.average_samples;
   }
   binding->written_step_s = step_s;
+  binding->written = values;
 }
 
 void ssRegistryWriteWoken(ssRegistry* registry, const dBodyID* bodies, int count, double step_s) {

@@ -28,11 +28,20 @@ typedef struct ssBodyTuned {
 
 /* A body's damping and auto-disable, given in seconds. body 0 holds the world's defaults. Laid out without padding
  * (104 bytes): adoption holds two of these a body, the plan's and the registry's. */
+/* The numbers the registry writes into a body binding's body (or the world's defaults) for a step of step_s. */
+typedef struct ssBodyWritten {
+  double linear_scale, angular_scale; /* has_damping */
+  int idle_steps;                     /* has_auto_disable, with the two below */
+  double idle_time_s;
+  int average_samples;
+} ssBodyWritten;
+
 typedef struct ssBodyBinding {
   dBodyID body;
   double linear_rate_per_s, angular_rate_per_s;
   double idle_time_s, average_window_s;
   double written_step_s;       /* the step the values were last written for; NAN after a (re)binding */
+  ssBodyWritten written;       /* what was written then, as computed (follow.c compares ODE's numbers with it) */
   ssBodyTuned tuned;           /* cleared by ssRegistry_BindDamping and ssRegistry_BindAutoDisable */
   int average_samples_written; /* ODE restarts its average whenever the count is set: write it only on change */
   unsigned char has_damping, has_auto_disable;
@@ -43,20 +52,12 @@ typedef struct ssBodyBinding {
  * (SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE: a damping scale outside [0, 1), a negative idle time). */
 ssStatus ssBodyValuesAsTuned(const char* what, dWorldID world, dBodyID body, double tuned_step_s, ssBodyBinding* out);
 
-/* The numbers the registry writes into a body binding's body (or the world's defaults) for a step of step_s. */
-typedef struct ssBodyWritten {
-  double linear_scale, angular_scale; /* has_damping */
-  int idle_steps;                     /* has_auto_disable, with the two below */
-  double idle_time_s;
-  int average_samples;
-} ssBodyWritten;
 
 /* ODE counts steps: a count of seconds in steps of h, where a whole number of steps computed with rounding error
  * (10·(1/60)/(1/60) = 10.000000000000002) must not become one more. */
 static inline double ssStepsIn(double seconds, double step_s) { return ceil(seconds / step_s - 1e-9); }
 
-/* Inline: Apply writes, and follow.c compares, every awake body's at every frame; at the tuned step they are the
- * tuned numbers. */
+/* At the tuned step they are the tuned numbers. */
 static inline void ssBodyWrittenFor(const ssBodyBinding* binding, double step_s, ssBodyWritten* out) {
   const ssBodyTuned* tuned = &binding->tuned;
   *out = (ssBodyWritten){0, 0, 0, 0, 0};
