@@ -101,7 +101,7 @@ static int bodyAsWritten(dWorldID world, const ssBodyBinding* binding) {
          samples == binding->average_samples_written;
 }
 
-ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
+ssStatus ssRegistryFollowProgram(ssRegistry* registry, int with_bodies, int* followed) {
   if (followed != NULL) *followed = 0;
   double step_s = ssRegistry_TunedStep(registry); /* what adopted numbers mean; nothing adopted, nothing to follow */
   if (step_s == 0) return SS_OK;
@@ -127,7 +127,7 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed) {
   ssBodyBinding* bodies = NULL;
   int* body_at = NULL;
   int body_count = 0;
-  const int bound = ssRegistryBodyBindingCount(registry);
+  const int bound = with_bodies ? ssRegistryBodyBindingCount(registry) : 0;
   const ssBodyBinding* bindings = bound > 0 ? ssRegistryBodyAt(registry, 0) : NULL; /* not changed before the end */
   const int until = ssPrefetchUntil(bound);
   ptrdiff_t torque_at = 0; /* the same in every body: read once */

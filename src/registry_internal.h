@@ -88,8 +88,11 @@ static inline void ssBodyWrittenFor(const ssBodyBinding* binding, double step_s,
  * the registry's tuned step: bound again as what it stands for, so that every step length writes what the program's
  * value means. A spring the program bound itself (ssRegistry_BindJoint, ...) it changes by binding again: not read. *followed (may be NULL) counts the values taken. Nothing is changed on an error.
  * Errors, naming the value: those of adoption for a value no spring stands for (erp outside [0, 1], cfm < 0, a
- * damping scale outside [0, 1), ...), SS_ERROR_NO_FINITE_MAPPING. */
-ssStatus ssRegistryFollowProgram(ssRegistry* registry, int* followed);
+ * damping scale outside [0, 1), ...), SS_ERROR_NO_FINITE_MAPPING. with_bodies = 0 leaves the bodies' numbers
+ * unread: where every Apply writes for the tuned step (a softness frozen there), what ODE holds is the tuned numbers
+ * or the program's, both meant for that step, and Apply rewrites neither; a later Apply for another step follows
+ * first. */
+ssStatus ssRegistryFollowProgram(ssRegistry* registry, int with_bodies, int* followed);
 
 /* A number that changes whenever a joint or body is bound or unbound: the stepper rebuilds its list on a change. */
 unsigned ssRegistryGeneration(const ssRegistry* registry);

@@ -218,7 +218,7 @@ ssStatus ssStepper_Create(const ssStepperDef* def, ssStepper** out) {
 }
 
 static ssStatus forgetDestroyed(ssStepper* stepper, int look_at_joints);
-static ssStatus followProgram(ssStepper* stepper, ssFrameReport* report);
+static ssStatus followProgram(ssStepper* stepper, ssFrameReport* report, int every_value);
 
 /* What the stepper adopted goes back to the program's own numbers at the tuned step (the ones it tuned, or wrote
  * since): the world is the program's again, and a stepper made on it next adopts what the program tuned, not what
@@ -235,7 +235,8 @@ static void restoreTuned(ssStepper* stepper) {
   ssPointerSetFree(&alive);
   if (listed != SS_OK) return;
   ssFrameReport unused = {0};
-  if (followProgram(stepper, &unused) != SS_OK) return; /* a value no spring stands for: left as the program set it */
+  /* a value no spring stands for is left as the program set it */
+  if (followProgram(stepper, &unused, 1) != SS_OK) return;
   ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, stepper->tuned_step_s, 0, NULL);
 }
 
@@ -794,11 +795,16 @@ static void holdForces(ssStepper* stepper, double remaining_s) {
 /* ---- the program's own writes ---- */
 
 /* Values the program wrote into what the registry rewrites (registry_internal.h, ssRegistryFollowProgram), taken as
- * newly tuned; the next step applies whatever the mapping. */
-static ssStatus followProgram(ssStepper* stepper, ssFrameReport* report) {
+ * newly tuned; the next step applies whatever the mapping. The bodies' numbers are read unless every step's are
+ * written for the tuned step (naive's softness, frozen there: a program's write then stays as written, and is
+ * followed when the stepping changes, before Apply writes for another step). */
+static ssStatus followProgram(ssStepper* stepper, ssFrameReport* report, int every_value) {
   if (stepper->def.registry == NULL) return SS_OK;
   int followed = 0;
-  ssStatus status = ssRegistryFollowProgram(stepper->def.registry, &followed);
+  const ssStepping* stepping = &stepper->def.stepping;
+  int bodies = every_value || stepping->frozen_step_s <= 0 ||
+               stepping->frozen_step_s != ssRegistry_TunedStep(stepper->def.registry);
+  ssStatus status = ssRegistryFollowProgram(stepper->def.registry, bodies, &followed);
   report->program_writes += followed;
   if (followed > 0) stepper->apply_due = 1;
   return status;
@@ -911,7 +917,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
     int callbacks = def->before_step || def->collide || def->step_done;
     ssStatus status = i == 0 ? SS_OK : findNew(stepper, callbacks);
     /* values the program set in the last step's callbacks */
-    if (status == SS_OK && i > 0 && callbacks) status = followProgram(stepper, report);
+    if (status == SS_OK && i > 0 && callbacks) status = followProgram(stepper, report, 0);
     if (status != SS_OK) return status;
     putForces(stepper, i, step_s, carried_s);
     if (i == 0 || apply_every_step || stepper->apply_due) {
@@ -1053,7 +1059,7 @@ static ssStatus startFrame(ssStepper* stepper, ssFrameReport* report) {
     }
     if (joints_changed) status = findNew(stepper, 1);
   }
-  if (status == SS_OK) status = followProgram(stepper, report);
+  if (status == SS_OK) status = followProgram(stepper, report, 0);
   /* after the check, on the list it passed: the bodies are those the program repaired, within every bound */
   if (status == SS_OK && stepper->rebase_gears) {
     ssGearsRebase(stepper->known.geared, stepper->known.geared_count);

@@ -131,6 +131,28 @@ TEST_F(FollowTest, ValuesWrittenEveryFrameAreFollowedAtEveryFrameLength) {
   EXPECT_EQ(probe.checked, 40);
 }
 
+// Under naive (the softness frozen at the tuned step) a body's damping the program writes stays in ODE as written,
+// unread: Apply writes nothing over it. When the stepping changes, it is followed before Apply writes for the new
+// step: the damping then holds what the program's last value means at that step.
+TEST_F(FollowTest, UnderNaiveABodysWriteStaysAsWrittenAndIsFollowedWhenTheSteppingChanges) {
+  ASSERT_EQ(Make(nullptr, nullptr), SS_OK) << ssLastError();
+  ssStepping stepping = ssStepper_Stepping(stepper);
+  ASSERT_EQ(ssSteppingForPolicy("naive", kTunedStep, &stepping), SS_OK);
+  ASSERT_EQ(ssStepper_SetStepping(stepper, &stepping), SS_OK) << ssLastError();
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 50, nullptr), SS_OK) << ssLastError();
+  dBodySetLinearDamping(arm, 0.03);
+  for (int frame = 0; frame < 5; ++frame) {
+    ASSERT_EQ(ssStepper_Step(stepper, frame % 2 ? 1.0 / 60 : 1.0 / 50, nullptr), SS_OK) << ssLastError();
+    EXPECT_EQ(dBodyGetLinearDamping(arm), 0.03) << frame;
+  }
+  ASSERT_EQ(ssSteppingForPolicy("implicit-euler", kTunedStep, &stepping), SS_OK);
+  ASSERT_EQ(ssStepper_SetStepping(stepper, &stepping), SS_OK) << ssLastError();
+  ssFrameReport report;
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 120, &report), SS_OK) << ssLastError();
+  EXPECT_GE(report.program_writes, 1);
+  EXPECT_NEAR(dBodyGetLinearDamping(arm), DampingAt(0.03, 1.0 / 120), ReadBackTolerance(1e-13, 0.03));
+}
+
 // A value the program writes in a callback is taken before the next step; one no spring stands for refuses the
 // frame by name, with nothing stepped, until the program writes another.
 TEST_F(FollowTest, AValueWrittenInACallbackIsTakenBeforeTheNextStepAndABadOneRefusedByName) {
