@@ -548,50 +548,6 @@ static int meetAlso(ssKnownBodies* known, dBodyID body) {
   return k;
 }
 
-ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
-                      const dBodyID* also, int also_count, int only_stepped, dBodyID* failed) {
-  CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed,
-                      bounds->forces};
-  const ssBodyValues* values = known->values;
-  const int count = known->count, until = ssPrefetchUntil(count);
-  ++known->checks;
-  int all = 1, unseen = 0;
-  if (only_stepped && known->stepped_valid) {
-    all = checkStepped(known, &check);
-  } else {
-    /* one pass reads each body once, marks it and checks what ODE steps (the usual case: all pass; the first
-     * failure is found after); a sleeping body's values are not read */
-    int asleep = 0;
-    known->stepped_count = 0;
-    for (int k = 0; k < count; ++k) {
-      if (k < until) prefetchBody(known, k + kPrefetchAhead, check.forces);
-      if (markBody(known, k, &asleep, &unseen))
-        all &= bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
-    }
-    known->stepped_valid = 1;
-  }
-  int failing = all ? -1 : firstMarkedFailing(known, &check);
-  if (failing < 0 && known->stepped_count < count) failing = wakeWalk(known, checkVisit, &check);
-  if (failing < 0) failing = checkUnseen(known, unseen, &check);
-  if (failing >= 0) return nameFailure(known, failing, bounds, when, step, steps, failed);
-  for (int a = 0; a < also_count; ++a) {
-    int k = meetAlso(known, also[a]);
-    if (k >= 0 && !checkVisit(known, k, &check)) return nameFailure(known, k, bounds, when, step, steps, failed);
-  }
-  for (int g = 0; g < known->geared_count && bounds->gear_step_s > 0; ++g) {
-    dBodyID body = known->geared[g];
-    double turn = ssGearTurn(body, bounds->gear_step_s);
-    if (turn <= SS_MAX_GEAR_TURN_RAD) continue;
-    char named[64];
-    *failed = body;
-    namedStep(named, when, step, steps);
-    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: turns its transmission gear %g rad in a step of %g s %s (spin, and "
-                  "speed over the gear's radius): above SS_MAX_GEAR_TURN_RAD = %g rad (ODE 0.16 aborts from pi)",
-                  (void*)body, turn, bounds->gear_step_s, named, SS_MAX_GEAR_TURN_RAD);
-  }
-  return SS_OK;
-}
-
 static int anyNonZero(const double* values) {
   return values[0] != 0 || values[1] != 0 || values[2] != 0 || values[3] != 0 || values[4] != 0 || values[5] != 0;
 }
@@ -614,13 +570,64 @@ static int startBody(ssKnownBodies* known, int k, double max_speed2, double max_
   return 1;
 }
 
+ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
+                      const dBodyID* also, int also_count, int only_stepped, dBodyID* failed) {
+  CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed,
+                      bounds->forces};
+  const ssBodyValues* values = known->values;
+  const int count = known->count, until = ssPrefetchUntil(count);
+  ++known->checks;
+  int all = 1, unseen = 0;
+  ssBodyBounds named = *bounds;
+  if (only_stepped && known->stepped_valid) {
+    all = checkStepped(known, &check);
+  } else {
+    /* one pass reads each body once, marks it and checks what ODE steps (the usual case: all pass; the first
+     * failure is found after); a sleeping body's values are not read. A body the frame's start passed over asleep
+     * and found awake now is started here: its frame force read, with its state (ssKnownStartFrame). */
+    const int late_start = known->sleepers_unread;
+    int asleep = 0;
+    known->stepped_count = 0;
+    for (int k = 0; k < count; ++k) {
+      if (k < until) prefetchBody(known, k + kPrefetchAhead, check.forces);
+      int was_awake = known->awake[k];
+      if (!markBody(known, k, &asleep, &unseen)) continue;
+      all &= late_start && !was_awake ? startBody(known, k, check.max_speed2, check.max_spin2)
+                                      : bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
+    }
+    known->stepped_valid = 1;
+    known->sleepers_unread = 0;
+    if (late_start) check.forces = named.forces = 1; /* a started body's forces were checked: named as such */
+  }
+  int failing = all ? -1 : firstMarkedFailing(known, &check);
+  if (failing < 0 && known->stepped_count < count) failing = wakeWalk(known, checkVisit, &check);
+  if (failing < 0) failing = checkUnseen(known, unseen, &check);
+  if (failing >= 0) return nameFailure(known, failing, &named, when, step, steps, failed);
+  for (int a = 0; a < also_count; ++a) {
+    int k = meetAlso(known, also[a]);
+    if (k >= 0 && !checkVisit(known, k, &check)) return nameFailure(known, k, &named, when, step, steps, failed);
+  }
+  for (int g = 0; g < known->geared_count && bounds->gear_step_s > 0; ++g) {
+    dBodyID body = known->geared[g];
+    double turn = ssGearTurn(body, bounds->gear_step_s);
+    if (turn <= SS_MAX_GEAR_TURN_RAD) continue;
+    char named[64];
+    *failed = body;
+    namedStep(named, when, step, steps);
+    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: turns its transmission gear %g rad in a step of %g s %s (spin, and "
+                  "speed over the gear's radius): above SS_MAX_GEAR_TURN_RAD = %g rad (ODE 0.16 aborts from pi)",
+                  (void*)body, turn, bounds->gear_step_s, named, SS_MAX_GEAR_TURN_RAD);
+  }
+  return SS_OK;
+}
+
 static int startVisit(ssKnownBodies* known, int k, void* context) {
   const CheckVisit* check = context;
   return startBody(known, k, check->max_speed2, check->max_spin2);
 }
 
 ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, const dBodyID* also, int also_count,
-                           dBodyID* failed, int* joints_changed) {
+                           int sleepers_later, dBodyID* failed, int* joints_changed) {
   CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed, 1};
   *joints_changed = 0;
   /* last frame's pushed bodies are unmarked through their list: only a pushed body's entry is written */
@@ -635,9 +642,15 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   for (int k = 0; k < count; ++k) {
     if (k < until) prefetchBody(known, k + kPrefetchAhead, 1), prefetchJoints(known, k + kPrefetchAhead);
     changed |= jointsChangedAt(known, k);
-    if (markBody(known, k, &asleep, &unseen)) all &= startBody(known, k, check.max_speed2, check.max_spin2);
+    if (sleepers_later && !known->awake[k]) { /* asleep at the last check: read by the check before the step */
+      asleep += 1;
+      unseen += known->moves_unseen[k];
+    } else if (markBody(known, k, &asleep, &unseen)) {
+      all &= startBody(known, k, check.max_speed2, check.max_spin2);
+    }
   }
   known->stepped_valid = 1;
+  known->sleepers_unread = sleepers_later;
   if (changed) { /* the caller lists the bodies again, each then checked at the next call, and calls again */
     *joints_changed = 1;
     return SS_OK;

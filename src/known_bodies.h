@@ -65,6 +65,9 @@ typedef struct ssKnownBodies {
    * a check after ODE's step alone reads these and what the walk reaches from them, and no sleeping body */
   int* queue;
   int stepped_count, stepped_valid;
+  /* the frame's start passed over the bodies asleep at the check before (sleepers_later): the next full check reads
+   * them, and starts those it finds awake */
+  int sleepers_unread;
   unsigned checks;    /* checks made, numbering them for reached */
   /* bodies found awake that were asleep at the check before (woken by the program, or by ODE through a joint), not
    * yet taken (ssKnownTakeWoken): their damping and auto-disable are written for the step when they wake */
@@ -153,8 +156,11 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
  * lists the bodies again and calls again, and the marks and forces read are made again); else the bodies ODE steps are
  * checked as ssKnownCheck with state and forces (also: sleeping bodies the program moved), and, all passing, the
  * accumulators of those it steps become their frame force (pushed marks a force or a carried force). A sleeping body's
- * force waits in its accumulator, as in ODE, and acts in the step that wakes it. */
+ * force waits in its accumulator, as in ODE, and acts in the step that wakes it. sleepers_later: a full check
+ * (ssKnownCheck) follows before the first step, after the program's callbacks; the bodies asleep at the last check are
+ * then not read here but there (their joints are: what was destroyed must be known first), and one found awake there
+ * is started there. Collision reads no sleeping body the program did not move, and those it moved are in also. */
 ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, const dBodyID* also, int also_count,
-                           dBodyID* failed, int* joints_changed);
+                           int sleepers_later, dBodyID* failed, int* joints_changed);
 
 #endif

@@ -1049,10 +1049,12 @@ static ssStatus startFrame(ssStepper* stepper, ssFrameReport* report) {
   const ssStepping* stepping = &stepper->def.stepping;
   ssBodyBounds bounds = {stepping->max_speed, stepping->max_angular_speed, 1, 0};
   ssStatus status = findNew(stepper, 0);
+  /* with callbacks the first step's boundary checks every body after them: a sleeping one is read there */
+  const int sleepers_later = stepper->def.before_step != NULL || stepper->def.collide != NULL;
   for (int joints_changed = 1; status == SS_OK && joints_changed;) {
     dBodyID failed = 0;
-    status = ssKnownStartFrame(&stepper->known, &bounds, stepper->moved.list, stepper->moved.count, &failed,
-                               &joints_changed);
+    status = ssKnownStartFrame(&stepper->known, &bounds, stepper->moved.list, stepper->moved.count, sleepers_later,
+                               &failed, &joints_changed);
     if (status != SS_OK) {
       report->failed_body = failed;
       return latch(stepper, status);

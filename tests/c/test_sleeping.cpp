@@ -233,6 +233,25 @@ TEST_F(Sleeping, ABodyAdoptedAsleepIsWrittenForTheStepWhenItWakes) {
   EXPECT_EQ(dBodyGetAutoDisableSteps(boxes[0]), 20);
 }
 
+// A body the program wakes between frames and pushes with a force gets the force over every substep of the frame
+// (F·dt), though the frame's start passes over a sleeping body when a check after the callbacks reads it.
+TEST_F(Sleeping, ABodyWokenBetweenFramesWithAForceGetsItOverTheWholeFrame) {
+  Adopt("implicit-euler", 1.0 / 180);
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 60, nullptr), SS_OK) << ssLastError();
+  dWorldSetGravity(world, 0, 0, 0);
+  dBodyID box = boxes[5];
+  const dReal* p = dBodyGetPosition(box);
+  dBodySetPosition(box, p[0], p[1], 2.0);  // in the air, asleep: nothing touches it
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 60, nullptr), SS_OK) << ssLastError();
+  ASSERT_FALSE(dBodyIsEnabled(box));
+  dBodyEnable(box);
+  dBodyAddForce(box, 3.0, 0, 0);
+  ssFrameReport report;
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 60, &report), SS_OK) << ssLastError();
+  EXPECT_EQ(report.steps, 3);
+  EXPECT_NEAR(dBodyGetLinearVel(box)[0], 3.0 * (1.0 / 60) / 1.0, 1e-12);  // F·dt over the frame, 1 kg
+}
+
 TEST_F(Sleeping, BodiesMadeAndDestroyedEveryFrameAreFollowed) {
   Adopt("implicit-euler", 1.0 / 240);  // four substeps a frame of 1/60 s
   const int first_known = ssStepper_KnownBodyCount(stepper);
