@@ -56,15 +56,17 @@ static void visitBody(void* context, dBodyID body) {
 
 /* The body's joints as the stepper sees them (ssJointSignature): a step's contacts are made after the program's
  * joints and emptied after the step, and hide nothing. */
-static ssJointSignature jointSignature(dBodyID body) {
+static ssJointSignature signatureOf(dBodyID body, int joints) {
   ssJointSignature signature = {0, 0};
-  for (int i = 0, count = dBodyGetNumJoints(body); i < count; ++i) {
+  for (int i = 0; i < joints; ++i) {
     dJointID joint = dBodyGetJoint(body, i);
     if (dJointGetType(joint) == dJointTypeContact) continue;
     if (signature.count++ == 0) signature.first = joint;
   }
   return signature;
 }
+
+static ssJointSignature jointSignature(dBodyID body) { return signatureOf(body, dBodyGetNumJoints(body)); }
 
 /* body's place in the list, or -1 */
 static int placeOf(const ssKnownBodies* known, dBodyID body) {
@@ -261,9 +263,18 @@ static void prefetchJoints(const ssKnownBodies* known, int k) {
   if (joint != NULL) SS_PREFETCH(joint), SS_PREFETCH(joint + 64);
 }
 
-static int jointsChangedAt(const ssKnownBodies* known, int k) {
-  ssJointSignature now = jointSignature(known->ids[k]);
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static int signatureChanged(const ssKnownBodies* known, int k, int joints) {
+  ssJointSignature now = signatureOf(known->ids[k], joints);
   return now.first != known->joints[k].first || now.count != known->joints[k].count;
+}
+
+/* Most bodies have no joint, and had none (the first is 0 then too): one read of ODE's. */
+static inline int jointsChangedAt(const ssKnownBodies* known, int k) {
+  int joints = dBodyGetNumJoints(known->ids[k]);
+  return joints == 0 ? known->joints[k].count != 0 : signatureChanged(known, k, joints);
 }
 
 ssStatus ssKnownCollectJoints(const ssKnownBodies* known, ssPointerSet* joints) {
