@@ -457,6 +457,14 @@ static inline void nearCallback(void* data, dGeomID geom1, dGeomID geom2) {
       contacts[i].surface.soft_erp = w->contact_erp;
       contacts[i].surface.soft_cfm = w->contact_cfm;
     }
+  }
+  /* the batch, on a copy: softened as each contact alone is below, or refused whole and left as given */
+  dContact batch[4], given[4];
+  memcpy(batch, contacts, sizeof batch);
+  memcpy(given, contacts, sizeof given);
+  ssStatus batch_status = w->adopt ? ssStepper_SoftenContacts(stepper, batch, count) : SS_OK;
+  int all_softened = 1;
+  for (int i = 0; i < count; ++i) {
     dContact before = contacts[i];
     ssStatus status = w->adopt ? ssStepper_SoftenContact(stepper, &contacts[i], body1, body2)
                                : ssContactSoften(&contacts[i], body1, body2, w->contact_spring, step.mapping,
@@ -468,15 +476,25 @@ static inline void nearCallback(void* data, dGeomID geom1, dGeomID geom2) {
                    "the contact", ssLastError());
       /* The program's choice when a contact cannot be softened: keep it with ODE's defaults (rigid). */
       contacts[i].surface.mode = dContactApprox1;
+      all_softened = 0;
     } else {
       FUZZ_REQUIRE(isfinite(contacts[i].surface.soft_erp) && isfinite(contacts[i].surface.soft_cfm) &&
                        contacts[i].surface.soft_cfm >= 0,
                    "contact softened OK with erp %g cfm %g", contacts[i].surface.soft_erp,
                    contacts[i].surface.soft_cfm);
     }
+    if (w->adopt && all_softened)
+      FUZZ_REQUIRE(memcmp(&batch[i].surface, &contacts[i].surface, sizeof batch[i].surface) == 0,
+                   "the batch softened contact %d of %d otherwise than alone", i, count);
     dJointID joint = dJointCreateContact(w->world, w->contacts, &contacts[i]);
     dJointAttach(joint, body1, body2);
   }
+  if (!w->adopt) return;
+  FUZZ_REQUIRE((batch_status == SS_OK) == all_softened, "the batch %s (%s) where each contact alone %s",
+               batch_status == SS_OK ? "passed" : "was refused", ssStatusName(batch_status),
+               all_softened ? "passed" : "was refused once");
+  if (batch_status != SS_OK)
+    FUZZ_REQUIRE(memcmp(batch, given, sizeof batch) == 0, "the batch was refused but changed its contacts");
 }
 
 static inline void collideAll(World* w, ssStepper* stepper) { dSpaceCollide(w->space, stepper, nearCallback); }
