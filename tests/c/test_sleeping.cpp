@@ -130,6 +130,39 @@ TEST_F(Sleeping, ASleepingBodyMovedOutOfRangeIsRefusedBeforeCollision) {
   }
 }
 
+// The look walks each space up to the geom that was first after the last step. A sleeping box at every place of the
+// list behind it, moved out of range, is refused before collision; with the first geom's body destroyed through the
+// stepper, a body made after is still found and stepped.
+TEST_F(Sleeping, WhatTheProgramMovesOrMakesIsFoundWhereverItWasInTheList) {
+  Adopt("implicit-euler");
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 60, nullptr), SS_OK) << ssLastError();
+  for (int place = 0; place < dSpaceGetNumGeoms(space); ++place) {
+    dBodyID box = dGeomGetBody(dSpaceGetGeom(space, place));
+    if (box == nullptr) continue;  // the plane
+    SCOPED_TRACE(place);
+    const dReal* p = dBodyGetPosition(box);
+    const double x = p[0], y = p[1], z = p[2];
+    dBodySetPosition(box, 1e12, 0, 0);
+    ssFrameReport report;
+    EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 60, &report), SS_ERROR_POSITION_LIMIT) << ssLastError();
+    EXPECT_EQ(report.failed_body, box);
+    dBodySetPosition(box, x, y, z);
+    ssStepper_Reset(stepper);
+    ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 60, nullptr), SS_OK) << ssLastError();
+  }
+  dGeomID first = dSpaceGetGeom(space, 0);
+  dBodyID gone = dGeomGetBody(first);
+  ASSERT_NE(gone, nullptr);
+  const int known = ssStepper_KnownBodyCount(stepper);
+  dGeomDestroy(first);
+  ASSERT_EQ(ssStepper_DestroyBody(stepper, gone), SS_OK) << ssLastError();
+  dBodyID ball = Ball(20, 20, 1);
+  ssFrameReport report;
+  ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 60, &report), SS_OK) << ssLastError();
+  EXPECT_EQ(ssStepper_KnownBodyCount(stepper), known);  // one gone, one made
+  EXPECT_LT(dBodyGetPosition(ball)[2], 1.0);             // stepped: it falls
+}
+
 // A stepper that adopts no space cannot see a sleeping body moved (ODE tells a move by a geom at the head of its space
 // only): it reads such a body asleep too, whether the program moves it between frames or in before_step.
 TEST_F(Sleeping, ASleepingBodyMovedWhereTheStepperDoesNotLookIsRefused) {
