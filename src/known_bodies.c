@@ -487,10 +487,9 @@ static int checkVisit(ssKnownBodies* known, int k, void* context) {
 
 /* A check's mark of body k, in the pass that reads it: whether ODE steps it (enabled, or awake at the last check:
  * ODE stepped it before it disabled it), then reached[] is this check's number and it is queued (stepped_count); a
- * sleeping body is counted in
- * *asleep, and in *unseen when the program could move it unseen (moves_unseen). awake[] becomes whether it is
- * enabled. */
-static inline int markBody(ssKnownBodies* known, int k, int* asleep, int* unseen) {
+ * sleeping body is counted in *unseen when the program could move it unseen (moves_unseen). awake[] becomes whether
+ * it is enabled, and a body that was asleep is noted woken. */
+static inline int markBody(ssKnownBodies* known, int k, int* unseen) {
   int enabled = dBodyIsEnabled(known->ids[k]) != 0, due = enabled | known->awake[k];
   if (enabled > known->awake[k]) noteWoken(known, known->ids[k]);
   known->awake[k] = (unsigned char)enabled;
@@ -498,7 +497,6 @@ static inline int markBody(ssKnownBodies* known, int k, int* asleep, int* unseen
     known->reached[k] = known->checks;
     known->queue[known->stepped_count++] = k;
   } else {
-    *asleep += 1;
     *unseen += known->moves_unseen[k];
   }
   return due;
@@ -597,12 +595,11 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
      * failure is found after); a sleeping body's values are not read. A body the frame's start passed over asleep
      * and found awake now is started here: its frame force read, with its state (ssKnownStartFrame). */
     const int late_start = known->sleepers_unread;
-    int asleep = 0;
     known->stepped_count = 0;
     for (int k = 0; k < count; ++k) {
       if (k < until) prefetchBody(known, k + kPrefetchAhead, check.forces);
       int was_awake = known->awake[k];
-      if (!markBody(known, k, &asleep, &unseen)) continue;
+      if (!markBody(known, k, &unseen)) continue;
       all &= late_start && !was_awake ? startBody(known, k, check.max_speed2, check.max_spin2)
                                       : bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
     }
@@ -648,15 +645,14 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   ++known->checks;
   /* one pass reads each body once: its joints (a sleeping body's joint may be destroyed too, so every body's are read
    * before a failure is told), its mark, and the state and forces of what ODE steps */
-  int all = 1, changed = 0, asleep = 0, unseen = 0;
+  int all = 1, changed = 0, unseen = 0;
   known->stepped_count = 0;
   for (int k = 0; k < count; ++k) {
     if (k < until) prefetchBody(known, k + kPrefetchAhead, 1), prefetchJoints(known, k + kPrefetchAhead);
     changed |= jointsChangedAt(known, k);
     if (sleepers_later && !known->awake[k]) { /* asleep at the last check: read by the check before the step */
-      asleep += 1;
       unseen += known->moves_unseen[k];
-    } else if (markBody(known, k, &asleep, &unseen)) {
+    } else if (markBody(known, k, &unseen)) {
       all &= startBody(known, k, check.max_speed2, check.max_spin2);
     }
   }
@@ -667,7 +663,7 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
     return SS_OK;
   }
   int failing = all ? -1 : firstMarkedFailing(known, &check);
-  if (failing < 0 && asleep > 0) failing = wakeWalk(known, startVisit, &check);
+  if (failing < 0 && known->stepped_count < count) failing = wakeWalk(known, startVisit, &check);
   if (failing < 0) failing = checkUnseen(known, unseen, &check); /* checked only: a sleeping body's force waits */
   for (int a = 0; failing < 0 && a < also_count; ++a) {
     int k = meetAlso(known, also[a]);

@@ -2,13 +2,13 @@
  * forces put back before each one, and the known bodies checked before and after it. A failure is latched: a broken
  * world is never stepped again until the program says it has repaired it. */
 #include <math.h>
-#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "array.h"
+#include "contact_memo.h"
 #include "error.h"
 #include "gears.h"
 #include "interpolation_internal.h"
@@ -20,36 +20,9 @@
 #include "steadystep/adopt.h"
 #include "steadystep/stepper.h"
 
-#if defined(__SSE2__) && defined(dDOUBLE)
-#include <emmintrin.h>
-#endif
 
 /* Frame times are sums of floating-point parts: a frame of exactly 2·max_step_s must not become 3 substeps. */
 static const double kStepCountSlack = 1e-9;
-
-/* A contact's surface as the program gave it and as ssStepper_SoftenContact wrote it, within one step: a near
- * callback gives most contacts the same surface, and the softness depends on nothing else (contact.c), so the next
- * such contact is written from here. */
-#if defined(dDOUBLE)
-typedef uint64_t RealBits;
-#else
-typedef uint32_t RealBits;
-#endif
-typedef struct ContactMemo {
-  int valid; /* 0 from the start of every step: the step's length, the mapping or the tuned world changed */
-  int mode_in, mode_out;
-  RealBits erp_in, cfm_in;     /* the given soft_erp and soft_cfm, as bits */
-  RealBits erp_mask, cfm_mask; /* all ones where mode_in uses the value, 0 where any value is the same surface */
-  dReal erp_out, cfm_out;
-  int rewrites; /* whether the written surface differs from the given one (naive's does not) */
-  int* counter; /* the frame report's count of contacts served as this one, or one nobody reads (no frame) */
-} ContactMemo;
-
-static RealBits bitsOf(dReal value) {
-  RealBits bits;
-  memcpy(&bits, &value, sizeof bits);
-  return bits;
-}
 
 struct ssStepper {
   ssStepperDef def;            /* def.registry: the registry in use, the given one or owned_registry */
@@ -79,7 +52,7 @@ struct ssStepper {
   int rebase_gears;      /* ssStepper_Reset was called: the next frame has ODE measure its gears afresh (gears.h) */
   ssStepInfo current;
   ssContactCache contact_cache; /* a program softens many contacts with the same numbers */
-  ContactMemo contact_memo;     /* the last contact softened in this step, as given and as written */
+  ssContactMemo contact_memo;   /* the last contact softened in this step, as given and as written */
   int contacts_outside_frames;  /* softened between frames: counted where no report reads them */
   ssFrameReport* report; /* the frame being stepped, for ssStepper_SoftenContact's counts */
   ssPoseHistory* poses;  /* SS_CUT_FIXED: the known bodies' last two states, to draw (interpolation.c) */
@@ -425,35 +398,12 @@ ssStepInfo ssStepper_CurrentStep(const ssStepper* stepper) {
   return (ssStepInfo){SS_MAPPING_IMPLICIT_EULER, 0, 0, 0, 0, 0, 0};
 }
 
-/* A contact's position, normal and depth summed: the sum less itself is 0 only when each is finite (a NaN or an
- * infinity makes it NaN). A sum that overflows says no for finite values, and the contacts then take the slow path,
- * which checks each value (contact.c). Summed over a batch, one comparison tells every contact of it. */
-static double geometrySum(const dContactGeom* geom) {
-  return (double)geom->depth + geom->pos[0] + geom->pos[1] + geom->pos[2] + geom->normal[0] + geom->normal[1] +
-         geom->normal[2];
-}
-
 /* Where a contact served as handed_on says is counted: the frame report's (a contact is never handed to matched),
  * or, outside a frame, a count nobody reads. */
 static int* contactCounter(ssStepper* stepper, ssRowFallback handed_on) {
   if (stepper->report == NULL) return &stepper->contacts_outside_frames;
   ssServedCounts* contacts = &stepper->report->contacts;
   return handed_on.to_implicit_euler ? &contacts->handed_to_implicit_euler : &contacts->by_mapping;
-}
-
-/* 0 when the surface is the one the memo was written from (the values its mode uses, bit for bit), else not 0. A
- * memo is made only from values the slow path took, so no NaN matches; -0 for 0 takes the slow path. */
-static RealBits surfaceDiffers(const ContactMemo* memo, const dSurfaceParameters* surface) {
-  RealBits mode = (RealBits)(unsigned)(surface->mode ^ memo->mode_in);
-  return ((bitsOf(surface->soft_erp) ^ memo->erp_in) & memo->erp_mask) |
-         ((bitsOf(surface->soft_cfm) ^ memo->cfm_in) & memo->cfm_mask) | mode;
-}
-
-/* Writes the memo's softness into a contact like the one it was made from. */
-static void writeMemo(const ContactMemo* memo, dSurfaceParameters* surface) {
-  surface->mode = memo->mode_out;
-  surface->soft_erp = memo->erp_out;
-  surface->soft_cfm = memo->cfm_out;
 }
 
 /* Kept out of line: the usual contact's path then needs no frame of its own. */
@@ -470,13 +420,8 @@ static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* co
     return ssFail(SS_ERROR_OUT_OF_RANGE, "tuned step = 0 s: adopt the world first (ssRegistry_Adopt), or soften "
                                          "with a spring of your own (ssContactSoften)");
   dSurfaceParameters* surface = &contact->surface;
+  const dSurfaceParameters given = *surface;
   ssSoftness world = ssRegistryTunedWorld(stepper->def.registry);
-  ContactMemo given = {.valid = 1,
-                       .mode_in = surface->mode,
-                       .erp_in = bitsOf(surface->soft_erp),
-                       .cfm_in = bitsOf(surface->soft_cfm),
-                       .erp_mask = (surface->mode & dContactSoftERP) ? ~(RealBits)0 : 0,
-                       .cfm_mask = (surface->mode & dContactSoftCFM) ? ~(RealBits)0 : 0};
   ssRowFallback handed_on = {0, 0};
   double erp = (surface->mode & dContactSoftERP) ? surface->soft_erp : world.erp;
   double cfm = (surface->mode & dContactSoftCFM) ? surface->soft_cfm : world.cfm;
@@ -484,26 +429,14 @@ static SS_OUT_OF_LINE ssStatus softenNewContact(ssStepper* stepper, dContact* co
   ssStatus status = ssContactSoftenCached(&stepper->contact_cache, contact, erp, cfm, tuned_step_s, step->mapping,
                                           step->softness_step_s, &handed_on);
   if (status != SS_OK) return status;
-  given.mode_out = surface->mode;
-  given.erp_out = surface->soft_erp;
-  given.cfm_out = surface->soft_cfm;
-  given.rewrites = given.mode_out != given.mode_in || bitsOf(given.erp_out) != given.erp_in ||
-                   bitsOf(given.cfm_out) != given.cfm_in;
-  given.counter = contactCounter(stepper, handed_on);
-  stepper->contact_memo = given;
+  ssContactMemoTake(&stepper->contact_memo, &given, surface, contactCounter(stepper, handed_on));
   return SS_OK;
 }
 
 /* One contact, as the last one or by its law; the memo then describes it (and its count). */
 static ssStatus softenOne(ssStepper* stepper, dContact* contact) {
-  const ContactMemo* memo = &stepper->contact_memo;
-  double sum = geometrySum(&contact->geom);
-  if (!memo->valid || surfaceDiffers(memo, &contact->surface) != 0 || sum - sum != 0.0) {
-    ssStatus status = softenNewContact(stepper, contact);
-    if (status != SS_OK) return status;
-  } else {
-    writeMemo(memo, &contact->surface);
-  }
+  if (!ssContactMemoFitsOne(&stepper->contact_memo, contact)) return softenNewContact(stepper, contact);
+  ssContactMemoWrite(&stepper->contact_memo, contact, 1);
   return SS_OK;
 }
 
@@ -522,8 +455,11 @@ static SS_OUT_OF_LINE ssStatus softenContactSlowly(ssStepper* stepper, dContact*
 
 ssStatus ssStepper_SoftenContact(ssStepper* stepper, dContact* contact, dBodyID body1, dBodyID body2) {
   (void)body1, (void)body2; /* no contact's softness depends on its bodies (contact.c) */
-  if (stepper == NULL || contact == NULL) return softenContactSlowly(stepper, contact);
-  return softenCounted(stepper, contact);
+  if (stepper == NULL || contact == NULL || !ssContactMemoFitsOne(&stepper->contact_memo, contact))
+    return softenContactSlowly(stepper, contact);
+  ssContactMemoWrite(&stepper->contact_memo, contact, 1);
+  *stepper->contact_memo.counter += 1;
+  return SS_OK;
 }
 
 /* A batch not every contact of which is like the last one: each checked on a copy first, so that an error leaves
@@ -542,52 +478,12 @@ static SS_OUT_OF_LINE ssStatus softenContactsSlowly(ssStepper* stepper, dContact
   return SS_OK;
 }
 
-/* Whether every contact of a batch has the memo's surface and a finite geometry: one pass, no branch a contact. With
- * SSE2 and double precision the given soft_erp and soft_cfm (one after the other in dSurfaceParameters) are compared
- * in one register, and the geometry's x and y summed in another. */
-#if defined(__SSE2__) && defined(dDOUBLE)
-_Static_assert(offsetof(dSurfaceParameters, soft_cfm) == offsetof(dSurfaceParameters, soft_erp) + sizeof(dReal),
-               "soft_erp and soft_cfm are read as one pair");
-static int batchAsMemo(const ContactMemo* memo, const dContact* contacts, int count) {
-  const __m128i soft_in = _mm_set_epi64x((long long)memo->cfm_in, (long long)memo->erp_in);
-  const __m128i soft_mask = _mm_set_epi64x((long long)memo->cfm_mask, (long long)memo->erp_mask);
-  __m128i soft_differs = _mm_setzero_si128();
-  __m128d sum_xy = _mm_setzero_pd();
-  double sum_z = 0;
-  unsigned mode_differs = 0;
-  for (int i = 0; i < count; ++i) {
-    const dSurfaceParameters* surface = &contacts[i].surface;
-    const dContactGeom* geom = &contacts[i].geom;
-    __m128i soft = _mm_loadu_si128((const __m128i*)(const void*)&surface->soft_erp);
-    soft_differs = _mm_or_si128(soft_differs, _mm_and_si128(_mm_xor_si128(soft, soft_in), soft_mask));
-    mode_differs |= (unsigned)(surface->mode ^ memo->mode_in);
-    sum_xy = _mm_add_pd(sum_xy, _mm_add_pd(_mm_loadu_pd(geom->pos), _mm_loadu_pd(geom->normal)));
-    sum_z += geom->pos[2] + geom->normal[2] + geom->depth;
-  }
-  double sum = _mm_cvtsd_f64(_mm_add_sd(sum_xy, _mm_unpackhi_pd(sum_xy, sum_xy))) + sum_z;
-  soft_differs = _mm_or_si128(soft_differs, _mm_cvtsi32_si128((int)mode_differs));
-  if (_mm_movemask_epi8(_mm_cmpeq_epi32(soft_differs, _mm_setzero_si128())) != 0xffff) return 0;
-  return memo->valid && sum - sum == 0.0;
-}
-#else
-static int batchAsMemo(const ContactMemo* memo, const dContact* contacts, int count) {
-  RealBits differs = 0;
-  double sum = 0;
-  for (int i = 0; i < count; ++i) {
-    differs |= surfaceDiffers(memo, &contacts[i].surface);
-    sum += geometrySum(&contacts[i].geom);
-  }
-  return memo->valid & (differs == 0) & (sum - sum == 0.0);
-}
-#endif
-
 ssStatus ssStepper_SoftenContacts(ssStepper* stepper, dContact* contacts, int count) {
-  if (stepper == NULL || contacts == NULL || count <= 0 || !batchAsMemo(&stepper->contact_memo, contacts, count))
+  int usual = stepper != NULL && contacts != NULL && count > 0;
+  if (!usual || !ssContactMemoFits(&stepper->contact_memo, contacts, count))
     return count == 0 && stepper != NULL ? SS_OK : softenContactsSlowly(stepper, contacts, count);
-  const ContactMemo* memo = &stepper->contact_memo;
-  if (memo->rewrites)
-    for (int i = 0; i < count; ++i) writeMemo(memo, &contacts[i].surface);
-  *memo->counter += count;
+  ssContactMemoWrite(&stepper->contact_memo, contacts, count);
+  *stepper->contact_memo.counter += count;
   return SS_OK;
 }
 
