@@ -143,7 +143,7 @@ TEST_F(FollowTest, UnderNaiveABodysWriteStaysAsWrittenAndIsFollowedWhenTheSteppi
   dBodySetLinearDamping(arm, 0.03);
   for (int frame = 0; frame < 5; ++frame) {
     ASSERT_EQ(ssStepper_Step(stepper, frame % 2 ? 1.0 / 60 : 1.0 / 50, nullptr), SS_OK) << ssLastError();
-    EXPECT_EQ(dBodyGetLinearDamping(arm), 0.03) << frame;
+    EXPECT_EQ(dBodyGetLinearDamping(arm), AsDReal(0.03)) << frame;
   }
   ASSERT_EQ(ssSteppingForPolicy("implicit-euler", kTunedStep, &stepping), SS_OK);
   ASSERT_EQ(ssStepper_SetStepping(stepper, &stepping), SS_OK) << ssLastError();
