@@ -85,9 +85,8 @@ static void prefetchBinding(const ssBodyBinding* binding, ptrdiff_t torque_at) {
   SS_PREFETCH(body + torque_at + 192);
 }
 
-/* Whether the body binding's numbers in ODE are those the registry last wrote. */
-static int bodyAsWritten(dWorldID world, const ssBodyBinding* binding) {
-  const ssBodyWritten written = binding->written;
+/* Whether the body binding's numbers in ODE are `written`. */
+static int bodyHolds(dWorldID world, const ssBodyBinding* binding, ssBodyWritten written) {
   dBodyID body = binding->body;
   if (binding->has_damping &&
       (!ssSameInOde(written.linear_scale, body ? dBodyGetLinearDamping(body) : dWorldGetLinearDamping(world)) ||
@@ -142,7 +141,7 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int with_bodies, int* fol
     /* a sleeping body's values are read when it wakes: ODE neither damps it nor counts its idle steps, and Apply
      * writes it no more than this reads it (ssRegistryWriteBodies) */
     int asleep = binding->body != 0 && !dBodyIsEnabled(binding->body);
-    if (!adopted || asleep || isnan(binding->written_step_s) || bodyAsWritten(world, binding)) continue;
+    if (!adopted || asleep || isnan(binding->written_step_s) || bodyHolds(world, binding, binding->written)) continue;
     ssBodyBinding* larger_bodies = realloc(bodies, (size_t)(body_count + 1) * sizeof *bodies);
     int* larger_at = realloc(body_at, (size_t)(body_count + 1) * sizeof *body_at);
     if (larger_bodies != NULL) bodies = larger_bodies;
@@ -176,4 +175,34 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int with_bodies, int* fol
   free(bodies);
   free(body_at);
   return SS_OK;
+}
+
+ssStatus ssRegistryFollowWoken(ssRegistry* registry, const dBodyID* woken, int count, int* followed) {
+  *followed = 0;
+  double step_s = ssRegistry_TunedStep(registry);
+  if (step_s == 0 || count == 0) return SS_OK;
+  dWorldID world = ssRegistryWorld(registry);
+  ssBodyBinding* planned = malloc((size_t)count * sizeof *planned);
+  int* planned_at = malloc((size_t)count * sizeof *planned_at);
+  ssStatus status = planned != NULL && planned_at != NULL
+                        ? SS_OK
+                        : ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory following the program's writes");
+  int planned_count = 0;
+  for (int w = 0; w < count && status == SS_OK; ++w) {
+    const ssBodyBinding* binding = ssRegistryFindBody(registry, woken[w]);
+    if (binding == NULL || !(binding->tuned.damping_step_s > 0 || binding->tuned.auto_disable_step_s > 0)) continue;
+    /* what the registry left there: what it last wrote, or, never written, what adoption read */
+    ssBodyWritten left = binding->written;
+    if (isnan(binding->written_step_s)) ssBodyWrittenFor(binding, step_s, &left);
+    if (bodyHolds(world, binding, left)) continue;
+    char what[64];
+    snprintf(what, sizeof what, "body %p, as the program set it while it slept,", (void*)binding->body);
+    status = ssBodyValuesAsTuned(what, world, binding->body, step_s, &planned[planned_count]);
+    planned_at[planned_count++] = (int)(binding - ssRegistryBodyAt(registry, 0));
+  }
+  for (int p = 0; p < planned_count && status == SS_OK; ++p) ssRegistryFollowBody(registry, planned_at[p], &planned[p]);
+  if (status == SS_OK) *followed = planned_count;
+  free(planned);
+  free(planned_at);
+  return status;
 }

@@ -94,6 +94,12 @@ static inline void ssBodyWrittenFor(const ssBodyBinding* binding, double step_s,
  * first. */
 ssStatus ssRegistryFollowProgram(ssRegistry* registry, int with_bodies, int* followed);
 
+/* ssRegistryFollowProgram for the bodies of woken[count] that just woke (the others are passed over): a damping or
+ * auto-disable the program set while one slept, which neither Apply nor the follow of every frame reads, is taken as
+ * newly tuned before the body is written for its step (ssRegistryWriteWoken). *followed counts them. Errors, with
+ * nothing changed: those of ssRegistryFollowProgram. */
+ssStatus ssRegistryFollowWoken(ssRegistry* registry, const dBodyID* woken, int count, int* followed);
+
 /* A number that changes whenever a joint or body is bound or unbound: the stepper rebuilds its list on a change. */
 unsigned ssRegistryGeneration(const ssRegistry* registry);
 

@@ -770,13 +770,21 @@ static int knownBodyTouches(const ssStepper* stepper) {
 }
 
 /* The damping and auto-disable of the bodies that woke since the last step, for this step: Apply wrote every awake
- * body, and leaves a sleeping one as the program set it until it wakes (ssRegistryWriteBodies). A body ODE woke
- * through a joint in its step is written before the next one. */
-static void writeWoken(ssStepper* stepper, double softness_step_s) {
-  int count;
+ * body, and leaves a sleeping one as the program set it until it wakes (ssRegistryWriteBodies). What the program set
+ * while one slept is followed first. A body ODE woke through a joint in its step is written before the next one.
+ * Errors, with the woken bodies kept for the next try: those of ssRegistryFollowWoken. */
+static ssStatus writeWoken(ssStepper* stepper, double softness_step_s, ssFrameReport* report) {
+  int count, followed = 0;
   const dBodyID* woken = ssKnownTakeWoken(&stepper->known, &count);
-  if (count > 0 && stepper->def.registry != NULL)
-    ssRegistryWriteWoken(stepper->def.registry, woken, count, softness_step_s);
+  if (count == 0 || stepper->def.registry == NULL) return SS_OK;
+  ssStatus status = ssRegistryFollowWoken(stepper->def.registry, woken, count, &followed);
+  if (status != SS_OK) {
+    stepper->known.woken_count = count; /* taken back: the list is as it was */
+    return status;
+  }
+  report->program_writes += followed;
+  ssRegistryWriteWoken(stepper->def.registry, woken, count, softness_step_s);
+  return SS_OK;
 }
 
 /* ODE's step, with its generator set to the stepping's seed for it and put back after it (stepping.step_seed). */
@@ -855,7 +863,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
          (status = checkKnown(stepper, 1, 0, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistoryBeforeLastStep(stepper->poses);
-    writeWoken(stepper, softness_step_s);
+    if ((status = writeWoken(stepper, softness_step_s, report)) != SS_OK) return refuseStep(stepper, status, i);
     int stepped = odeStep(stepper, step_s);
     if (def->contact_group) dJointGroupEmpty(def->contact_group);
     /* what the program adds or moves next lands before the spaces' first geoms now */

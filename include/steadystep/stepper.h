@@ -74,7 +74,9 @@
  * step that follows a callback, the stepper compares every adopted value it rewrites for each step with what it last
  * wrote: one that differs was the program's, and is taken as newly tuned at the tuned step (as adoption took the
  * first), so that every step length gets what the program's value means. (A spring bound by hand with the registry
- * is changed by binding it again: its rows are not read.) report->program_writes counts them. A value no
+ * is changed by binding it again: its rows are not read. Under a softness frozen at the tuned step, as naive's, a
+ * body's damping and auto-disable are written for that step only and not read back: the program's value stays as it
+ * wrote it, and is followed when the stepping changes.) report->program_writes counts them. A value no
  * spring stands for (an erp outside [0, 1], a cfm below 0, a damping scale of 1) refuses the frame by name, with
  * nothing stepped, until the program sets another.
  *

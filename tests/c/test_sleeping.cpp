@@ -266,6 +266,31 @@ TEST_F(Sleeping, ABodyAdoptedAsleepIsWrittenForTheStepWhenItWakes) {
   EXPECT_EQ(dBodyGetAutoDisableSteps(boxes[0]), 20);
 }
 
+// What the program sets on a sleeping body stays the program's when the body wakes: followed as newly tuned, not
+// written over with what adoption read. Under naive it stays as written, bit for bit; at steps of 1/120 s the idle
+// time it stands for is kept (30 steps tuned at 1/60 s are 60).
+TEST_F(Sleeping, WhatTheProgramSetsOnASleepingBodyIsFollowedWhenItWakes) {
+  for (const char* policy : {"naive", "implicit-euler"}) {
+    SCOPED_TRACE(policy);
+    const bool naive = std::string(policy) == "naive";
+    dBodyID box = boxes[naive ? 9 : 11];  // one of the sleeping level's, asleep still
+    for (dBodyID each : boxes) dBodySetAutoDisableSteps(each, 10);
+    Adopt(policy, 1.0 / 120);
+    const double frame_s = naive ? 1.0 / 60 : 1.0 / 120;
+    ASSERT_EQ(ssStepper_Step(stepper, frame_s, nullptr), SS_OK) << ssLastError();
+    ASSERT_FALSE(dBodyIsEnabled(box));
+    dBodySetAutoDisableSteps(box, 30);  // asleep: the program's settings change
+    ASSERT_EQ(ssStepper_Step(stepper, frame_s, nullptr), SS_OK) << ssLastError();
+    dBodyEnable(box);
+    ssFrameReport report;
+    ASSERT_EQ(ssStepper_Step(stepper, frame_s, &report), SS_OK) << ssLastError();
+    EXPECT_EQ(dBodyGetAutoDisableSteps(box), naive ? 30 : 60);
+    EXPECT_EQ(report.program_writes, 1);
+    ssStepper_Destroy(stepper);
+    stepper = nullptr;
+  }
+}
+
 // A body the program wakes between frames and pushes with a force gets the force over every substep of the frame
 // (F·dt), though the frame's start passes over a sleeping body when a check after the callbacks reads it.
 TEST_F(Sleeping, ABodyWokenBetweenFramesWithAForceGetsItOverTheWholeFrame) {
