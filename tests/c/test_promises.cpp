@@ -119,6 +119,7 @@ class PromiseTest : public OdeTest {
   dSpaceID space = nullptr;
   dJointGroupID contacts = nullptr;
   ssStepper* stepper = nullptr;
+  int batched = 0;  // the near callback softens a pair's contacts in one call
 };
 
 // ---- a. one check at the boundary, before every physics step ----
@@ -349,7 +350,7 @@ TEST_F(PromiseTest, ABatchInTheNearCallbackCountsAndMovesAsOneCallAContact) {
   dBodySetLinearVel(box, 0.3, 0, 0);
   std::vector<double> path[2];
   ssServedCounts counted[2] = {};
-  for (int batched = 0; batched < 2; ++batched) {
+  for (batched = 0; batched < 2; ++batched) {
     dBodySetPosition(box, 0, 0, 0.06);
     dBodySetLinearVel(box, 0.3, 0, 0);
     dBodySetAngularVel(box, 0, 0, 0);
@@ -358,25 +359,16 @@ TEST_F(PromiseTest, ABatchInTheNearCallbackCountsAndMovesAsOneCallAContact) {
     dRandSetSeed(1);  // QuickStep's row order: the same for both runs
     ssStepperDef def = Def();
     def.collide_context = this;
-    def.collide = batched ? [](void* context, ssStepper*) {
+    def.collide = [](void* context, ssStepper*) {
       dSpaceCollide(static_cast<PromiseTest*>(context)->space, context, [](void* data, dGeomID a, dGeomID b) {
         auto* t = static_cast<PromiseTest*>(data);
         dContact contact[4];
         std::memset(contact, 0, sizeof contact);
         for (dContact& c : contact) c.surface.mode = dContactSoftCFM, c.surface.mu = 1, c.surface.soft_cfm = 1e-4;
         int n = dCollide(a, b, 4, &contact[0].geom, sizeof(dContact));
-        EXPECT_EQ(ssStepper_SoftenContacts(t->stepper, contact, n), SS_OK);
-        for (int i = 0; i < n; ++i) t->Attach(&contact[i], a, b);
-      });
-    } : [](void* context, ssStepper*) {
-      dSpaceCollide(static_cast<PromiseTest*>(context)->space, context, [](void* data, dGeomID a, dGeomID b) {
-        auto* t = static_cast<PromiseTest*>(data);
-        dContact contact[4];
-        std::memset(contact, 0, sizeof contact);
-        for (dContact& c : contact) c.surface.mode = dContactSoftCFM, c.surface.mu = 1, c.surface.soft_cfm = 1e-4;
-        int n = dCollide(a, b, 4, &contact[0].geom, sizeof(dContact));
+        if (t->batched) EXPECT_EQ(ssStepper_SoftenContacts(t->stepper, contact, n), SS_OK);
         for (int i = 0; i < n; ++i) {
-          EXPECT_EQ(ssStepper_SoftenContact(t->stepper, &contact[i], dGeomGetBody(a), dGeomGetBody(b)), SS_OK);
+          if (!t->batched) EXPECT_EQ(ssStepper_SoftenContact(t->stepper, &contact[i], 0, 0), SS_OK);
           t->Attach(&contact[i], a, b);
         }
       });
