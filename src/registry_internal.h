@@ -26,16 +26,16 @@ typedef struct ssBodyTuned {
   int average_samples;
 } ssBodyTuned;
 
-/* A body's damping and auto-disable, given in seconds. body 0 holds the world's defaults. Laid out without padding
- * (104 bytes): adoption holds two of these a body, the plan's and the registry's. */
 /* The numbers the registry writes into a body binding's body (or the world's defaults) for a step of step_s. */
 typedef struct ssBodyWritten {
   double linear_scale, angular_scale; /* has_damping */
-  int idle_steps;                     /* has_auto_disable, with the two below */
-  double idle_time_s;
+  double idle_time_s;                 /* has_auto_disable, with the two below */
+  int idle_steps;
   int average_samples;
 } ssBodyWritten;
 
+/* A body's damping and auto-disable, given in seconds. body 0 holds the world's defaults. Laid out without padding
+ * (136 bytes): adoption holds two of these a body, the plan's and the registry's. */
 typedef struct ssBodyBinding {
   dBodyID body;
   double linear_rate_per_s, angular_rate_per_s;
@@ -51,7 +51,6 @@ typedef struct ssBodyBinding {
  * tuned_step_s, as adoption binds them (adopt.c). what names the body in messages. Errors: those of adoption
  * (SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE: a damping scale outside [0, 1), a negative idle time). */
 ssStatus ssBodyValuesAsTuned(const char* what, dWorldID world, dBodyID body, double tuned_step_s, ssBodyBinding* out);
-
 
 /* ODE counts steps: a count of seconds in steps of h, where a whole number of steps computed with rounding error
  * (10·(1/60)/(1/60) = 10.000000000000002) must not become one more. */
