@@ -366,9 +366,13 @@ TEST_F(PromiseTest, ABatchInTheNearCallbackCountsAndMovesAsOneCallAContact) {
         std::memset(contact, 0, sizeof contact);
         for (dContact& c : contact) c.surface.mode = dContactSoftCFM, c.surface.mu = 1, c.surface.soft_cfm = 1e-4;
         int n = dCollide(a, b, 4, &contact[0].geom, sizeof(dContact));
-        if (t->batched) EXPECT_EQ(ssStepper_SoftenContacts(t->stepper, contact, n), SS_OK);
+        if (t->batched) {
+          EXPECT_EQ(ssStepper_SoftenContacts(t->stepper, contact, n), SS_OK);
+        }
         for (int i = 0; i < n; ++i) {
-          if (!t->batched) EXPECT_EQ(ssStepper_SoftenContact(t->stepper, &contact[i], 0, 0), SS_OK);
+          if (!t->batched) {
+            EXPECT_EQ(ssStepper_SoftenContact(t->stepper, &contact[i], 0, 0), SS_OK);
+          }
           t->Attach(&contact[i], a, b);
         }
       });
