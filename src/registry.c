@@ -27,6 +27,11 @@ struct ssRegistry {
   int joint_count, joint_capacity;
   ssBodyBinding* bodies;
   int body_count, body_capacity;
+  /* bodies[0 .. bodies_passed) were passed by a write for bodies_passed_step_s: written for it, or asleep then (a
+   * sleeping body is written before the step it wakes for, ssRegistryWriteWoken); a binding changed in place lowers
+   * it to its place, so that a write at that step passes only what changed or was added since */
+  int bodies_passed;
+  double bodies_passed_step_s;
   ssBindingIndex joint_index; /* (joint, rowTag) -> position in joints */
   ssBindingIndex body_index;  /* (body, 0) -> position in bodies */
   unsigned generation; /* changes whenever the set of bound joints or bodies does */
@@ -34,6 +39,11 @@ struct ssRegistry {
   unsigned last_stamp; /* the last stamp given to a joint row's binding */
   ssRegistryAttachment apply; /* Apply's state (apply.c) */
 };
+
+/* The binding at place i changed: written again at the next write whatever its step. */
+static void bodyChangedAt(ssRegistry* registry, int i) {
+  if (i < registry->bodies_passed) registry->bodies_passed = i;
+}
 
 /* Refuses a body of another world than the registry's (0, the static world, is everyone's): the registry's writes
  * for it would be read by a world the registry never steps. */
@@ -270,6 +280,7 @@ ssStatus ssRegistry_BindDamping(ssRegistry* registry, dBodyID body, double linea
   if (status != SS_OK) return status;
   ssBodyBinding* binding = bodyBinding(registry, body);
   if (binding == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding damping");
+  bodyChangedAt(registry, (int)(binding - registry->bodies));
   binding->has_damping = 1;
   binding->linear_rate_per_s = linear_rate_per_s;
   binding->angular_rate_per_s = angular_rate_per_s;
@@ -287,6 +298,7 @@ ssStatus ssRegistry_BindAutoDisable(ssRegistry* registry, dBodyID body, double i
   if (status != SS_OK) return status;
   ssBodyBinding* binding = bodyBinding(registry, body);
   if (binding == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory binding auto-disable");
+  bodyChangedAt(registry, (int)(binding - registry->bodies));
   binding->has_auto_disable = 1;
   binding->idle_time_s = idle_time_s;
   binding->average_window_s = average_window_s;
@@ -303,6 +315,7 @@ ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body) {
   if (position < 0) return ssFail(SS_ERROR_NOT_FOUND, "body %p: not bound", (void*)body);
   ssIndexRemove(&registry->body_index, body, 0);
   registry->bodies[position] = registry->bodies[--registry->body_count];
+  bodyChangedAt(registry, position); /* the last binding moved there */
   if (position < registry->body_count) ssIndexPut(&registry->body_index, registry->bodies[position].body, 0, position);
   registry->generation += 1;
   registry->revision += 1;
@@ -345,18 +358,23 @@ static void writeBody(ssBodyBinding* binding, dWorldID world, double step_s) {
 void ssRegistryWriteWoken(ssRegistry* registry, const dBodyID* bodies, int count, double step_s) {
   for (int i = 0; i < count; ++i) {
     ssBodyBinding* binding = ssRegistryFindBody(registry, bodies[i]);
-    if (binding != NULL && binding->written_step_s != step_s)
-      writeBody(binding, registry->world, step_s);
+    if (binding == NULL || binding->written_step_s == step_s) continue;
+    writeBody(binding, registry->world, step_s);
+    if (step_s != registry->bodies_passed_step_s) bodyChangedAt(registry, (int)(binding - registry->bodies));
   }
 }
 
 void ssRegistryWriteBodies(ssRegistry* registry, double step_s) {
-  for (int i = 0; i < registry->body_count; ++i) {
+  /* at the step of the last pass, only what changed or was added since: a sleeping level is not walked again */
+  int from = step_s == registry->bodies_passed_step_s ? registry->bodies_passed : 0;
+  for (int i = from; i < registry->body_count; ++i) {
     ssBodyBinding* binding = &registry->bodies[i];
     /* a sleeping body is written when it wakes, as the program's writes to it are followed then (follow.c) */
     if (binding->written_step_s != step_s && (binding->body == 0 || dBodyIsEnabled(binding->body)))
       writeBody(binding, registry->world, step_s);
   }
+  registry->bodies_passed = registry->body_count;
+  registry->bodies_passed_step_s = step_s;
 }
 
 dWorldID ssRegistryWorld(const ssRegistry* registry) { return registry->world; }
@@ -421,6 +439,7 @@ void ssRegistryFollowWorldLaw(ssRegistry* registry, ssRowLaw law) {
 
 void ssRegistryFollowBody(ssRegistry* registry, int i, const ssBodyBinding* binding) {
   registry->bodies[i] = *binding;
+  bodyChangedAt(registry, i);
   registry->revision += 1;
 }
 

@@ -131,7 +131,9 @@ SS_API ssStatus ssRegistry_UnbindBody(ssRegistry* registry, dBodyID body);
  *  SS_MAX_FORCE_N, or, with no load declared (ssRegistry_SetJointLoad), a matched static stiffness
  *  erp/(step_s·cfm) more than 5 % from k, or a pure damper's 1/cfm more than 5 % from c: an undeclared load would
  *  rest elsewhere than the spring puts it; docs/exact-mappings.md) is written with implicit Euler and counted.
- *  Either everything is written or, on an error, nothing is. report may be NULL.
+ *  Either everything is written or, on an error, nothing is. report may be NULL. A sleeping body's damping and
+ *  auto-disable are passed over (ODE steps none of it): a stepper writes them before the step the body wakes for;
+ *  called directly, Apply writes them at its first call for another step length once the body is awake.
  *  Errors: SS_ERROR_NOT_FINITE, SS_ERROR_OUT_OF_RANGE (registry NULL, step_s, previous_step_s);
  *  SS_ERROR_UNSUPPORTED for an unknown mapping. */
 SS_API ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s, double previous_step_s,

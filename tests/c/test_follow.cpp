@@ -131,6 +131,21 @@ TEST_F(FollowTest, ValuesWrittenEveryFrameAreFollowedAtEveryFrameLength) {
   EXPECT_EQ(probe.checked, 40);
 }
 
+// At steps that keep one length, other than the tuned step, a body's damping the program writes is followed and
+// written for that length before the next step (Apply passes only the bindings changed since its last write).
+TEST_F(FollowTest, ABodysWriteAtAnUnchangedStepIsWrittenForThatStep) {
+  ASSERT_EQ(Make(nullptr, nullptr), SS_OK) << ssLastError();
+  for (int frame = 0; frame < 6; ++frame) {
+    if (frame == 3) dBodySetLinearDamping(arm, 0.05);
+    ssFrameReport report;
+    ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 120, &report), SS_OK) << ssLastError();
+    ASSERT_EQ(report.steps, 1);
+    EXPECT_EQ(report.program_writes, frame == 3 ? 1 : 0) << frame;
+    double damping = frame >= 3 ? 0.05 : 0.01;
+    EXPECT_NEAR(dBodyGetLinearDamping(arm), DampingAt(damping, 1.0 / 120), ReadBackTolerance(1e-13, damping)) << frame;
+  }
+}
+
 // Under naive (the softness frozen at the tuned step) a body's damping the program writes stays in ODE as written,
 // unread: Apply writes nothing over it. When the stepping changes, it is followed before Apply writes for the new
 // step: the damping then holds what the program's last value means at that step.

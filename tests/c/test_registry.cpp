@@ -547,6 +547,57 @@ TEST_F(RegistryTest, AutoDisableIsGivenInSeconds) {
   ssRegistry_Destroy(registry);
 }
 
+// Apply at the step of its last write passes only the bindings changed or added since: a binding added, bound again in
+// place, or moved by an unbinding is written at that same step, and a sleeping body is passed over
+// (ODE steps none of it) and written at the first Apply for another step once it is awake.
+TEST_F(RegistryTest, EveryBodyBindingChangedSinceTheLastWriteIsWrittenAtTheSameStep) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  const double step_s = 1.0 / 90.0, other_step_s = 1.0 / 45.0;
+  auto scale = [](double rate, double h) { return 1 - std::exp(-rate * h); };
+  auto tolerance = [](double rate, double h) { return ReadBackTolerance(1e-15, rate * h); };
+  std::vector<dBodyID> bodies;
+  for (int i = 0; i < 6; ++i) {
+    bodies.push_back(MakeBody(1.0));
+    ASSERT_EQ(ssRegistry_BindDamping(registry, bodies.back(), 1.0, 1.0), SS_OK);
+  }
+  dBodyID sleeper = bodies[3];
+  dBodyDisable(sleeper);
+  dBodySetLinearDamping(sleeper, 0.5);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, step_s, 0, nullptr), SS_OK);
+  for (dBodyID body : bodies)
+    if (body != sleeper) EXPECT_NEAR(dBodyGetLinearDamping(body), scale(1.0, step_s), tolerance(1.0, step_s));
+  EXPECT_EQ(dBodyGetLinearDamping(sleeper), 0.5);  // passed over asleep
+
+  // woken, with a body bound since: the write at the same step passes the new binding alone
+  dBodyEnable(sleeper);
+  dBodyID added = MakeBody(1.0);
+  ASSERT_EQ(ssRegistry_BindDamping(registry, added, 2.0, 2.0), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, step_s, 0, nullptr), SS_OK);
+  EXPECT_NEAR(dBodyGetLinearDamping(added), scale(2.0, step_s), tolerance(2.0, step_s));
+  EXPECT_EQ(dBodyGetLinearDamping(sleeper), 0.5);  // a stepper writes it before the step it wakes for
+
+  // bound again in place
+  ASSERT_EQ(ssRegistry_BindDamping(registry, bodies[1], 3.0, 3.0), SS_OK);
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, step_s, 0, nullptr), SS_OK);
+  EXPECT_NEAR(dBodyGetLinearDamping(bodies[1]), scale(3.0, step_s), tolerance(3.0, step_s));
+
+  // bound after the last write, then moved to the first place by an unbinding
+  dBodyID moved = MakeBody(1.0);
+  ASSERT_EQ(ssRegistry_BindDamping(registry, moved, 5.0, 5.0), SS_OK);
+  ASSERT_EQ(ssRegistry_UnbindBody(registry, bodies[0]), SS_OK);
+  dBodySetLinearDamping(bodies[0], 0.25);  // not bound: left as the program sets it
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, step_s, 0, nullptr), SS_OK);
+  EXPECT_NEAR(dBodyGetLinearDamping(moved), scale(5.0, step_s), tolerance(5.0, step_s));
+  EXPECT_EQ(dBodyGetLinearDamping(bodies[0]), 0.25);
+
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, other_step_s, 0, nullptr), SS_OK);
+  EXPECT_NEAR(dBodyGetLinearDamping(sleeper), scale(1.0, other_step_s), tolerance(1.0, other_step_s));
+  EXPECT_NEAR(dBodyGetLinearDamping(bodies[1]), scale(3.0, other_step_s), tolerance(3.0, other_step_s));
+  EXPECT_NEAR(dBodyGetLinearDamping(added), scale(2.0, other_step_s), tolerance(2.0, other_step_s));
+  EXPECT_NEAR(dBodyGetLinearDamping(moved), scale(5.0, other_step_s), tolerance(5.0, other_step_s));
+  ssRegistry_Destroy(registry);
+}
+
 TEST_F(RegistryTest, VisitsEachBoundBodyOnce) {
   ssRegistry* registry = ssRegistry_Create(world);
   for (int i = 0; i < 3; ++i) {
