@@ -299,9 +299,13 @@ void ssKnownTakeJointsOf(ssKnownBodies* known, dBodyID body) {
   if (k >= 0) known->joints[k] = jointSignature(body);
 }
 
+/* A body asleep at the last check with no joint but contacts then has its joints read when it is found awake
+ * (bodyWoke): while it sleeps ODE steps no joint attached to it, and it has none bound that could be destroyed. */
+static inline int jointsRead(const ssKnownBodies* known, int k) { return known->awake[k] || known->joints[k].count; }
+
 int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body) {
   for (int k = 0; k < known->count; ++k)
-    if (jointsChangedAt(known, k)) {
+    if (jointsRead(known, k) && jointsChangedAt(known, k)) {
       if (body != NULL) *body = known->ids[k];
       return 1;
     }
@@ -437,9 +441,18 @@ static int bodyWithin(const ssBodyValues* v, double max_speed2, double max_spin2
 
 /* A body found awake that was asleep, kept for ssKnownTakeWoken (out of memory: not kept; its numbers are written at
  * the next change of step, as before it woke). */
-static void noteWoken(ssKnownBodies* known, dBodyID body) {
+/* Body k found woken, by the program or by ODE through a joint: noted for its write, and its joints read when they
+ * were passed over while it slept (jointsRead). */
+static void bodyWoke(ssKnownBodies* known, int k) {
   if (ssReserveOne((void**)&known->woken, known->woken_count, &known->woken_capacity, sizeof *known->woken))
-    known->woken[known->woken_count++] = body;
+    known->woken[known->woken_count++] = known->ids[k];
+  if (known->joints[k].count == 0 && jointsChangedAt(known, k)) known->joints_due = 1;
+}
+
+int ssKnownTakeJointsDue(ssKnownBodies* known) {
+  int due = known->joints_due;
+  known->joints_due = 0;
+  return due;
 }
 
 const dBodyID* ssKnownTakeWoken(ssKnownBodies* known, int* count) {
@@ -464,7 +477,7 @@ static int wakeWalk(ssKnownBodies* known, int (*visit)(ssKnownBodies*, int, void
         int k = other != 0 && other != body ? placeOf(known, other) : -1;
         if (k < 0 || known->reached[k] == known->checks) continue;
         known->reached[k] = known->checks;
-        if (!known->awake[k]) noteWoken(known, other);
+        if (!known->awake[k]) bodyWoke(known, k);
         known->awake[k] = 1;
         known->queue[queued] = k;
         known->stepped_count = ++queued;
@@ -491,7 +504,7 @@ static int checkVisit(ssKnownBodies* known, int k, void* context) {
  * it is enabled, and a body that was asleep is noted woken. */
 static inline int markBody(ssKnownBodies* known, int k, int* unseen) {
   int enabled = dBodyIsEnabled(known->ids[k]) != 0, due = enabled | known->awake[k];
-  if (enabled > known->awake[k]) noteWoken(known, known->ids[k]);
+  if (enabled > known->awake[k]) bodyWoke(known, k);
   known->awake[k] = (unsigned char)enabled;
   if (due) {
     known->reached[k] = known->checks;
@@ -644,12 +657,14 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   const int count = known->count, until = ssPrefetchUntil(count);
   ++known->checks;
   /* one pass reads each body once: its joints (a sleeping body's joint may be destroyed too, so every body's are read
-   * before a failure is told), its mark, and the state and forces of what ODE steps */
+   * before a failure is told, but one that had none: jointsRead), its mark, and the state and forces of what ODE
+   * steps. A body found woken here or by the walk has its joints read then (bodyWoke). */
   int all = 1, changed = 0, unseen = 0;
   known->stepped_count = 0;
+  known->joints_due = 0; /* every body awake at the last check is read below */
   for (int k = 0; k < count; ++k) {
     if (k < until) prefetchBody(known, k + kPrefetchAhead, 1), prefetchJoints(known, k + kPrefetchAhead);
-    changed |= jointsChangedAt(known, k);
+    if (jointsRead(known, k)) changed |= jointsChangedAt(known, k);
     if (sleepers_later && !known->awake[k]) { /* asleep at the last check: read by the check before the step */
       unseen += known->moves_unseen[k];
     } else if (markBody(known, k, &unseen)) {
@@ -664,6 +679,10 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   }
   int failing = all ? -1 : firstMarkedFailing(known, &check);
   if (failing < 0 && known->stepped_count < count) failing = wakeWalk(known, startVisit, &check);
+  if (ssKnownTakeJointsDue(known)) { /* a body the walk or the marks woke has a joint attached since: as above */
+    *joints_changed = 1;
+    return SS_OK;
+  }
   if (failing < 0) failing = checkUnseen(known, unseen, &check); /* checked only: a sleeping body's force waits */
   for (int a = 0; failing < 0 && a < also_count; ++a) {
     int k = meetAlso(known, also[a]);

@@ -73,6 +73,9 @@ typedef struct ssKnownBodies {
    * yet taken (ssKnownTakeWoken): their damping and auto-disable are written for the step when they wake */
   dBodyID* woken;
   int woken_count, woken_capacity;
+  /* a body passed over asleep with no joint but contacts (its joints are not read while it sleeps: ODE steps none)
+   * was found woken with a joint attached since: the stepper finds it before the step (ssKnownTakeJointsDue) */
+  int joints_due;
   ssPointerMap index; /* body -> its place in the arrays above */
   dSpaceID seen_space; /* the space whose heads the stepper looks at (its def.space, with those nested), or 0 */
   int count, capacity;
@@ -107,7 +110,8 @@ int ssKnownJoined(const ssKnownBodies* known, dBodyID body);
 void ssKnownForget(ssKnownBodies* known, dBodyID body);
 
 /* Whether a body's joints differ from those listed (a joint was attached, detached or destroyed since), giving the
- * first such body (body may be NULL). */
+ * first such body (body may be NULL). A body asleep at the last check with no joint but contacts is not read: a joint
+ * attached to it is found when it wakes (ssKnownTakeJointsDue). */
 int ssKnownJointsChanged(const ssKnownBodies* known, dBodyID* body);
 
 /* Whether body's joints differ from those listed with it, or body is not listed. */
@@ -123,6 +127,10 @@ void ssKnownTakeJointsOf(ssKnownBodies* known, dBodyID body);
 /* Sets the force and torque accumulators of every listed body ODE steps (pushed or awake) to its frame force
  * (with_frame_forces) or to zero; a sleeping body's are left for the step that wakes it. */
 void ssKnownResetAccumulators(const ssKnownBodies* known, int with_frame_forces);
+
+/* Whether a check found a body woken, passed over asleep with no joint, with a joint attached since: the caller then
+ * looks at the joints (ssKnownJointsChanged finds it) before ODE steps it. Cleared by the call. */
+int ssKnownTakeJointsDue(ssKnownBodies* known);
 
 /* The bodies that woke since the last call (known->woken), the list emptied: *count of them, valid until the next
  * check. */
@@ -148,18 +156,20 @@ typedef struct ssBodyBounds {
  * SS_ERROR_BLOWUP (a state not finite), SS_ERROR_POSITION_LIMIT, SS_ERROR_SPEED_LIMIT, SS_ERROR_NOT_FINITE (a force or
  * torque) or SS_ERROR_OUT_OF_RANGE (one beyond SS_MAX_FORCE_N). only_stepped says that nothing but ODE's step ran
  * since the last check (no program code could enable or move a body): then the bodies that check found ODE stepping
- * are read, and the walk from them, not every body (stepped_valid). */
+ * are read, and the walk from them, not every body (stepped_valid). A body found woken that slept with no joint has
+ * its joints read: one attached since sets joints_due (ssKnownTakeJointsDue). */
 ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       const dBodyID* also, int also_count, int only_stepped, dBodyID* failed);
 
-/* Before a frame, one pass: *joints_changed says whether a body's joints changed (then nothing is checked: the caller
- * lists the bodies again and calls again, and the marks and forces read are made again); else the bodies ODE steps are
+/* Before a frame, one pass: *joints_changed says whether a body's joints changed, or a body found woken (marked, or
+ * reached by the walk) has a joint attached while it slept (then nothing is checked: the caller lists the bodies again
+ * and calls again, and the marks and forces read are made again); else the bodies ODE steps are
  * checked as ssKnownCheck with state and forces (also: sleeping bodies the program moved), and, all passing, the
  * accumulators of those it steps become their frame force (pushed marks a force or a carried force). A sleeping body's
  * force waits in its accumulator, as in ODE, and acts in the step that wakes it. sleepers_later: a full check
  * (ssKnownCheck) follows before the first step, after the program's callbacks; the bodies asleep at the last check are
- * then not read here but there (their joints are: what was destroyed must be known first), and one found awake there
- * is started there. Collision reads no sleeping body the program did not move, and those it moved are in also. */
+ * then not read here but there (the joints of those with any are: what was destroyed must be known first), and one
+ * found awake there is started there. Collision reads no sleeping body the program did not move, and those it moved are in also. */
 ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, const dBodyID* also, int also_count,
                            int sleepers_later, dBodyID* failed, int* joints_changed);
 

@@ -817,9 +817,11 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
   ssApplyReport applied;
   for (int i = 0; i < steps; ++i) {
     double previous_step_s = use_history ? stepper->previous_step_s : 0;
-    /* what the last step's callbacks made or destroyed (joints too, where there are callbacks) */
+    /* what the last step's callbacks made or destroyed (joints too, where there are callbacks, or where the last
+     * check woke a body with a joint attached while it slept) */
     int callbacks = def->before_step || def->collide || def->step_done;
-    ssStatus status = i == 0 ? SS_OK : findNew(stepper, callbacks);
+    int joints_due = ssKnownTakeJointsDue(&stepper->known);
+    ssStatus status = i == 0 ? SS_OK : findNew(stepper, callbacks || joints_due);
     /* values the program set in the last step's callbacks */
     if (status == SS_OK && i > 0 && callbacks) status = followProgram(stepper, report, 0);
     if (status != SS_OK) return status;
@@ -862,6 +864,16 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
         ((status = refreshKnown(stepper)) != SS_OK || /* what the callbacks bound or watched */
          (status = checkKnown(stepper, 1, 0, "before", i, steps, step_s, report)) != SS_OK))
       return refuseStep(stepper, status, i);
+    /* the check woke a body with a joint attached while it slept: the joint and what it reaches are adopted and
+     * written for this step, which is the first ODE steps them in, and checked */
+    if (ssKnownTakeJointsDue(&stepper->known)) {
+      if ((status = findNew(stepper, 1)) == SS_OK && stepper->apply_due) {
+        stepper->apply_due = 0;
+        status = apply(stepper, mapping, softness_step_s, previous_step_s, &applied, report);
+      }
+      if (status == SS_OK) status = checkKnown(stepper, 1, 0, "before", i, steps, step_s, report);
+      if (status != SS_OK) return refuseStep(stepper, status, i);
+    }
     if (i == steps - 1 && stepping->cut == SS_CUT_FIXED) ssPoseHistoryBeforeLastStep(stepper->poses);
     if ((status = writeWoken(stepper, softness_step_s, report)) != SS_OK) return refuseStep(stepper, status, i);
     int stepped = odeStep(stepper, step_s);

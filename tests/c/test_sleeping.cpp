@@ -66,7 +66,8 @@ class Sleeping : public OdeTest {
   void Collide(ssStepper*) { dSpaceCollide(space, this, &Near); }
   static void CollideCallback(void* context, ssStepper* stepper) { static_cast<Sleeping*>(context)->Collide(stepper); }
 
-  void Adopt(const char* policy, double max_step_s = 1.0 / 60) {
+  void Adopt(const char* policy, double max_step_s = 1.0 / 60, ssStepDoneCallback* step_done = nullptr,
+             void* step_done_context = nullptr) {
     ssStepperDef def = TestStepperDef();
     def.world = world;
     def.space = space;
@@ -74,9 +75,13 @@ class Sleeping : public OdeTest {
     ASSERT_EQ(ssSteppingForPolicy(policy, def.tuned_step_s, &def.stepping), SS_OK) << ssLastError();
     def.stepping.max_step_s = max_step_s;
     def.stepping.max_step_slack = 0;
-    def.collide = &CollideCallback;
-    def.collide_context = this;
-    def.contact_group = contacts;
+    if (!program_collides) {
+      def.collide = &CollideCallback;
+      def.collide_context = this;
+      def.contact_group = contacts;
+    }
+    def.step_done = step_done;
+    def.step_done_context = step_done_context;
     ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK) << ssLastError();
   }
 
@@ -92,6 +97,7 @@ class Sleeping : public OdeTest {
   }
 
   static constexpr int kBoxes = 20;
+  bool program_collides = false;  // the program collides before each frame, the stepper empties no contacts
   dSpaceID space = nullptr;
   dJointGroupID contacts = nullptr;
   std::vector<dBodyID> boxes;
@@ -266,6 +272,65 @@ TEST_F(Sleeping, ABodyAdoptedAsleepIsWrittenForTheStepWhenItWakes) {
   ASSERT_TRUE(dBodyIsEnabled(boxes[0]));
   ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 120, nullptr), SS_OK) << ssLastError();
   EXPECT_EQ(dBodyGetAutoDisableSteps(boxes[0]), 20);
+}
+
+// A joint the program attaches to a sleeping body with no joint is stepped by ODE only once the body wakes: it is
+// adopted, and written for the step, before that step, whether the program wakes the body or a ball's contact does
+// in ODE's step, and whether the stepper collides or the program does before the frame. (The stepper reads no joints
+// of such a body while it sleeps.)
+TEST_F(Sleeping, AJointAttachedToASleepingBodyIsWrittenBeforeTheStepThatWakesIt) {
+  const double tuned_erp = 0.2, tuned_cfm = 1e-5, tuned_s = 1.0 / 60, step_s = 1.0 / 120;
+  // the stop's spring at the tuned step, as the program set it, at a step of step_s (implicit Euler)
+  const double k = tuned_erp / (tuned_s * tuned_cfm), c = (1 - tuned_erp) / tuned_cfm;
+  const double erp = step_s * k / (step_s * k + c), cfm = 1 / (step_s * k + c);
+  struct Watch {
+    dBodyID body = nullptr;
+    dJointID hinge = nullptr;
+    int steps_awake = 0;
+    double erp = 0, cfm = 0;  // the stop's, after the first step the body was awake for
+  };
+  for (int variant = 0; variant < 4; ++variant) {
+    const bool by_ball = variant % 2 == 1;
+    program_collides = variant >= 2;
+    SCOPED_TRACE(std::string(by_ball ? "woken by a ball's contact" : "woken by the program") +
+                 (program_collides ? ", the program colliding" : ", the stepper colliding"));
+    Watch watch;
+    watch.body = boxes[6 + 2 * variant];
+    Adopt("implicit-euler", step_s,
+          [](void* context, double) {
+            auto* w = static_cast<Watch*>(context);
+            if (!dBodyIsEnabled(w->body) || w->steps_awake++ > 0) return;
+            w->erp = dJointGetHingeParam(w->hinge, dParamStopERP);
+            w->cfm = dJointGetHingeParam(w->hinge, dParamStopCFM);
+          },
+          &watch);
+    auto frame = [&] {
+      if (program_collides) Collide(nullptr);
+      ssStatus status = ssStepper_Step(stepper, step_s, nullptr);
+      if (program_collides) dJointGroupEmpty(contacts);
+      return status;
+    };
+    ASSERT_EQ(frame(), SS_OK) << ssLastError();
+    const dReal* p = dBodyGetPosition(watch.body);
+    watch.hinge = dJointCreateHinge(world, 0);
+    dJointAttach(watch.hinge, watch.body, 0);
+    dJointSetHingeAnchor(watch.hinge, p[0], p[1], p[2]);
+    dJointSetHingeAxis(watch.hinge, 0, 0, 1);
+    dJointSetHingeParam(watch.hinge, dParamLoStop, -0.1);
+    dJointSetHingeParam(watch.hinge, dParamHiStop, 0.1);
+    dJointSetHingeParam(watch.hinge, dParamStopERP, tuned_erp);
+    dJointSetHingeParam(watch.hinge, dParamStopCFM, tuned_cfm);
+    for (int i = 0; i < 3; ++i) ASSERT_EQ(frame(), SS_OK) << ssLastError();
+    ASSERT_EQ(watch.steps_awake, 0);
+    if (by_ball) Ball(p[0], p[1], p[2] + 0.12);
+    else dBodyEnable(watch.body);
+    for (int i = 0; i < 120 && watch.steps_awake == 0; ++i) ASSERT_EQ(frame(), SS_OK) << ssLastError();
+    ASSERT_GT(watch.steps_awake, 0);
+    EXPECT_NEAR(watch.erp, erp, ReadBackTolerance(1e-12, erp));
+    EXPECT_NEAR(watch.cfm, cfm, ReadBackTolerance(1e-12 * cfm, cfm));
+    ssStepper_Destroy(stepper);
+    stepper = nullptr;
+  }
 }
 
 // What the program sets on a sleeping body stays the program's when the body wakes: followed as newly tuned, not
