@@ -663,13 +663,16 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   known->stepped_count = 0;
   known->joints_due = 0; /* every body awake at the last check is read below */
   for (int k = 0; k < count; ++k) {
-    if (k < until) prefetchBody(known, k + kPrefetchAhead, 1), prefetchJoints(known, k + kPrefetchAhead);
-    if (jointsRead(known, k)) changed |= jointsChangedAt(known, k);
+    int ahead = k + kPrefetchAhead;
+    if (k < until && (known->awake[ahead] || !sleepers_later)) /* else at most its joints are read below */
+      prefetchBody(known, ahead, 1), prefetchJoints(known, ahead);
     if (sleepers_later && !known->awake[k]) { /* asleep at the last check: read by the check before the step */
       unseen += known->moves_unseen[k];
-    } else if (markBody(known, k, &unseen)) {
-      all &= startBody(known, k, check.max_speed2, check.max_spin2);
+      if (known->joints[k].count > 0) changed |= jointsChangedAt(known, k);
+      continue;
     }
+    if (jointsRead(known, k)) changed |= jointsChangedAt(known, k);
+    if (markBody(known, k, &unseen)) all &= startBody(known, k, check.max_speed2, check.max_spin2);
   }
   known->stepped_valid = 1;
   known->sleepers_unread = sleepers_later;
