@@ -564,8 +564,10 @@ TEST_F(RegistryTest, EveryBodyBindingChangedSinceTheLastWriteIsWrittenAtTheSameS
   dBodyDisable(sleeper);
   dBodySetLinearDamping(sleeper, 0.5);
   ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, step_s, 0, nullptr), SS_OK);
-  for (dBodyID body : bodies)
-    if (body != sleeper) EXPECT_NEAR(dBodyGetLinearDamping(body), scale(1.0, step_s), tolerance(1.0, step_s));
+  for (dBodyID body : bodies) {
+    if (body == sleeper) continue;
+    EXPECT_NEAR(dBodyGetLinearDamping(body), scale(1.0, step_s), tolerance(1.0, step_s));
+  }
   EXPECT_EQ(dBodyGetLinearDamping(sleeper), 0.5);  // passed over asleep
 
   // woken, with a body bound since: the write at the same step passes the new binding alone
