@@ -154,6 +154,8 @@ static int append(ssKnownBodies* known, dBodyID body) {
   known->joints[k] = jointSignature(body);
   known->awake[k] = 1; /* checked at the next check, whatever ODE does with it */
   known->moves_unseen[k] = !hasGeomIn(body, known->seen_space);
+  known->joined_count += known->joints[k].count > 0;
+  known->unseen_count += known->moves_unseen[k];
   known->reached[k] = 0;
   known->count += 1;
   known->stepped_valid = 0;
@@ -198,6 +200,7 @@ ssStatus ssKnownRebuild(ssKnownBodies* known, const ssRegistry* registry, const 
     int old = placeOf(known, rebuilt.ids[k]);
     if (old < 0) continue;
     rebuilt.bodies[k] = known->bodies[old];
+    rebuilt.joined_count += (known->joints[old].count > 0) - (rebuilt.joints[k].count > 0);
     rebuilt.joints[k] = known->joints[old];
   }
   rebuilt.woken = known->woken, rebuilt.woken_count = known->woken_count; /* still to be written */
@@ -234,6 +237,8 @@ void ssKnownForget(ssKnownBodies* known, dBodyID body) {
   if (k < 0) return;
   int pushed = known->bodies[k].pushed;
   ssPointerMapRemove(&known->index, body);
+  known->joined_count -= known->joints[k].count > 0;
+  known->unseen_count -= known->moves_unseen[k];
   if (k != last) {
     known->bodies[k] = known->bodies[last];
     known->ids[k] = known->ids[last];
@@ -296,7 +301,10 @@ int ssKnownJointsChangedOf(const ssKnownBodies* known, dBodyID body) {
 
 void ssKnownTakeJointsOf(ssKnownBodies* known, dBodyID body) {
   int k = placeOf(known, body);
-  if (k >= 0) known->joints[k] = jointSignature(body);
+  if (k < 0) return;
+  ssJointSignature now = jointSignature(body);
+  known->joined_count += (now.count > 0) - (known->joints[k].count > 0);
+  known->joints[k] = now;
 }
 
 /* A body asleep at the last check with no joint but contacts then has its joints read when it is found awake
@@ -612,6 +620,11 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
     for (int k = 0; k < count; ++k) {
       if (k < until) prefetchBody(known, k + kPrefetchAhead, check.forces);
       int was_awake = known->awake[k];
+      /* asleep at the last check and still (most of a sleeping level): its mark stays, and only its moves count */
+      if (!was_awake && !dBodyIsEnabled(known->ids[k])) {
+        unseen += known->moves_unseen[k];
+        continue;
+      }
       if (!markBody(known, k, &unseen)) continue;
       all &= late_start && !was_awake ? startBody(known, k, check.max_speed2, check.max_spin2)
                                       : bodyWithin(&values[k], check.max_speed2, check.max_spin2, check.forces);
@@ -659,10 +672,22 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   /* one pass reads each body once: its joints (a sleeping body's joint may be destroyed too, so every body's are read
    * before a failure is told, but one that had none: jointsRead), its mark, and the state and forces of what ODE
    * steps. A body found woken here or by the walk has its joints read then (bodyWoke). */
+  /* a level mostly asleep (as the last check found it), where no sleeping body has anything to read (joints besides
+   * contacts, or moves the looks cannot see): the awake ones are found in the marks (memchr); where most are awake,
+   * the pass below asks for each body ahead */
+  const int awake_alone = sleepers_later && known->joined_count == 0 && known->unseen_count == 0 &&
+                          known->stepped_count < count / 4;
   int all = 1, changed = 0, unseen = 0;
   known->stepped_count = 0;
   known->joints_due = 0; /* every body awake at the last check is read below */
-  for (int k = 0; k < count; ++k) {
+  for (int k = 0; awake_alone && k < count; ++k) {
+    const unsigned char* next = memchr(known->awake + k, 1, (size_t)(count - k));
+    if (next == NULL) break;
+    k = (int)(next - known->awake);
+    changed |= jointsChangedAt(known, k);
+    if (markBody(known, k, &unseen)) all &= startBody(known, k, check.max_speed2, check.max_spin2);
+  }
+  for (int k = 0; !awake_alone && k < count; ++k) {
     int ahead = k + kPrefetchAhead;
     if (k < until && (known->awake[ahead] || !sleepers_later)) /* else at most its joints are read below */
       prefetchBody(known, ahead, 1), prefetchJoints(known, ahead);

@@ -79,6 +79,9 @@ typedef struct ssKnownBodies {
   ssPointerMap index; /* body -> its place in the arrays above */
   dSpaceID seen_space; /* the space whose heads the stepper looks at (its def.space, with those nested), or 0 */
   int count, capacity;
+  /* how many are listed with a joint besides contacts, and how many could move unseen: with neither, the frame's
+   * start has nothing to read of a body asleep at the last check (with callbacks), and finds the awake ones alone */
+  int joined_count, unseen_count;
   int* pushed; /* indices into bodies of those with pushed set, and only those */
   int pushed_count;
   int carrying; /* whether any body may carry a force */
