@@ -65,24 +65,27 @@ _Static_assert(offsetof(dSurfaceParameters, soft_cfm) == offsetof(dSurfaceParame
                "soft_erp and soft_cfm are read as one pair");
 static inline int ssContactMemoFits(const ssContactMemo* memo, const dContact* contacts, int count) {
   const __m128i soft_in = _mm_set_epi64x((long long)memo->cfm_in, (long long)memo->erp_in);
-  const __m128i soft_mask = _mm_set_epi64x((long long)memo->cfm_mask, (long long)memo->erp_mask);
-  __m128i soft_differs = _mm_setzero_si128();
-  __m128d sum_xy = _mm_setzero_pd();
-  double sum_z = 0;
-  unsigned mode_differs = 0;
-  for (int i = 0; i < count; ++i) {
-    const dSurfaceParameters* surface = &contacts[i].surface;
-    const dContactGeom* geom = &contacts[i].geom;
+  __m128i soft_differs = _mm_setzero_si128(); /* masked once, after the pass */
+  __m128d pos_normal_xy = _mm_setzero_pd();
+  double pos_z = 0, normal_z = 0, depth = 0;
+  unsigned mode_differs = memo->valid ? 0 : 1; /* a memo not valid fits nothing */
+  for (const dContact *contact = contacts, *end = contacts + count; contact != end; ++contact) {
+    const dSurfaceParameters* surface = &contact->surface;
+    const dContactGeom* geom = &contact->geom;
     __m128i soft = _mm_loadu_si128((const __m128i*)(const void*)&surface->soft_erp);
-    soft_differs = _mm_or_si128(soft_differs, _mm_and_si128(_mm_xor_si128(soft, soft_in), soft_mask));
+    soft_differs = _mm_or_si128(soft_differs, _mm_xor_si128(soft, soft_in));
     mode_differs |= (unsigned)(surface->mode ^ memo->mode_in);
-    sum_xy = _mm_add_pd(sum_xy, _mm_add_pd(_mm_loadu_pd(geom->pos), _mm_loadu_pd(geom->normal)));
-    sum_z += geom->pos[2] + geom->normal[2] + geom->depth;
+    pos_normal_xy = _mm_add_pd(pos_normal_xy, _mm_add_pd(_mm_loadu_pd(geom->pos), _mm_loadu_pd(geom->normal)));
+    pos_z += geom->pos[2];
+    normal_z += geom->normal[2];
+    depth += geom->depth;
   }
-  double sum = _mm_cvtsd_f64(_mm_add_sd(sum_xy, _mm_unpackhi_pd(sum_xy, sum_xy))) + sum_z;
-  soft_differs = _mm_or_si128(soft_differs, _mm_cvtsi32_si128((int)mode_differs));
+  const __m128i soft_mask = _mm_set_epi64x((long long)memo->cfm_mask, (long long)memo->erp_mask);
+  soft_differs = _mm_or_si128(_mm_and_si128(soft_differs, soft_mask), _mm_cvtsi32_si128((int)mode_differs));
   if (_mm_movemask_epi8(_mm_cmpeq_epi32(soft_differs, _mm_setzero_si128())) != 0xffff) return 0;
-  return memo->valid && sum - sum == 0.0;
+  double sum = _mm_cvtsd_f64(_mm_add_sd(pos_normal_xy, _mm_unpackhi_pd(pos_normal_xy, pos_normal_xy))) + pos_z +
+               normal_z + depth;
+  return sum - sum == 0.0;
 }
 #else
 static inline int ssContactMemoFits(const ssContactMemo* memo, const dContact* contacts, int count) {
