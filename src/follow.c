@@ -77,7 +77,7 @@ static ssStatus followRows(ssRegistry* registry, double step_s, FollowedRow** ou
 /* A large world's body binding kPrefetchAhead places on asked for: its body's flags, and the auto-disable and damping
  * numbers ODE 0.16 keeps a few lines past the torque accumulator, torque_at bytes into every body (dxBody: a hint;
  * another layout costs a load). */
-static void prefetchBinding(const ssBodyBinding* binding, ptrdiff_t torque_at) {
+SS_PREFETCH_HELPER void prefetchBinding(const ssBodyBinding* binding, ptrdiff_t torque_at) {
   const char* body = (const char*)binding->body;
   if (body == NULL) return;
   SS_PREFETCH(body);

@@ -263,7 +263,7 @@ void ssKnownForget(ssKnownBodies* known, dBodyID body) {
 }
 
 /* The head of a body's first joint (where ODE keeps its joint list): what dBodyGetJoint reads beyond the body. */
-static void prefetchJoints(const ssKnownBodies* known, int k) {
+SS_PREFETCH_HELPER void prefetchJoints(const ssKnownBodies* known, int k) {
   const char* joint = (const char*)known->joints[k].first;
   if (joint != NULL) SS_PREFETCH(joint), SS_PREFETCH(joint + 64);
 }
@@ -423,7 +423,7 @@ static int forcesWithin(const ssBodyValues* v) {
   return (f > t ? f : t) <= magnitudeBits(SS_MAX_FORCE_N);
 }
 
-static void prefetchState(const ssBodyValues* v) {
+SS_PREFETCH_HELPER void prefetchState(const ssBodyValues* v) {
   SS_PREFETCH(v->position);
   SS_PREFETCH(v->linear_vel);
   SS_PREFETCH(v->angular_vel);
@@ -524,7 +524,7 @@ static inline int markBody(ssKnownBodies* known, int k, int* unseen) {
 }
 
 /* A large world's next body asked for: the flags and joints at its head, and, awake, the values a pass reads. */
-static void prefetchBody(const ssKnownBodies* known, int k, int forces) {
+SS_PREFETCH_HELPER void prefetchBody(const ssKnownBodies* known, int k, int forces) {
   const ssBodyValues* v = &known->values[k];
   SS_PREFETCH(known->ids[k]);
   if (!known->awake[k]) return; /* asleep at the last check: most likely its values are not read */
