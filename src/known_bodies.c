@@ -447,10 +447,9 @@ static int bodyWithin(const ssBodyValues* v, double max_speed2, double max_spin2
   return stateWithin(v, max_speed2, max_spin2) & (!forces || forcesWithin(v));
 }
 
-/* A body found awake that was asleep, kept for ssKnownTakeWoken (out of memory: not kept; its numbers are written at
- * the next change of step, as before it woke). */
-/* Body k found woken, by the program or by ODE through a joint: noted for its write, and its joints read when they
- * were passed over while it slept (jointsRead). */
+/* Body k found woken, by the program or by ODE through a joint: kept for ssKnownTakeWoken (out of memory: not kept;
+ * its numbers are written at the next change of step, as before it woke), and its joints read when they were passed
+ * over while it slept (jointsRead). */
 static void bodyWoke(ssKnownBodies* known, int k) {
   if (ssReserveOne((void**)&known->woken, known->woken_count, &known->woken_capacity, sizeof *known->woken))
     known->woken[known->woken_count++] = known->ids[k];

@@ -172,7 +172,8 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
  * force waits in its accumulator, as in ODE, and acts in the step that wakes it. sleepers_later: a full check
  * (ssKnownCheck) follows before the first step, after the program's callbacks; the bodies asleep at the last check are
  * then not read here but there (the joints of those with any are: what was destroyed must be known first), and one
- * found awake there is started there. Collision reads no sleeping body the program did not move, and those it moved are in also. */
+ * found awake there is started there. Collision reads no sleeping body the program did not move, and those it moved
+ * are in also. */
 ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, const dBodyID* also, int also_count,
                            int sleepers_later, dBodyID* failed, int* joints_changed);
 

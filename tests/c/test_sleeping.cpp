@@ -99,8 +99,8 @@ class Sleeping : public OdeTest {
   }
 
   static constexpr int kBoxes = 20;
-  bool program_collides = false;
-  ssRegistry* registry = nullptr;  // the stepper's own when none is given  // the program collides before each frame, the stepper empties no contacts
+  bool program_collides = false;  // the program collides before each frame, the stepper empties no contacts
+  ssRegistry* registry = nullptr;  // the stepper's own when none is given
   dSpaceID space = nullptr;
   dJointGroupID contacts = nullptr;
   std::vector<dBodyID> boxes;
