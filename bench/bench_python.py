@@ -8,7 +8,7 @@ what another process does to the machine is not counted), with the load average 
    own loop, for both bindings: PyODE (examples/pyode_vehicle.py: a vehicle among 50 crates, PyODE's near callback
    in its own loop) and odepy (50 crates on the ground, odepy's near callback). Adopted, its contacts are made by a
    ContactRule in C (target: at most 1.05 of its own loop), or kept in its near callback with one soften_contact a
-   contact (for comparison). Each variant is checked bit for bit against its own loop first; interleaved repeats.
+   contact, or (odepy, whose dCollide fills an array) one soften_contacts a pair (for comparison). Each variant is checked bit for bit against its own loop first; interleaved repeats.
 3. The lab from Python: the pile scene driven frame by frame from Python (ssScene_Frame through cffi, one sample per
    frame) against the same run driven from C in one call (ssRun_Execute, one record per step): the ratio Python /
    C (target: at most 1.05 for 500 bodies or more). Scene building is counted on both sides (a few ms).
@@ -151,6 +151,7 @@ class OdepyProgram:
     README (dCollide, bounce 0.2, mu 5000, dJointCreateContact in a joint group emptied after each step)."""
 
     name = "odepy (50 crates on the ground)"
+    variants = ("own", "rule", "near", "pair")
 
     def __init__(self):
         import odepy
@@ -195,7 +196,19 @@ class OdepyProgram:
                     stepper.soften_contact(contact, b1, b2)
                 odepy.dJointAttach(odepy.dJointCreateContact(world, group, ctypes.byref(contact)), b1, b2)
 
-        callback = odepy.dNearCallback(near)
+        def near_by_pair(data, g1, g2):  # the same contacts, softened with one soften_contacts a pair
+            count = odepy.dCollide(g1, g2, 150, ctypes.byref(contacts[0].geom), size)
+            b1, b2 = odepy.dGeomGetBody(g1), odepy.dGeomGetBody(g2)
+            for i in range(count):
+                contact = contacts[i]
+                contact.surface.mode = odepy.dContactBounce
+                contact.surface.mu = 5000.0
+                contact.surface.bounce = 0.2
+            stepper.soften_contacts(contacts, count)
+            for i in range(count):
+                odepy.dJointAttach(odepy.dJointCreateContact(world, group, ctypes.byref(contacts[i])), b1, b2)
+
+        callback = odepy.dNearCallback(near_by_pair if variant == "pair" else near)
         made["callback"] = callback
         if variant == "own":
             def frame(frame_s):
@@ -251,10 +264,10 @@ def _contact_run(program, variant: str) -> tuple[float, bytes, int]:
 
 def contacts_at_the_cost_of_c() -> int:
     """Prints part 2; 1 when an adopted variant is not its own loop to the bit."""
-    variants = ("own", "rule", "near")
     print(f"contacts at the cost of C: {CONTACT_FRAMES} frames of {FRAME_S * 1e3:.2f} ms under naive, "
           f"{CONTACT_REPEATS} interleaved repeats, medians ({machine()}):")
     for program in (PyodeProgram(), OdepyProgram()):
+        variants = getattr(program, "variants", ("own", "rule", "near"))
         times = {variant: [] for variant in variants}
         contacts = 0
         for _ in range(CONTACT_REPEATS):
@@ -272,7 +285,10 @@ def contacts_at_the_cost_of_c() -> int:
         print(f"  {program.name}: {contacts / CONTACT_FRAMES:.0f} contacts a step, bit for bit its own loop")
         print(f"    own loop (its near callback)                   {own / CONTACT_FRAMES * 1e3:7.3f} ms a frame")
         for variant, label in (("rule", "adopted, ContactRule (contacts in C)"),
-                               ("near", "adopted, soften_contact in its near callback")):
+                               ("near", "adopted, soften_contact in its near callback"),
+                               ("pair", "adopted, soften_contacts a pair (odepy)")):
+            if variant not in variants:
+                continue
             ratios = [a / b for a, b in zip(times[variant], times["own"])]
             print(f"    {label:<46} {statistics.median(times[variant]) / CONTACT_FRAMES * 1e3:7.3f} ms a frame, "
                   f"ratio {statistics.median(ratios):.3f} (range {min(ratios):.3f}-{max(ratios):.3f})"

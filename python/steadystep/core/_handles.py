@@ -89,6 +89,24 @@ def handle(name: str, kind: str, value, checked: bool = True):
     return ffi.cast(_C_TYPES[kind], address(name, kind, value, checked))
 
 
+def contacts(name: str, value, count: int):
+    """count ODE dContacts in a row as the library's `dContact*`: an odepy dContact array (ctypes, at least count
+    long), or what contact() takes for the first of them (an odepy dContact, a pointer, an address; a PyODE Contact
+    only for count <= 1: PyODE keeps each contact in an object of its own)."""
+    if isinstance(value, ctypes.Array):
+        element = value._type_.__name__
+        if element != "dContact":
+            raise _wrong(name, "contact", value, f"an array of {element}, not of dContact")
+        if count > len(value):
+            raise SteadystepError(Status.OUT_OF_RANGE,
+                                  f"count = {count}: more than the {len(value)} contacts of {name}")
+        return ffi.cast("dContact*", ctypes.addressof(value))
+    if count > 1 and (pyode.FAMILY.get(type(value)) == "contact" or pyode.is_pyode(value)):
+        raise SteadystepError(Status.OUT_OF_RANGE, f"{name} = {shown(value)}: a PyODE Contact holds one contact, not "
+                              f"count = {count} in a row; soften each with soften_contact")
+    return contact(name, value)
+
+
 def contact(name: str, value):
     """An ODE dContact as the library's `dContact*`: an odepy dContact (a ctypes Structure, by its address), a
     ctypes pointer to one, a PyODE Contact (the dContact it holds), or an integer address; None or 0 is NULL
