@@ -151,3 +151,18 @@ def test_no_contacts_is_nothing_to_do_and_a_wrong_array_is_refused(adopted):
         stepper.soften_contacts((ctypes.c_double * 4)(), 1)
     with pytest.raises(ss.SteadystepError, match="contacts = NULL with count = 1"):
         stepper.soften_contacts(None, 1)
+
+
+def test_a_pyode_contact_is_one_contact(adopted):
+    ode = pytest.importorskip("ode")
+    stepper = adopted[3]
+    contact = ode.Contact()
+    contact.setMode(ode.ContactSoftERP | ode.ContactSoftCFM)
+    contact.setSoftERP(0.2)
+    contact.setSoftCFM(1e-5)
+    with pytest.raises(ss.SteadystepError, match="a PyODE Contact holds one contact, not count = 2"):
+        stepper.soften_contacts(contact, 2)
+    assert contact.getSoftERP() == 0.2
+    stepper.soften_contacts(contact, 1)
+    k, c = 0.2 / (1 / 60 * 1e-5), (1 - 0.2) / 1e-5
+    assert math.isclose(contact.getSoftERP(), k / 120 / (k / 120 + c), rel_tol=1e-12)
