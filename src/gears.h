@@ -9,10 +9,15 @@
 /* Whether a transmission joint gears the body. */
 int ssGeared(dBodyID body);
 
-/* How far a geared body turns its gear in a step of step_s (rad): its spin, and its speed over the gear's radius (a
- * gear moved sideways by its radius turns the point where the gears mesh as far as a turn of one radian would). The
- * largest over its transmission joints. */
+/* How far a geared body turns its gear in a step of step_s (rad): its spin, its speed over the gear's radius (a
+ * gear moved sideways by its radius turns the point where the gears mesh as far as a turn of one radian would), and
+ * the swing of the line between the joint's two anchors as they move apart or past each other (pi once they may
+ * pass: ODE measures the phase towards the mesh, between them). The largest over its transmission joints. */
 double ssGearTurn(dBodyID body, double step_s);
+
+/* ssGearTurn at the spin and speed the body may reach by the end of the step: its accumulated torque and force (what
+ * ODE applies in the step) added over step_s, the torque over the smallest principal moment of its inertia. */
+double ssGearTurnInStep(dBodyID body, double step_s);
 
 /* Makes ODE measure every transmission joint on these bodies afresh at its next step: the gears' current angles
  * become their phase 0, and the phase error between them is forgotten. For after a failure: the step that ran away

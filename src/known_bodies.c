@@ -647,8 +647,9 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
     char named[64];
     *failed = body;
     namedStep(named, when, step, steps);
-    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: turns its transmission gear %g rad in a step of %g s %s (spin, and "
-                  "speed over the gear's radius): above SS_MAX_GEAR_TURN_RAD = %g rad (ODE 0.16 aborts from pi)",
+    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: turns its transmission gear %g rad in a step of %g s %s (spin, "
+                  "speed over the gear's radius, and the swing of the line between the gears' anchors): above "
+                  "SS_MAX_GEAR_TURN_RAD = %g rad (ODE 0.16 aborts from pi)",
                   (void*)body, turn, bounds->gear_step_s, named, SS_MAX_GEAR_TURN_RAD);
   }
   return SS_OK;

@@ -166,7 +166,9 @@
  *  < M_PI`, transmission.cpp) when a gear turns by pi or more between two steps: at 1/60 s that is 188 rad/s, far
  *  inside the speed guard. A stepper refuses the step (SS_ERROR_SPEED_LIMIT, named) once a geared body spins faster
  *  than this turn per step, before and after every step, with half of ODE's edge as the margin for the step that
- *  follows. What no spin shows (a step that failed a check, a rotation the program sets) is made good by
+ *  follows; the turn counts the spin and the sliding the body's force and torque can add in the step, and the swing
+ *  of the line between the gears' anchors when they move relative to each other (ODE measures the phase towards the
+ *  mesh between them: anchors that may pass each other in a step turn it by pi). What no spin shows (a step that failed a check, a rotation the program sets) is made good by
  *  ssStepper_Reset, which has ODE measure the gears afresh. */
 #define SS_MAX_GEAR_TURN_RAD 1.5707963267948966
 
