@@ -599,6 +599,26 @@ static int startBody(ssKnownBodies* known, int k, double max_speed2, double max_
   return 1;
 }
 
+/* Every geared body's turn in a step of step_s within SS_MAX_GEAR_TURN_RAD: at the spin and speed it has, or with
+ * with_forces at those its force and torque can give it in the step (ssGearTurnInStep). */
+static ssStatus checkGears(const ssKnownBodies* known, double step_s, int with_forces, const char* when, int step,
+                           int steps, dBodyID* failed) {
+  for (int g = 0; g < known->geared_count; ++g) {
+    dBodyID body = known->geared[g];
+    double turn = with_forces ? ssGearTurnInStep(body, step_s) : ssGearTurn(body, step_s);
+    if (turn <= SS_MAX_GEAR_TURN_RAD) continue;
+    char named[64];
+    *failed = body;
+    namedStep(named, when, step, steps);
+    /* within the 256 bytes of ssLastError; why pi/2 is in limits.h */
+    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p turns its transmission gear %g rad in a step of %g s %s: above "
+                  "SS_MAX_GEAR_TURN_RAD = %g rad (spin, speed%s, and the swing of the line between the gears' anchors)",
+                  (void*)body, turn, step_s, named, SS_MAX_GEAR_TURN_RAD,
+                  with_forces ? " with its force and torque" : "");
+  }
+  return SS_OK;
+}
+
 ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       const dBodyID* also, int also_count, int only_stepped, dBodyID* failed) {
   CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed,
@@ -640,19 +660,11 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
     int k = meetAlso(known, also[a]);
     if (k >= 0 && !checkVisit(known, k, &check)) return nameFailure(known, k, &named, when, step, steps, failed);
   }
-  for (int g = 0; g < known->geared_count && bounds->gear_step_s > 0; ++g) {
-    dBodyID body = known->geared[g];
-    double turn = ssGearTurn(body, bounds->gear_step_s);
-    if (turn <= SS_MAX_GEAR_TURN_RAD) continue;
-    char named[64];
-    *failed = body;
-    namedStep(named, when, step, steps);
-    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: turns its transmission gear %g rad in a step of %g s %s (spin, "
-                  "speed over the gear's radius, and the swing of the line between the gears' anchors): above "
-                  "SS_MAX_GEAR_TURN_RAD = %g rad (ODE 0.16 aborts from pi)",
-                  (void*)body, turn, bounds->gear_step_s, named, SS_MAX_GEAR_TURN_RAD);
-  }
-  return SS_OK;
+  return bounds->gear_step_s > 0 ? checkGears(known, bounds->gear_step_s, 0, when, step, steps, failed) : SS_OK;
+}
+
+ssStatus ssKnownCheckGearsInStep(const ssKnownBodies* known, double step_s, int step, int steps, dBodyID* failed) {
+  return checkGears(known, step_s, 1, "before", step, steps, failed);
 }
 
 static int startVisit(ssKnownBodies* known, int k, void* context) {

@@ -164,6 +164,11 @@ typedef struct ssBodyBounds {
 ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       const dBodyID* also, int also_count, int only_stepped, dBodyID* failed);
 
+/* Just before ODE's step `step` of `steps`, of step_s, with its forces in the accumulators: every geared body's
+ * turn within SS_MAX_GEAR_TURN_RAD at the spin and speed its force and torque can give it in the step (the checks
+ * bound it at the spin it has). On the first failure sets *failed and returns SS_ERROR_SPEED_LIMIT, named. */
+ssStatus ssKnownCheckGearsInStep(const ssKnownBodies* known, double step_s, int step, int steps, dBodyID* failed);
+
 /* Before a frame, one pass: *joints_changed says whether a body's joints changed, or a body found woken (marked, or
  * reached by the walk) has a joint attached while it slept (then nothing is checked: the caller lists the bodies again
  * and calls again, and the marks and forces read are made again); else the bodies ODE steps are

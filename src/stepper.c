@@ -728,21 +728,12 @@ static ssStatus checkKnown(ssStepper* stepper, int forces, int only_stepped, con
   return status;
 }
 
-/* Before ODE's step, with its forces in the accumulators: no geared body may turn its gear past SS_MAX_GEAR_TURN_RAD
- * with the spin and speed those forces can give it in the step (ODE 0.16 aborts from pi; the checks bound the turn
- * at the spin a body has). */
+/* Before ODE's step, with its forces in the accumulators: the geared bodies' turn (ssKnownCheckGearsInStep). */
 static ssStatus checkGearsInStep(ssStepper* stepper, double step_s, int index, int steps, ssFrameReport* report) {
-  const ssKnownBodies* known = &stepper->known;
-  for (int g = 0; g < known->geared_count; ++g) {
-    dBodyID body = known->geared[g];
-    double turn = ssGearTurnInStep(body, step_s);
-    if (turn <= SS_MAX_GEAR_TURN_RAD) continue;
-    report->failed_body = body;
-    return ssFail(SS_ERROR_SPEED_LIMIT, "body %p: turns its transmission gear up to %g rad in a step of %g s with "
-                  "its force and torque (step %d of %d): above SS_MAX_GEAR_TURN_RAD = %g rad (ODE 0.16 aborts from pi)",
-                  (void*)body, turn, step_s, index + 1, steps, SS_MAX_GEAR_TURN_RAD);
-  }
-  return SS_OK;
+  dBodyID failed = 0;
+  ssStatus status = ssKnownCheckGearsInStep(&stepper->known, step_s, index + 1, steps, &failed);
+  if (status != SS_OK) report->failed_body = failed;
+  return status;
 }
 
 /* The registry's Apply for a step; *applied says who served the rows (counted for every step they serve). */
