@@ -22,7 +22,8 @@ typedef uint32_t ssRealBits;
 #endif
 
 typedef struct ssContactMemo {
-  int valid; /* 0 from the start of every step: the step's length, the mapping or the tuned world changed */
+  unsigned stale; /* 1 from the start of every step (the step's length, the mapping or the tuned world changed): fits
+                   * nothing; 0 once a contact is taken */
   int mode_in, mode_out;
   ssRealBits erp_in, cfm_in;     /* the given soft_erp and soft_cfm, as bits */
   ssRealBits erp_mask, cfm_mask; /* all ones where mode_in uses the value, 0 where any value is the same surface */
@@ -40,7 +41,7 @@ static inline ssRealBits ssBitsOf(dReal value) {
 /* The memo of a contact given with surface `given` and softened to `written`, counted in *counter. */
 static inline void ssContactMemoTake(ssContactMemo* memo, const dSurfaceParameters* given,
                                      const dSurfaceParameters* written, int* counter) {
-  *memo = (ssContactMemo){.valid = 1,
+  *memo = (ssContactMemo){.stale = 0,
                           .mode_in = given->mode,
                           .mode_out = written->mode,
                           .erp_in = ssBitsOf(given->soft_erp),
@@ -68,7 +69,7 @@ static inline int ssContactMemoFits(const ssContactMemo* memo, const dContact* c
   __m128i soft_differs = _mm_setzero_si128(); /* masked once, after the pass */
   __m128d pos_normal_xy = _mm_setzero_pd();
   double pos_z = 0, normal_z = 0, depth = 0;
-  unsigned mode_differs = memo->valid ? 0 : 1; /* a memo not valid fits nothing */
+  unsigned mode_differs = memo->stale;
   for (const dContact *contact = contacts, *end = contacts + count; contact != end; ++contact) {
     const dSurfaceParameters* surface = &contact->surface;
     const dContactGeom* geom = &contact->geom;
@@ -82,10 +83,12 @@ static inline int ssContactMemoFits(const ssContactMemo* memo, const dContact* c
   }
   const __m128i soft_mask = _mm_set_epi64x((long long)memo->cfm_mask, (long long)memo->erp_mask);
   soft_differs = _mm_or_si128(_mm_and_si128(soft_differs, soft_mask), _mm_cvtsi32_si128((int)mode_differs));
-  if (_mm_movemask_epi8(_mm_cmpeq_epi32(soft_differs, _mm_setzero_si128())) != 0xffff) return 0;
-  double sum = _mm_cvtsd_f64(_mm_add_sd(pos_normal_xy, _mm_unpackhi_pd(pos_normal_xy, pos_normal_xy))) + pos_z +
-               normal_z + depth;
-  return sum - sum == 0.0;
+  const __m128i same = _mm_cmpeq_epi32(soft_differs, _mm_setzero_si128());
+  /* every sum in both lanes; x - x is 0 where x is finite and NaN where it is not, and only NaN is unordered */
+  const __m128d sums = _mm_add_pd(pos_normal_xy, _mm_set1_pd(pos_z + normal_z + depth));
+  const __m128d zero_if_finite = _mm_sub_pd(sums, sums);
+  const __m128d finite = _mm_cmpord_pd(zero_if_finite, zero_if_finite);
+  return _mm_movemask_epi8(_mm_and_si128(same, _mm_castpd_si128(finite))) == 0xffff;
 }
 #else
 static inline int ssContactMemoFits(const ssContactMemo* memo, const dContact* contacts, int count) {
@@ -100,7 +103,7 @@ static inline int ssContactMemoFits(const ssContactMemo* memo, const dContact* c
     sum += (double)geom->depth + geom->pos[0] + geom->pos[1] + geom->pos[2] + geom->normal[0] + geom->normal[1] +
            geom->normal[2];
   }
-  return memo->valid & (differs == 0) & (sum - sum == 0.0);
+  return !memo->stale & (differs == 0) & (sum - sum == 0.0);
 }
 #endif
 
@@ -112,7 +115,7 @@ static inline int ssContactMemoFitsOne(const ssContactMemo* memo, const dContact
                        ((ssBitsOf(surface->soft_cfm) ^ memo->cfm_in) & memo->cfm_mask);
   double sum = (double)geom->depth + geom->pos[0] + geom->pos[1] + geom->pos[2] + geom->normal[0] + geom->normal[1] +
                geom->normal[2];
-  return memo->valid & (surface->mode == memo->mode_in) & (differs == 0) & (sum - sum == 0.0);
+  return !memo->stale & (surface->mode == memo->mode_in) & (differs == 0) & (sum - sum == 0.0);
 }
 
 /* Writes the memo's softness into contacts[count], which fit it. */

@@ -120,7 +120,7 @@ static void describeNextStep(ssStepper* stepper) {
   if (step_s == 0) step_s = stepping->cut == SS_CUT_FIXED ? stepping->max_step_s : stepping->fixed_step_s;
   stepper->current = (ssStepInfo){stepping->mapping, step_s,           softnessStep(stepping, step_s),
                                    stepper->previous_step_s, 0, 1, stepper->time_s};
-  stepper->contact_memo.valid = 0;
+  stepper->contact_memo.stale = 1;
   stepper->contacts_outside_frames = 0; /* read by nobody: kept from growing without end */
 }
 
@@ -479,8 +479,7 @@ static SS_OUT_OF_LINE ssStatus softenContactsSlowly(ssStepper* stepper, dContact
 }
 
 ssStatus ssStepper_SoftenContacts(ssStepper* stepper, dContact* contacts, int count) {
-  int usual = stepper != NULL && contacts != NULL && count > 0;
-  if (!usual || !ssContactMemoFits(&stepper->contact_memo, contacts, count))
+  if (stepper == NULL || count <= 0 || contacts == NULL || !ssContactMemoFits(&stepper->contact_memo, contacts, count))
     return count == 0 && stepper != NULL ? SS_OK : softenContactsSlowly(stepper, contacts, count);
   ssContactMemoWrite(&stepper->contact_memo, contacts, count);
   *stepper->contact_memo.counter += count;
@@ -840,7 +839,7 @@ static ssStatus takeSteps(ssStepper* stepper, int steps, double step_s, double c
         return status;
     }
     stepper->current = (ssStepInfo){mapping, step_s, softness_step_s, previous_step_s, i, steps, stepper->time_s};
-    stepper->contact_memo.valid = 0;
+    stepper->contact_memo.stale = 1;
     if (def->before_step) def->before_step(def->before_step_context, stepper);
     /* what before_step destroyed with ODE's own calls is forgotten before anything reads it */
     if (def->before_step && !stepper->destroy_requested && (status = forgetDestroyed(stepper, 1)) != SS_OK)

@@ -427,6 +427,36 @@ TEST_F(PromiseTest, ABatchWithOneBadContactIsRefusedByNameAndLeftAsGiven) {
   EXPECT_EQ(ssStepper_SoftenContacts(stepper, batch, 4), SS_OK) << ssLastError();
 }
 
+// Every value of a contact's geometry (its position's and normal's x, y and z, its depth), at every place in a batch
+// whose surface is the last one softened, refused by name when it is NaN or either infinity: the check that serves
+// such a batch sums them, and a sum of finite values is what it takes as finite.
+TEST_F(PromiseTest, ABatchWithAnyGeometryValueNotFiniteIsRefusedAndLeftAsGiven) {
+  ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
+  dContact batch[4];
+  std::memset(batch, 0, sizeof batch);
+  for (dContact& c : batch) {
+    c.geom.pos[0] = 0.25, c.geom.pos[1] = -0.5, c.geom.normal[2] = 1, c.geom.depth = 0.001;
+    c.surface.mode = dContactSoftCFM, c.surface.soft_cfm = 1e-4;
+  }
+  const double bad[] = {NAN, INFINITY, -INFINITY};
+  const char* names[] = {"position", "position", "position", "normal", "normal", "normal", "depth"};
+  for (int place = 0; place < 4; ++place)
+    for (int value = 0; value < 7; ++value)
+      for (double b : bad) {
+        ASSERT_EQ(ssStepper_SoftenContacts(stepper, batch, 4), SS_OK) << ssLastError();  // the memo is this surface
+        dContact given[4];
+        std::memcpy(given, batch, sizeof batch);
+        dContactGeom& geom = given[place].geom;
+        (value < 3 ? geom.pos[value] : value < 6 ? geom.normal[value - 3] : geom.depth) = b;
+        dContact before[4];
+        std::memcpy(before, given, sizeof given);
+        EXPECT_EQ(ssStepper_SoftenContacts(stepper, given, 4), SS_ERROR_NOT_FINITE)
+            << "contact " << place << ", value " << value << " = " << b;
+        EXPECT_TRUE(Names(names[value])) << ssLastError();
+        EXPECT_EQ(std::memcmp(before, given, sizeof given), 0);
+      }
+}
+
 TEST_F(PromiseTest, ABatchRefusesANullStepperANullArrayAndANegativeCount) {
   ASSERT_EQ(Make(Def()), SS_OK) << ssLastError();
   dContact contact;
