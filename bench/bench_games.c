@@ -78,6 +78,21 @@ static void collide(void* context, ssStepper* stepper) {
   collideAll(context);
 }
 
+/* A projectile made age_s ago at the spawning's place for game->frame, fired up at 10 m/s: where and how fast it is
+ * now (up for two seconds: gone before it lands). */
+static dBodyID makeProjectile(Game* game, double age_s) {
+  const double launch_mps = 10.0, gravity_mps2 = 9.81;
+  dBodyID body = dBodyCreate(game->world);
+  dMass mass;
+  dMassSetSphereTotal(&mass, 0.2, 0.1);
+  dBodySetMass(body, &mass);
+  dBodySetPosition(body, -5.0 - (double)(game->frame % 7), -5.0,
+                   1.0 + (launch_mps - 0.5 * gravity_mps2 * age_s) * age_s);
+  dBodySetLinearVel(body, 0, 0, launch_mps - gravity_mps2 * age_s);
+  dGeomSetBody(dCreateSphere(game->space, 0.1), body);
+  return body;
+}
+
 /* boxes of 0.5 m on a square grid 1 m apart, resting on the plane z = 0; chunked: in hash spaces of kChunk boxes */
 static Game* build(int boxes, int asleep, int spawning, int chunked, const char* policy) {
   Game* game = calloc(1, sizeof *game);
@@ -107,6 +122,9 @@ static Game* build(int boxes, int asleep, int spawning, int chunked, const char*
     dWorldQuickStep(game->world, kFrame_s);
     dJointGroupEmpty(game->contacts);
   }
+  /* spawning: the projectiles of the last kLifetime frames in flight, so that every frame measured destroys one */
+  for (int slot = 0; spawning && slot < kLifetime; ++slot, ++game->frame)
+    game->projectiles[slot] = makeProjectile(game, (kLifetime - slot) * kFrame_s);
   if (policy == NULL) return game;
   ssStepperDef def = ssDefaultStepperDef();
   def.world = game->world;
@@ -131,14 +149,7 @@ static void spawnAndDespawn(Game* game) {
     if (game->stepper != NULL) check(ssStepper_DestroyBody(game->stepper, old), "destroy body");
     else dBodyDestroy(old);
   }
-  dBodyID body = dBodyCreate(game->world);
-  dMass mass;
-  dMassSetSphereTotal(&mass, 0.2, 0.1);
-  dBodySetMass(body, &mass);
-  dBodySetPosition(body, -5.0 - (double)(game->frame % 7), -5.0, 1.0);
-  dBodySetLinearVel(body, 0, 0, 10.0); /* up for two seconds: gone before it lands */
-  dGeomSetBody(dCreateSphere(game->space, 0.1), body);
-  game->projectiles[slot] = body;
+  game->projectiles[slot] = makeProjectile(game, 0);
   game->frame += 1;
 }
 
