@@ -99,13 +99,14 @@ ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone) {
  * listed (a new nested space, a static geom moved or added, the marker moved), -1 when out of memory. *added counts
  * the geoms of the bodies met that the listing does not account for. */
 static int walkHead(ssSeenSpaces* seen, ssSeenSpace* space, ssBodyList* found, ssBodyList* moved, long* added) {
+  const dGeomID marker_geom = space->head_count >= 2 ? space->head[0] : 0;
   for (int i = 0, geoms = dSpaceGetNumGeoms(space->space); i < geoms; ++i) {
     dGeomID geom = dSpaceGetGeom(space->space, i);
     /* what lies behind the marker was there at the mark, unless it moved: then another follows it. The marker's own
      * move does not show when it was first already, so its body is taken as moved too */
-    int marker = geom == space->marker;
-    if (marker && (space->after_marker != (i + 1 < geoms ? dSpaceGetGeom(space->space, i + 1) : 0) ||
-                   space->marker_body != dGeomGetBody(geom)))
+    int marker = geom == marker_geom;
+    if (marker && (space->head[1] != (i + 1 < geoms ? dSpaceGetGeom(space->space, i + 1) : 0) ||
+                   space->head_bodies[0] != dGeomGetBody(geom)))
       return 0;
     if (dGeomIsSpace(geom)) {
       if (!spaceListed(seen, (dSpaceID)geom)) return 0;
@@ -123,7 +124,7 @@ static int walkHead(ssSeenSpaces* seen, ssSeenSpace* space, ssBodyList* found, s
     }
     if (marker) return 1;
   }
-  return space->marker == 0; /* a marker not met was destroyed (or taken out of the space) */
+  return marker_geom == 0; /* a marker not met was destroyed (or taken out of the space) */
 }
 
 int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved) {
@@ -144,17 +145,31 @@ void ssSeenMark(ssSeenSpaces* seen) {
   for (int s = 0; s < seen->count; ++s) {
     ssSeenSpace* space = &seen->spaces[s];
     if (space->sweep_and_prune) continue; /* listed at every look */
-    int geoms = dSpaceGetNumGeoms(space->space);
-    space->marker = geoms > 0 ? dSpaceGetGeom(space->space, 0) : 0;
-    space->after_marker = geoms > 1 ? dSpaceGetGeom(space->space, 1) : 0;
-    space->marker_body = space->marker != 0 && !dGeomIsSpace(space->marker) ? dGeomGetBody(space->marker) : 0;
+    /* the first geoms, and a 0 after the last when the list ends within SS_SEEN_HEAD */
+    const int geoms = dSpaceGetNumGeoms(space->space), kept = geoms < SS_SEEN_HEAD ? geoms + 1 : SS_SEEN_HEAD;
+    for (int i = 0; i < kept; ++i) {
+      dGeomID geom = i < geoms ? dSpaceGetGeom(space->space, i) : 0;
+      space->head[i] = geom;
+      space->head_bodies[i] = geom != 0 && !dGeomIsSpace(geom) ? dGeomGetBody(geom) : 0;
+    }
+    space->head_count = kept;
   }
 }
 
 void ssSeenForget(ssSeenSpaces* seen, dBodyID body) {
-  /* a marker of the body's may be destroyed before the next look meets it: that space's next look walks it whole */
-  for (int s = 0; s < seen->count; ++s)
-    if (seen->spaces[s].marker_body == body) seen->spaces[s].marker = seen->spaces[s].after_marker = 0;
+  /* the body's geoms leave each head, destroyed before or after: the geoms kept behind them follow each other, so
+   * the first left is a marker, with the one behind it (a geom of the body still there shows as static and is
+   * listed) */
+  for (int s = 0; s < seen->count; ++s) {
+    ssSeenSpace* space = &seen->spaces[s];
+    int kept = 0;
+    for (int i = 0; i < space->head_count; ++i) {
+      if (space->head[i] != 0 && space->head_bodies[i] == body) continue;
+      space->head[kept] = space->head[i];
+      space->head_bodies[kept++] = space->head_bodies[i];
+    }
+    space->head_count = kept;
+  }
   int held = ssPointerMapGet(&seen->bodies, body, 0);
   if (held == 0) return;
   seen->geoms -= held;

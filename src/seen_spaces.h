@@ -22,11 +22,17 @@ typedef struct ssBodyList {
   int count, capacity;
 } ssBodyList;
 
+/* How many of a space's first geoms a mark keeps: a program destroys what is oldest, and ODE steps the newest body
+ * first, so the first geoms after a step are those most often destroyed before the next (ssSeenForget). */
+enum { SS_SEEN_HEAD = 8 };
+
 typedef struct ssSeenSpace {
   dSpaceID space;
-  dGeomID marker;       /* the first geom after the last step; 0: none (the whole list is head) */
-  dGeomID after_marker; /* the geom behind it then: the marker moved since when another follows it */
-  dBodyID marker_body;  /* the marker's body then (0: static, or a nested space) */
+  /* the first geoms after the last step, less those whose bodies the stepper destroyed since: head[0] is the marker
+   * and head[1] the geom behind it (0: none, the list ended there), by which a marker that moved since shows */
+  dGeomID head[SS_SEEN_HEAD];
+  dBodyID head_bodies[SS_SEEN_HEAD]; /* their bodies then (0: static, or a nested space) */
+  int head_count;                    /* under 2: no marker (the whole list is head) */
   int sweep_and_prune;
 } ssSeenSpace;
 
@@ -55,11 +61,12 @@ ssStatus ssSeenList(ssSeenSpaces* seen, dSpaceID root, ssBodyList* gone);
  * bodies then belong to the listing), 0 when the spaces must be listed in full (ssSeenList), -1 when out of memory. */
 int ssSeenLook(ssSeenSpaces* seen, ssBodyList* found, ssBodyList* moved);
 
-/* After a step: each space's marker set to its first geom, and the one behind it. Four reads a space. */
+/* After a step: each space's marker set to its first geom, with those behind it (SS_SEEN_HEAD in all). */
 void ssSeenMark(ssSeenSpaces* seen);
 
-/* body, about to be destroyed through the stepper: its geoms there leave the count (destroyed before or after), and a
- * space whose marker it held is walked whole at the next look. */
+/* body, about to be destroyed through the stepper: its geoms there leave the count (destroyed before or after), and
+ * leave the heads: a space whose marker it held takes the next geom kept as its marker (walked whole at the next look
+ * when none is left). */
 void ssSeenForget(ssSeenSpaces* seen, dBodyID body);
 
 #endif
