@@ -28,10 +28,14 @@ struct ssRegistry {
   ssBodyBinding* bodies;
   int body_count, body_capacity;
   /* bodies[0 .. bodies_passed) were passed by a write for bodies_passed_step_s: written for it, or asleep then (a
-   * sleeping body is written before the step it wakes for, ssRegistryWriteWoken); a binding changed in place lowers
-   * it to its place, so that a write at that step passes only what changed or was added since */
+   * sleeping body is written before the step it wakes for, ssRegistryWriteWoken), except the places in
+   * bodies_changed, changed since (bound again, followed, or the last binding moved there by an unbinding). A write
+   * at that step passes only those and what was added since; more changes than the list holds lower bodies_passed
+   * to the first of them instead */
   int bodies_passed;
   double bodies_passed_step_s;
+  int bodies_changed[16];
+  int bodies_changed_count;
   ssBindingIndex joint_index; /* (joint, rowTag) -> position in joints */
   ssBindingIndex body_index;  /* (body, 0) -> position in bodies */
   unsigned generation; /* changes whenever the set of bound joints or bodies does */
@@ -40,9 +44,18 @@ struct ssRegistry {
   ssRegistryAttachment apply; /* Apply's state (apply.c) */
 };
 
-/* The binding at place i changed: written again at the next write whatever its step. */
+/* The binding at place i changed: passed again at the next write whatever its step. */
 static void bodyChangedAt(ssRegistry* registry, int i) {
-  if (i < registry->bodies_passed) registry->bodies_passed = i;
+  enum { kChangedMax = sizeof registry->bodies_changed / sizeof registry->bodies_changed[0] };
+  if (i >= registry->bodies_passed) return;
+  if (registry->bodies_changed_count < kChangedMax) {
+    registry->bodies_changed[registry->bodies_changed_count++] = i;
+    return;
+  }
+  for (int c = 0; c < registry->bodies_changed_count; ++c)
+    if (registry->bodies_changed[c] < i) i = registry->bodies_changed[c];
+  registry->bodies_passed = i;
+  registry->bodies_changed_count = 0;
 }
 
 /* Refuses a body of another world than the registry's (0, the static world, is everyone's): the registry's writes
@@ -364,17 +377,28 @@ void ssRegistryWriteWoken(ssRegistry* registry, const dBodyID* bodies, int count
   }
 }
 
+/* The binding at place i, for a write at step_s: written unless it was for step_s already, or it sleeps (written when
+ * it wakes, as the program's writes to it are followed then, follow.c). */
+static void passBody(ssRegistry* registry, int i, double step_s) {
+  ssBodyBinding* binding = &registry->bodies[i];
+  if (binding->written_step_s != step_s && (binding->body == 0 || dBodyIsEnabled(binding->body)))
+    writeBody(binding, registry->world, step_s);
+}
+
 void ssRegistryWriteBodies(ssRegistry* registry, double step_s) {
   /* at the step of the last pass, only what changed or was added since: a sleeping level is not walked again */
-  int from = step_s == registry->bodies_passed_step_s ? registry->bodies_passed : 0;
-  for (int i = from; i < registry->body_count; ++i) {
-    ssBodyBinding* binding = &registry->bodies[i];
-    /* a sleeping body is written when it wakes, as the program's writes to it are followed then (follow.c) */
-    if (binding->written_step_s != step_s && (binding->body == 0 || dBodyIsEnabled(binding->body)))
-      writeBody(binding, registry->world, step_s);
+  int from = 0;
+  if (step_s == registry->bodies_passed_step_s) {
+    from = registry->bodies_passed;
+    for (int c = 0; c < registry->bodies_changed_count; ++c) {
+      int i = registry->bodies_changed[c]; /* a place an unbinding emptied since is past the end */
+      if (i < from && i < registry->body_count) passBody(registry, i, step_s);
+    }
   }
+  for (int i = from; i < registry->body_count; ++i) passBody(registry, i, step_s);
   registry->bodies_passed = registry->body_count;
   registry->bodies_passed_step_s = step_s;
+  registry->bodies_changed_count = 0;
 }
 
 dWorldID ssRegistryWorld(const ssRegistry* registry) { return registry->world; }

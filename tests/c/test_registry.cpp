@@ -600,6 +600,49 @@ TEST_F(RegistryTest, EveryBodyBindingChangedSinceTheLastWriteIsWrittenAtTheSameS
   ssRegistry_Destroy(registry);
 }
 
+// Between two writes at one step, any number of bindings changed anywhere, and places emptied by unbinding, in random
+// rounds: each write leaves every bound body with its own rate's damping for the step, whatever the registry keeps
+// of what changed (a few places, or everything from the first of many).
+TEST_F(RegistryTest, AnyNumberOfBodyBindingsChangedBetweenWritesAreAllWritten) {
+  ssRegistry* registry = ssRegistry_Create(world);
+  const double step_s = 1.0 / 60.0;
+  std::vector<dBodyID> bound;
+  std::vector<double> rate;
+  for (int i = 0; i < 60; ++i) {
+    bound.push_back(MakeBody(1.0));
+    rate.push_back(1.0);
+    ASSERT_EQ(ssRegistry_BindDamping(registry, bound.back(), 1.0, 1.0), SS_OK);
+  }
+  ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, step_s, 0, nullptr), SS_OK);
+  unsigned seed = 7;
+  auto next = [&seed](int n) { return static_cast<int>((seed = seed * 1103515245u + 12345u) / 65536u % n); };
+  for (int round = 0; round < 40; ++round) {
+    SCOPED_TRACE(round);
+    const int changes = round % 4 == 3 ? 30 : 1 + round % 5;  // a few, or more than the registry lists
+    for (int c = 0; c < changes; ++c) {
+      const int k = next(static_cast<int>(bound.size()));
+      if (next(3) == 0 && bound.size() > 20) {  // unbound: the last binding moves to its place
+        ASSERT_EQ(ssRegistry_UnbindBody(registry, bound[k]), SS_OK);
+        bound.erase(bound.begin() + k), rate.erase(rate.begin() + k);
+      } else {
+        rate[k] = 0.5 + next(100) / 10.0;
+        ASSERT_EQ(ssRegistry_BindDamping(registry, bound[k], rate[k], rate[k]), SS_OK);
+      }
+    }
+    if (round % 2) {  // one made and bound besides
+      bound.push_back(MakeBody(1.0));
+      rate.push_back(2.5);
+      ASSERT_EQ(ssRegistry_BindDamping(registry, bound.back(), 2.5, 2.5), SS_OK);
+    }
+    ASSERT_EQ(ssRegistry_Apply(registry, SS_MAPPING_IMPLICIT_EULER, step_s, 0, nullptr), SS_OK);
+    for (size_t i = 0; i < bound.size(); ++i)
+      ASSERT_NEAR(dBodyGetLinearDamping(bound[i]), 1 - std::exp(-rate[i] * step_s),
+                  ReadBackTolerance(1e-15, rate[i] * step_s))
+          << "body " << i;
+  }
+  ssRegistry_Destroy(registry);
+}
+
 TEST_F(RegistryTest, VisitsEachBoundBodyOnce) {
   ssRegistry* registry = ssRegistry_Create(world);
   for (int i = 0; i < 3; ++i) {
