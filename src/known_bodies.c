@@ -619,6 +619,14 @@ static ssStatus checkGears(const ssKnownBodies* known, double step_s, int with_f
   return SS_OK;
 }
 
+/* The first place from k on (count: none) of a body awake at the last check or awake now: the bodies passed over sleep
+ * still, and none moves unseen. Its own loop, the arrays held in registers across ODE's calls: most of a sleeping
+ * level passes here. */
+static int firstNotStillAsleep(const dBodyID* ids, const unsigned char* awake, int k, int count) {
+  while (k < count && !awake[k] && !dBodyIsEnabled(ids[k])) ++k;
+  return k;
+}
+
 ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const char* when, int step, int steps,
                       const dBodyID* also, int also_count, int only_stepped, dBodyID* failed) {
   CheckVisit check = {bounds->max_speed * bounds->max_speed, bounds->max_angular_speed * bounds->max_angular_speed,
@@ -634,10 +642,11 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
     /* one pass reads each body once, marks it and checks what ODE steps (the usual case: all pass; the first
      * failure is found after); a sleeping body's values are not read. A body the frame's start passed over asleep
      * and found awake now is started here: its frame force read, with its state (ssKnownStartFrame). */
-    const int late_start = known->sleepers_unread;
+    const int late_start = known->sleepers_unread, none_unseen = known->unseen_count == 0;
     known->stepped_count = 0;
     for (int k = 0; k < count; ++k) {
       if (k < until) prefetchBody(known, k + kPrefetchAhead, check.forces);
+      else if (none_unseen && (k = firstNotStillAsleep(known->ids, known->awake, k, count)) == count) break;
       int was_awake = known->awake[k];
       /* asleep at the last check and still (most of a sleeping level): its mark stays, and only its moves count */
       if (!was_awake && !dBodyIsEnabled(known->ids[k])) {
