@@ -6,8 +6,12 @@
  * whatever the program adds or moves before the next step lands in front of it, and nothing behind it is new. A look
  * walks the heads only, as far as what changed. What no walk sees, a geom the program destroyed, shows in the count:
  * the spaces hold as many geoms as at the last listing, plus those found since, less those the stepper removed, or
- * something was destroyed with ODE's own calls, and the spaces are listed in full. A sweep-and-prune space reorders
- * its geoms as they move (dSpaceGetGeom lists the moved ones first) and is listed at every look. */
+ * something was destroyed with ODE's own calls, and the spaces are listed in full. A body destroyed that way and
+ * another made at its address before the look leave the count as it was and are taken for one (ODE's API tells no
+ * freed handle from a live one). The mark keeps the first geoms, not the first alone: a body destroyed through the
+ * stepper leaves them, and the next kept is the marker, so destroying what ODE stepped last costs no full walk. A
+ * sweep-and-prune space reorders its geoms as they move (dSpaceGetGeom lists the moved ones first) and is listed at
+ * every look. */
 #ifndef STEADYSTEP_SEEN_SPACES_H
 #define STEADYSTEP_SEEN_SPACES_H
 

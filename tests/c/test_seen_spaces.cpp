@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <ostream>
 #include <set>
 #include <string>
 #include <vector>
@@ -24,6 +25,8 @@ struct Layout {
   dSpaceID (*make)(dSpaceID parent);
   bool nested;  // half the bodies in a space nested in the root
 };
+
+void PrintTo(const Layout& layout, std::ostream* out) { *out << layout.name; }
 
 class SeenSpaces : public OdeTest, public ::testing::WithParamInterface<Layout> {
  protected:
