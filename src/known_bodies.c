@@ -646,7 +646,8 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
     known->stepped_count = 0;
     for (int k = 0; k < count; ++k) {
       if (k < until) prefetchBody(known, k + kPrefetchAhead, check.forces);
-      else if (none_unseen && !known->awake[k] && (k = firstNotStillAsleep(known->ids, known->awake, k, count)) == count)
+      else if (none_unseen && !known->awake[k] &&
+               (k = firstNotStillAsleep(known->ids, known->awake, k, count)) == count)
         break;
       int was_awake = known->awake[k];
       /* asleep at the last check and still (most of a sleeping level): its mark stays, and only its moves count */

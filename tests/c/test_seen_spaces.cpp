@@ -180,13 +180,12 @@ TEST_P(SeenSpaces, AMarkerMovedInFrontOfAMovedSleeperIsNoLongerTrusted) {
   ssBodyListFree(&gone);
 }
 
-INSTANTIATE_TEST_SUITE_P(HashAndSimpleAlone,
-                         SeenSpaces,
-                         ::testing::Values(Layout{"hash", [](dSpaceID parent) { return dHashSpaceCreate(parent); }, false},
-                                           Layout{"simple", [](dSpaceID parent) { return dSimpleSpaceCreate(parent); },
-                                                  false},
-                                           Layout{"hash_in_hash",
-                                                  [](dSpaceID parent) { return dHashSpaceCreate(parent); }, true}),
+dSpaceID MakeHash(dSpaceID parent) { return dHashSpaceCreate(parent); }
+dSpaceID MakeSimple(dSpaceID parent) { return dSimpleSpaceCreate(parent); }
+
+INSTANTIATE_TEST_SUITE_P(HashSimpleAndNested, SeenSpaces,
+                         ::testing::Values(Layout{"hash", MakeHash, false}, Layout{"simple", MakeSimple, false},
+                                           Layout{"hash_in_hash", MakeHash, true}),
                          [](const ::testing::TestParamInfo<Layout>& info) { return std::string(info.param.name); });
 
 }  // namespace
