@@ -21,11 +21,7 @@ from steadystep.core._native import InvalidValue, SimulationFailure, ffi, lib
 S = ss.Status
 
 
-@pytest.fixture(scope="module", autouse=True)
-def ode():
-    odepy.dInitODE2(0)
-    yield
-    odepy.dCloseODE()
+pytestmark = pytest.mark.usefixtures("odepy_initialised")
 
 
 def _world_with_a_box(max_speed=0.0):

@@ -13,11 +13,7 @@ import steadystep as ss
 from steadystep.core._native import ffi, lib
 
 
-@pytest.fixture(scope="module", autouse=True)
-def ode():
-    odepy.dInitODE2(0)
-    yield
-    odepy.dCloseODE()
+pytestmark = pytest.mark.usefixtures("odepy_initialised")
 
 
 @pytest.fixture

@@ -12,11 +12,7 @@ import pytest
 import steadystep as ss
 
 
-@pytest.fixture(scope="module", autouse=True)
-def ode():
-    odepy.dInitODE2(0)
-    yield
-    odepy.dCloseODE()
+pytestmark = pytest.mark.usefixtures("odepy_initialised")
 
 
 @pytest.fixture
