@@ -16,12 +16,13 @@
  * world's, as a large level is kept in chunks: one hash space of n geoms clears n² bits at every collision, which
  * at 100,000 boxes is most of ODE's own frame and would hide the library's share.
  *
- * Under valgrind, `callgrind --toggle-collect=` on gameFrameOwn and gameFrameAdopted counts the instructions of each
- * copy (docs/measurements.md).
+ * Under valgrind, `callgrind --toggle-collect=gameFrameOwn` (or gameFrameAdopted) on `bench_games count` counts the
+ * instructions of one copy (docs/measurements.md).
  *
  *   bench_games [frames] [repeats] [largest box count]   (default 120 frames, 5 repeats, 100000: about 10 min on
  *   a 2-core machine; 100,000 boxes take four repeats of 10 frames, two in each building order)
- *   bench_games share [frames] [repeats] [largest box count]   the share alone */
+ *   bench_games share [frames] [repeats] [largest box count]   the share alone
+ *   bench_games count own|adopted <scene 0-4> <boxes> <frames>   one copy, untimed, for callgrind */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -240,24 +241,26 @@ static const struct {
                {"static, chunked", 0, 0, 1}}; /* the share's scene, timed under implicit-euler; counted as the others */
 enum { kSceneCount = sizeof kScenes / sizeof kScenes[0], kGameScenes = kSceneCount - 1 };
 
-/* bench_games count <scene 0-4> <boxes> <frames>: both copies stepped, untimed, for callgrind's counts; as in the
- * timed runs, each first takes kWarmFrames uncounted (the stepper's first frame lists what it adopted: once, not a
- * frame's cost). */
+/* bench_games count own|adopted <scene 0-4> <boxes> <frames>: one copy stepped, untimed, for callgrind's counts; as
+ * in the timed runs, it first takes kWarmFrames uncounted (the stepper's first frame lists what it adopted: once, not
+ * a frame's cost). Each copy is counted in a process of its own, as a program runs alone: stepped one after the
+ * other in one process, the second copy's frames allocate from the heap the first's left, and pay for it (at 1,000
+ * sleeping boxes with spawning, 0.6 M instructions in 60 frames, whichever copy runs second). */
 static int countInstructions(int argc, char** argv) {
-  int scene = argc > 2 ? atoi(argv[2]) : -1, boxes = argc > 3 ? atoi(argv[3]) : 0;
-  int frames = argc > 4 ? atoi(argv[4]) : 0;
-  if (scene < 0 || scene >= kSceneCount || boxes <= 0 || frames <= 0) {
-    fprintf(stderr, "usage: bench_games count <scene 0-%d> <boxes> <frames>\n", kSceneCount - 1);
+  const char* copy = argc > 2 ? argv[2] : "";
+  const int adopted = strcmp(copy, "adopted") == 0;
+  int scene = argc > 3 ? atoi(argv[3]) : -1, boxes = argc > 4 ? atoi(argv[4]) : 0;
+  int frames = argc > 5 ? atoi(argv[5]) : 0;
+  if ((!adopted && strcmp(copy, "own") != 0) || scene < 0 || scene >= kSceneCount || boxes <= 0 || frames <= 0) {
+    fprintf(stderr, "usage: bench_games count own|adopted <scene 0-%d> <boxes> <frames>\n", kSceneCount - 1);
     return 2;
   }
   dInitODE2(0);
-  Game* own = build(boxes, kScenes[scene].asleep, kScenes[scene].spawning, kScenes[scene].chunked, NULL);
-  Game* adopted = build(boxes, kScenes[scene].asleep, kScenes[scene].spawning, kScenes[scene].chunked, "naive");
-  for (int i = 0; i < kWarmFrames; ++i) ownFrame(own), adoptedFrame(adopted);
-  for (int i = 0; i < frames; ++i) gameFrameOwn(own);
-  for (int i = 0; i < frames; ++i) gameFrameAdopted(adopted);
-  destroy(own);
-  destroy(adopted);
+  Game* game = build(boxes, kScenes[scene].asleep, kScenes[scene].spawning, kScenes[scene].chunked,
+                     adopted ? "naive" : NULL);
+  for (int i = 0; i < kWarmFrames; ++i) adopted ? adoptedFrame(game) : ownFrame(game);
+  for (int i = 0; i < frames; ++i) adopted ? gameFrameAdopted(game) : gameFrameOwn(game);
+  destroy(game);
   return 0;
 }
 
