@@ -15,6 +15,18 @@
 #include "prefetch.h"
 #include "steadystep/limits.h"
 
+/* awake[] holds this many bytes past the list, set to 1 by a check that runs over sleepers: a run of them then ends
+ * there with no count compared (firstNotStillAsleep, which reads four marks at once) */
+enum { kAwakeSentinels = 4 };
+
+/* A body's check, inlined where it is called (GCC keeps it out of line): the passes make it for every awake body,
+ * two or three times a frame, and the call was a sixth of it */
+#if defined(__GNUC__)
+#define SS_BODY_CHECK static inline __attribute__((always_inline))
+#else
+#define SS_BODY_CHECK static inline
+#endif
+
 void ssKnownFree(ssKnownBodies* known) {
   free(known->bodies);
   free(known->ids);
@@ -114,7 +126,7 @@ static int reserve(ssKnownBodies* known, int capacity) {
   if ((grown[1] = realloc(known->ids, n * sizeof *known->ids)) != NULL) known->ids = grown[1];
   if ((grown[2] = realloc(known->values, n * sizeof *known->values)) != NULL) known->values = grown[2];
   if ((grown[3] = realloc(known->joints, n * sizeof *known->joints)) != NULL) known->joints = grown[3];
-  if ((grown[4] = realloc(known->awake, n * sizeof *known->awake)) != NULL) known->awake = grown[4];
+  if ((grown[4] = realloc(known->awake, n + kAwakeSentinels)) != NULL) known->awake = grown[4];
   if ((grown[5] = realloc(known->reached, n * sizeof *known->reached)) != NULL) known->reached = grown[5];
   if ((grown[6] = realloc(known->queue, n * sizeof *known->queue)) != NULL) known->queue = grown[6];
   if ((grown[7] = realloc(known->pushed, n * sizeof *known->pushed)) != NULL) known->pushed = grown[7];
@@ -443,7 +455,7 @@ static ssStatus nameFailure(const ssKnownBodies* known, int k, const ssBodyBound
   return describe(known->ids[k], bounds, named);
 }
 
-static int bodyWithin(const ssBodyValues* v, double max_speed2, double max_spin2, int forces) {
+SS_BODY_CHECK int bodyWithin(const ssBodyValues* v, double max_speed2, double max_spin2, int forces) {
   return stateWithin(v, max_speed2, max_spin2) & (!forces || forcesWithin(v));
 }
 
@@ -584,7 +596,7 @@ static int anyNonZero(const double* values) {
 /* One body at the frame's start: 0 when its state or forces fail the check; else, with a force or torque (not all
  * zeros, -0 included: the largest magnitude is not 0) or a carried force, its frame force read and the body marked
  * pushed. */
-static int startBody(ssKnownBodies* known, int k, double max_speed2, double max_spin2) {
+SS_BODY_CHECK int startBody(ssKnownBodies* known, int k, double max_speed2, double max_spin2) {
   const ssBodyValues* values = &known->values[k];
   uint64_t force = largestOf(values->force), torque = largestOf(values->torque);
   uint64_t largest = force > torque ? force : torque;
@@ -619,11 +631,17 @@ static ssStatus checkGears(const ssKnownBodies* known, double step_s, int with_f
   return SS_OK;
 }
 
-/* The first place from k on (count: none) of a body awake at the last check or awake now: the bodies passed over sleep
- * still, and none moves unseen. Its own loop, the arrays held in registers across ODE's calls: most of a sleeping
- * level passes here. */
-static int firstNotStillAsleep(const dBodyID* ids, const unsigned char* awake, int k, int count) {
-  while (k < count && !awake[k] && !dBodyIsEnabled(ids[k])) ++k;
+/* The first place from k on of a body awake at the last check or awake now, or the list's end, where awake[] holds
+ * kAwakeSentinels ones: the bodies passed over sleep still, and none moves unseen. Its own loop, the arrays held in
+ * registers across ODE's calls, four marks read at once: most of a sleeping level passes here. */
+static int firstNotStillAsleep(const dBodyID* ids, const unsigned char* awake, int k) {
+  for (uint32_t four; memcpy(&four, awake + k, sizeof four), four == 0; k += 4) {
+    if (dBodyIsEnabled(ids[k])) return k;
+    if (dBodyIsEnabled(ids[k + 1])) return k + 1;
+    if (dBodyIsEnabled(ids[k + 2])) return k + 2;
+    if (dBodyIsEnabled(ids[k + 3])) return k + 3;
+  }
+  while (!awake[k] && !dBodyIsEnabled(ids[k])) ++k;
   return k;
 }
 
@@ -644,10 +662,11 @@ ssStatus ssKnownCheck(ssKnownBodies* known, const ssBodyBounds* bounds, const ch
      * and found awake now is started here: its frame force read, with its state (ssKnownStartFrame). */
     const int late_start = known->sleepers_unread, none_unseen = known->unseen_count == 0;
     known->stepped_count = 0;
+    if (count > 0) memset(known->awake + count, 1, kAwakeSentinels); /* firstNotStillAsleep's end */
     for (int k = 0; k < count; ++k) {
       if (k < until) prefetchBody(known, k + kPrefetchAhead, check.forces);
       else if (none_unseen && !known->awake[k] &&
-               (k = firstNotStillAsleep(known->ids, known->awake, k, count)) == count)
+               (k = firstNotStillAsleep(known->ids, known->awake, k)) == count)
         break;
       int was_awake = known->awake[k];
       /* asleep at the last check and still (most of a sleeping level): its mark stays, and only its moves count */
@@ -704,9 +723,11 @@ ssStatus ssKnownStartFrame(ssKnownBodies* known, const ssBodyBounds* bounds, con
   known->stepped_count = 0;
   known->joints_due = 0; /* every body awake at the last check is read below */
   for (int k = 0; awake_alone && k < count; ++k) {
-    const unsigned char* next = memchr(known->awake + k, 1, (size_t)(count - k));
-    if (next == NULL) break;
-    k = (int)(next - known->awake);
+    if (!known->awake[k]) { /* the next awake body, past the sleepers; those after an awake one are met in turn */
+      const unsigned char* next = memchr(known->awake + k, 1, (size_t)(count - k));
+      if (next == NULL) break;
+      k = (int)(next - known->awake);
+    }
     changed |= jointsChangedAt(known, k);
     if (markBody(known, k, &unseen)) all &= startBody(known, k, check.max_speed2, check.max_spin2);
   }

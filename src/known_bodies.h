@@ -54,7 +54,8 @@ typedef struct ssKnownBodies {
   ssBodyValues* values;   /* bodies[i]'s values, packed: the checks read nothing else */
   ssJointSignature* joints; /* each body's joints when listed */
   /* whether ODE stepped the body at the last check or would step it next (enabled, or woken through its joints):
-   * a body ODE has disabled since is checked once more, then no more until it wakes */
+   * a body ODE has disabled since is checked once more, then no more until it wakes; a few bytes longer than the
+   * list, the end of a run of sleepers (known_bodies.c) */
   unsigned char* awake;
   /* whether the program could move the body while it sleeps without the stepper's looks seeing it (no geom of it in
    * seen_space, where ODE puts a moved geom at the head): such a body is checked asleep too */

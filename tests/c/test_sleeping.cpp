@@ -254,6 +254,25 @@ TEST_F(Sleeping, ASleepingBodyTheProgramWakesIsCheckedBeforeItSteps) {
   EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 60, nullptr), SS_OK) << ssLastError();
 }
 
+// Wherever a body is among the sleepers, one the program wakes is found and checked before it steps: the check after
+// the callbacks passes over a run of sleepers four at a time, and one at a time where fewer than four are left.
+TEST_F(Sleeping, AWokenBodyIsCheckedWhereverItIsAmongTheSleepers) {
+  Adopt("naive");
+  for (dBodyID woken : boxes) {
+    ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 60, nullptr), SS_OK) << ssLastError();  // every box read, asleep
+    ASSERT_EQ(ssStepper_Step(stepper, 1.0 / 60, nullptr), SS_OK) << ssLastError();  // the sleepers passed over
+    dBodySetLinearVel(woken, 1e6, 0, 0);  // above max_speed; stepped unchecked, it flies off, and ODE goes on
+    dBodyEnable(woken);
+    ssFrameReport report;
+    EXPECT_EQ(ssStepper_Step(stepper, 1.0 / 60, &report), SS_ERROR_SPEED_LIMIT);
+    EXPECT_EQ(report.failed_body, woken) << ssLastError();
+    dBodySetLinearVel(woken, 0, 0, 0);
+    dBodyDisable(woken);
+    ssStepper_Reset(stepper);
+  }
+  EXPECT_EQ(Awake(), 0);
+}
+
 // A body adopted asleep is written when it wakes, whatever the frames: at steps of constant length as well, where
 // Apply has nothing else to write. Its idle time stays the program's (10 steps of 1/60 s are 20 of 1/120 s).
 TEST_F(Sleeping, ABodyAdoptedAsleepIsWrittenForTheStepWhenItWakes) {
