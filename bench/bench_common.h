@@ -50,4 +50,21 @@ static inline double benchMedian(double* values, int count) {
   return values[count / 2];
 }
 
+/* Where the median of the population count sorted values were drawn from lies, with 95 % confidence: between the
+ * order statistics the sign test gives (sorted[k - 1] and sorted[count - k] for the largest k with P(B <= k - 1) at
+ * most 2.5 %, B binomial over count draws of 1/2), which assumes nothing of the values' distribution. Below 6 values
+ * no interval is that sure: their whole range. */
+static inline void benchMedianInterval(const double* sorted, int count, double* low, double* high) {
+  double term = 1, at_most = 0; /* P(B = j) and P(B <= j - 1), as k = j + 1 grows */
+  for (int j = 0; j < count; ++j) term *= 0.5;
+  int k = 0;
+  while (k < count / 2 && at_most + term <= 0.025) {
+    at_most += term;
+    term *= (double)(count - k) / (k + 1);
+    ++k;
+  }
+  *low = sorted[k > 0 ? k - 1 : 0];
+  *high = sorted[k > 0 ? count - k : count - 1];
+}
+
 #endif

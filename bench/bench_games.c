@@ -9,7 +9,8 @@
  *  - asleep, spawning: both.
  * Projectiles fly up from beside the field and never touch a box, so that a sleeping level stays asleep. The two
  * copies are stepped in alternating blocks, timed by this thread's CPU time; the ratio of adopted to own of each
- * pair of blocks is kept, and their median printed with the middle half's range.
+ * pair of blocks is kept, and their median printed with the interval it lies in with 95 % confidence and the middle
+ * half's range.
  *
  * Then the library's share of a frame as the world grows (10 to 100,000 boxes, `implicit-euler`, static boxes): the
  * adopted frame's time over the own frame's, less one. There the boxes are kept in hash spaces of 1,000 nested in the
@@ -216,7 +217,8 @@ static double measure(int boxes, int asleep, int spawning, int chunked, const ch
 }
 
 /* The median ratio adopted / own over every pair of blocks of the repeats (a burst of another process' load spoils a
- * pair, not the figure), printed with the middle half's range and the own frame's time. */
+ * pair, not the figure), printed with the own frame's time, where the pairs' median lies with 95 % confidence (what
+ * the run can tell from 1.02) and the middle half's range (how much one pair says). */
 static double reportScene(const char* name, int boxes, int asleep, int spawning, int chunked, const char* policy,
                           int frames, int repeats) {
   static double ratios[64 * kPairs];
@@ -226,8 +228,10 @@ static double reportScene(const char* name, int boxes, int asleep, int spawning,
               frames / repeats;
   const int count = repeats * kPairs;
   benchSort(ratios, count);
-  printf("  %-22s %6d boxes  own %9.1f us/frame  adopted/own %.4f  (middle half %.4f to %.4f)\n", name, boxes, own_us,
-         ratios[count / 2], ratios[count / 4], ratios[(3 * count) / 4]);
+  double low, high;
+  benchMedianInterval(ratios, count, &low, &high);
+  printf("  %-22s %6d boxes  own %9.1f us/frame  adopted/own %.4f  (95 %% interval %.4f to %.4f, middle half %.4f "
+         "to %.4f)\n", name, boxes, own_us, ratios[count / 2], low, high, ratios[count / 4], ratios[(3 * count) / 4]);
   return ratios[count / 2];
 }
 
