@@ -272,7 +272,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
 
   if (mapping == SS_MAPPING_IMPLICIT_EULER && APPLY_CACHE_ON(state, SS_APPLY_SAME_STEP) &&
       state->applied_mapping == mapping && state->applied_step_s == step_s &&
-      state->applied_revision == state->revision) {
+      state->applied_revision == ssRegistryRevision(registry)) {
     if (report != NULL) *report = (ssApplyReport){state->applied_counts.rows, 0};
     return SS_OK;
   }
@@ -325,7 +325,7 @@ ssStatus ssRegistry_Apply(ssRegistry* registry, ssMapping mapping, double step_s
   ssRegistryWriteBodies(registry, step_s);
   state->applied_mapping = mapping;
   state->applied_step_s = step_s;
-  state->applied_revision = state->revision;
+  state->applied_revision = ssRegistryRevision(registry);
   state->applied_counts = counts;
   if (report != NULL) *report = counts;
   return SS_OK;

@@ -208,7 +208,7 @@ static int rebuild(ApplyState* state, ssRegistry* registry) {
   state->row_count = count;
   state->loaded_rows = 0;
   for (int i = 0; i < count; ++i) state->loaded_rows += rows[i].binding.load != 0;
-  state->revision = ssRegistryRevision(registry);
+  state->revision = ssRegistryRowsRevision(registry);
   state->stamp = ssRegistryLastStamp(registry);
   buildLaws(state);
   state->handed_wait = state->handed_failed = 0;
@@ -224,11 +224,11 @@ ApplyState* ssApplyStateOf(ssRegistry* registry) {
     if (state == NULL) return NULL;
     state->world_written = (ssSoftness){NAN, NAN};
     state->applied_step_s = NAN;
-    state->revision = ssRegistryRevision(registry) - 1; /* built at once below */
+    state->revision = ssRegistryRowsRevision(registry) - 1; /* built at once below */
     attachment->state = state;
     attachment->free_state = freeState;
   }
-  if (state->revision != ssRegistryRevision(registry) && !rebuild(state, registry)) return NULL;
+  if (state->revision != ssRegistryRowsRevision(registry) && !rebuild(state, registry)) return NULL;
   return state;
 }
 

@@ -2,9 +2,10 @@
  * between Applies. Nothing outside the room reads it; the registry holds it as an attachment it never opens.
  *
  * Invariants (apply_state.c keeps them; apply.c relies on them):
- *  - The state is built for the registry's revision (revision) and its rows are the bindings' in order
- *    (ssRegistryJointRowAt), each with a copy of what Apply reads of its binding. Built again on any change of the
- *    bindings; what ODE holds by Apply's writes (written) is carried over to the rows whose stamp is unchanged.
+ *  - The state is built for the registry's rows revision (revision: ssRegistryRowsRevision) and its rows are the
+ *    bindings' in order (ssRegistryJointRowAt), each with a copy of what Apply reads of its binding. Built again on
+ *    any change of the rows' or the world's bindings (a body's is none of the state's); what ODE holds by Apply's
+ *    writes (written) is carried over to the rows whose stamp is unchanged.
  *  - rows[i].written is what ODE holds for the row as Apply last wrote it (NAN: bound since, written at the next
  *    Apply whatever ODE holds), except while written_by_law: a row with law_slot >= 0 then holds
  *    law_written[law_slot] (the by-law pass writes no row's own); materializeWritten puts those back before a row's
@@ -23,9 +24,9 @@
  *    its stamp == apply_stamp.
  *  - rows[i].computed (and computed_fallback), where computed_mapping is an accurate mapping, is the law's softness
  *    for (computed_mapping, mass, computed_step_s, computed_previous_s): the mappings are pure functions of these.
- *  - The same-step shortcut: when the last Apply was implicit Euler at applied_step_s with applied_revision ==
- *    revision, ODE holds every value an implicit-Euler Apply at that step would write, and applied_counts is its
- *    report. */
+ *  - The same-step shortcut: when the last Apply was implicit Euler at applied_step_s with applied_revision the
+ *    registry's revision now (ssRegistryRevision: any binding, a body's too), ODE holds every value an
+ *    implicit-Euler Apply at that step would write, and applied_counts is its report. */
 #ifndef STEADYSTEP_APPLY_STATE_H
 #define STEADYSTEP_APPLY_STATE_H
 
@@ -85,7 +86,7 @@ typedef struct BodyCache {
 } BodyCache;
 
 typedef struct ApplyState {
-  unsigned revision; /* the registry's, at the build */
+  unsigned revision; /* the registry's rows revision, at the build */
   unsigned stamp;    /* the registry's last stamp, at the build */
   ApplyRow* rows;
   HotRow* hot_rows;
@@ -109,7 +110,7 @@ typedef struct ApplyState {
   int body_count;
   int bodies_stale;
   unsigned apply_stamp;
-  unsigned applied_revision; /* the same-step shortcut */
+  unsigned applied_revision; /* the same-step shortcut: the registry's revision at the last Apply */
   double applied_step_s;     /* NAN: none */
   ssMapping applied_mapping;
   ssApplyReport applied_counts;

@@ -15,7 +15,7 @@
 #include "steadystep/registry.h"
 
 /* What the program bound, and nothing derived from it: Apply keeps what it computes and writes in its own state
- * (apply.c), which it rebuilds whenever revision changes. */
+ * (apply.c), which it rebuilds whenever rows_revision changes. */
 struct ssRegistry {
   dWorldID world;
   int world_bound;
@@ -38,11 +38,19 @@ struct ssRegistry {
   int bodies_changed_count;
   ssBindingIndex joint_index; /* (joint, rowTag) -> position in joints */
   ssBindingIndex body_index;  /* (body, 0) -> position in bodies */
-  unsigned generation; /* changes whenever the set of bound joints or bodies does */
-  unsigned revision;   /* changes whenever any binding does */
+  unsigned generation;    /* changes whenever the set of bound joints or bodies does */
+  unsigned revision;      /* changes whenever any binding does */
+  unsigned rows_revision; /* changes whenever a joint row's or the world's binding does (Apply builds its rows from
+                           * these: a body adopted or followed each frame rebuilds none) */
   unsigned last_stamp; /* the last stamp given to a joint row's binding */
   ssRegistryAttachment apply; /* Apply's state (apply.c) */
 };
+
+/* A joint row's or the world's binding changed: Apply's rows are built again (rows_revision). */
+static void rowsChanged(ssRegistry* registry) {
+  registry->revision += 1;
+  registry->rows_revision += 1;
+}
 
 /* The binding at place i changed: passed again at the next write whatever its step. */
 static void bodyChangedAt(ssRegistry* registry, int i) {
@@ -91,7 +99,7 @@ void ssRegistry_Destroy(ssRegistry* registry) {
 }
 
 void ssRegistryBindWorldLaw(ssRegistry* registry, ssRowLaw law, double effective_mass) {
-  registry->revision += 1;
+  rowsChanged(registry);
   registry->world_bound = 1;
   registry->world_law = law;
   registry->world_mass = effective_mass > 0 ? effective_mass : 1.0;
@@ -167,7 +175,7 @@ static void appendJoint(ssRegistry* registry, dJointID joint, int joint_type, ss
 
 ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointParam param, int axis, ssRowLaw law,
                                 double effective_mass) {
-  registry->revision += 1;
+  rowsChanged(registry);
   int joint_type = dJointGetType(joint);
   ssJointRowBinding* existing = findJoint(registry, joint, param, axis);
   if (existing != NULL) {
@@ -182,7 +190,7 @@ ssStatus ssRegistryBindJointLaw(ssRegistry* registry, dJointID joint, ssJointPar
 
 void ssRegistryAppendJointLaw(ssRegistry* registry, dJointID joint, int joint_type, ssJointParam param, int axis,
                               ssRowLaw law) {
-  registry->revision += 1;
+  rowsChanged(registry);
   appendJoint(registry, joint, joint_type, param, axis, law, 0);
 }
 
@@ -219,7 +227,7 @@ ssStatus ssRegistry_SetJointLoad(ssRegistry* registry, dJointID joint, ssJointPa
     return ssFail(SS_ERROR_UNSUPPORTED, "a %s joint's %s rows have no single direction to carry a load",
                   ssJointTypeName(joint), ssJointParamName(param));
   binding->load = load;
-  registry->revision += 1;
+  rowsChanged(registry);
   return SS_OK;
 }
 
@@ -232,7 +240,7 @@ ssStatus ssRegistry_UnbindJoint(ssRegistry* registry, dJointID joint) {
   registry->joint_count = kept;
   reindexJoints(registry);
   registry->generation += 1;
-  registry->revision += 1;
+  rowsChanged(registry);
   return SS_OK;
 }
 
@@ -245,7 +253,7 @@ int ssRegistryUnbindJointsNotIn(ssRegistry* registry, const ssPointerSet* alive)
   registry->joint_count = kept;
   reindexJoints(registry);
   registry->generation += 1;
-  registry->revision += 1;
+  rowsChanged(registry);
   return unbound;
 }
 
@@ -424,7 +432,7 @@ ssStatus ssRegistryReserve(ssRegistry* registry, int more_joints, int more_bodie
 double ssRegistry_TunedStep(const ssRegistry* registry) { return registry != NULL ? registry->tuned_step_s : 0; }
 
 void ssRegistrySetTuned(ssRegistry* registry, double tuned_step_s, ssSoftness tuned_world) {
-  registry->revision += 1;
+  rowsChanged(registry);
   registry->tuned_step_s = tuned_step_s;
   registry->tuned_world = tuned_world;
 }
@@ -450,15 +458,17 @@ unsigned ssRegistryLastStamp(const ssRegistry* registry) { return registry->last
 
 unsigned ssRegistryRevision(const ssRegistry* registry) { return registry->revision; }
 
+unsigned ssRegistryRowsRevision(const ssRegistry* registry) { return registry->rows_revision; }
+
 void ssRegistryFollowJointLaw(ssRegistry* registry, int i, ssRowLaw law) {
   registry->joints[i].law = law;
-  registry->revision += 1;
+  rowsChanged(registry);
 }
 
 void ssRegistryFollowWorldLaw(ssRegistry* registry, ssRowLaw law) {
   registry->world_law = law;
   if (registry->tuned_step_s > 0) registry->tuned_world = law.tuned; /* contacts without soft modes */
-  registry->revision += 1;
+  rowsChanged(registry);
 }
 
 void ssRegistryFollowBody(ssRegistry* registry, int i, const ssBodyBinding* binding) {

@@ -159,9 +159,13 @@ const ssJointRowBinding* ssRegistryJointRowAt(const ssRegistry* registry, int i)
 /* The largest stamp given to a binding so far (0: none). */
 unsigned ssRegistryLastStamp(const ssRegistry* registry);
 
-/* A number that changes whenever any binding does (a row, its load, the world, a body, the tuned step): what Apply
- * derives from the bindings is rebuilt on a change. */
+/* A number that changes whenever any binding does (a row, its load, the world, a body, the tuned step): an Apply at
+ * the step it last wrote writes again after a change. */
 unsigned ssRegistryRevision(const ssRegistry* registry);
+
+/* A number that changes whenever a joint row's or the world's binding does (a row, its load, the world, the tuned
+ * step), not a body's: Apply's rows, built from these, are built again on a change. */
+unsigned ssRegistryRowsRevision(const ssRegistry* registry);
 
 /* The i-th row takes law as the program's newly tuned one (follow.c): not a new binding (what Apply last wrote stays
  * what it compares with), but a change of the bindings. */
