@@ -1,12 +1,14 @@
 /* What the library costs where games spend it: a field of boxes resting on a plane in a hash space, softened
  * contacts made in the program's near callback, stepped by the program's own loop (dSpaceCollide, dWorldQuickStep,
  * dJointGroupEmpty) and by the same world adopted through its space under `naive` (bit for bit the same motion).
- * Four scenes:
+ * Five scenes:
  *  - static: the boxes rest, awake;
  *  - spawning: besides, one projectile made each frame and the one made 60 frames earlier destroyed (dGeomDestroy,
  *    then dBodyDestroy in the program's loop, ssStepper_DestroyBody adopted);
  *  - asleep: the boxes disabled by ODE's auto-disable, the level at rest;
- *  - asleep, spawning: both.
+ *  - asleep, spawning: both;
+ *  - jointed, spawning: the boxes of each row hinged in pairs, with stops (the adopted rows Apply writes), awake,
+ *    and spawning.
  * Projectiles fly up from beside the field and never touch a box, so that a sleeping level stays asleep. The two
  * copies are stepped in alternating blocks, timed by this thread's CPU time; the ratio of adopted to own of each
  * pair of blocks is kept, and their median printed with the interval it lies in with 95 % confidence and the middle
@@ -23,7 +25,7 @@
  *   bench_games [frames] [repeats] [largest box count]   (default 120 frames, 5 repeats, 100000: about 10 min on
  *   a 2-core machine; 100,000 boxes take four repeats of 10 frames, two in each building order)
  *   bench_games share [frames] [repeats] [largest box count]   the share alone
- *   bench_games count own|adopted <scene 0-4> <boxes> <frames>   one copy, untimed, for callgrind */
+ *   bench_games count own|adopted <scene 0-5> <boxes> <frames>   one copy, untimed, for callgrind */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -47,6 +49,15 @@ typedef struct Game {
   dBodyID projectiles[kLifetime];
   long frame;
 } Game;
+
+/* A scene: what the boxes do, and how the world keeps them. */
+typedef struct Scene {
+  const char* name;
+  int asleep;   /* ODE's auto-disable on: the boxes fall asleep as the program settles them */
+  int spawning; /* a projectile made and one destroyed each frame */
+  int chunked;  /* the boxes in hash spaces of kChunk nested in the world's */
+  int jointed;  /* each pair of neighbours in a row hinged, with stops the program tuned (a level of ragdolls) */
+} Scene;
 
 static void check(ssStatus status, const char* what) { benchCheck("bench_games", status, what); }
 
@@ -95,11 +106,26 @@ static dBodyID makeProjectile(Game* game, double age_s) {
   return body;
 }
 
-/* boxes of 0.5 m on a square grid 1 m apart, resting on the plane z = 0; chunked: in hash spaces of kChunk boxes */
-static Game* build(int boxes, int asleep, int spawning, int chunked, const char* policy) {
+/* Hinges the box at place i to the next in its row of side: at their middle, turning about y, within stops of
+ * 0.2 rad at the program's ERP and CFM (tuned at 60 fps). */
+static void hinge(Game* game, const dBodyID* bodies, int i, int side) {
+  dJointID joint = dJointCreateHinge(game->world, 0);
+  dJointAttach(joint, bodies[i], bodies[i + 1]);
+  dJointSetHingeAnchor(joint, i % side + 0.5, i / side, 0.25);
+  dJointSetHingeAxis(joint, 0, 1, 0);
+  dJointSetHingeParam(joint, dParamLoStop, -0.2);
+  dJointSetHingeParam(joint, dParamHiStop, 0.2);
+  dJointSetHingeParam(joint, dParamStopERP, 0.3);
+  dJointSetHingeParam(joint, dParamStopCFM, 1e-4);
+}
+
+/* boxes of 0.5 m on a square grid 1 m apart, resting on the plane z = 0, kept as scene says */
+static Game* build(const Scene* scene, int boxes, const char* policy) {
   Game* game = calloc(1, sizeof *game);
-  if (game == NULL) exit(1);
-  *game = (Game){dWorldCreate(), dHashSpaceCreate(0), NULL, 0, dJointGroupCreate(0), NULL, spawning, {0}, 0};
+  dBodyID* bodies = malloc((size_t)boxes * sizeof *bodies);
+  if (game == NULL || bodies == NULL) exit(1);
+  *game = (Game){dWorldCreate(), dHashSpaceCreate(0), NULL, 0, dJointGroupCreate(0), NULL, scene->spawning, {0}, 0};
+  const int chunked = scene->chunked, asleep = scene->asleep;
   if (chunked) {
     game->chunk_count = (boxes + kChunk - 1) / kChunk;
     if ((game->chunks = calloc((size_t)game->chunk_count, sizeof *game->chunks)) == NULL) exit(1);
@@ -117,7 +143,11 @@ static Game* build(int boxes, int asleep, int spawning, int chunked, const char*
     dBodySetMass(body, &mass);
     dBodySetPosition(body, i % side, i / side, 0.25);
     dGeomSetBody(dCreateBox(chunked ? game->chunks[i / kChunk] : game->space, 0.5, 0.5, 0.5), body);
+    bodies[i] = body;
   }
+  for (int i = 0; scene->jointed && i + 1 < boxes; i += 2)
+    if (i % side + 1 < side) hinge(game, bodies, i, side);
+  free(bodies);
   /* settled by the program before it is adopted: the boxes sit in their contacts (and fall asleep) */
   for (int i = 0; i < (asleep ? 60 : 5); ++i) {
     collideAll(game);
@@ -125,7 +155,7 @@ static Game* build(int boxes, int asleep, int spawning, int chunked, const char*
     dJointGroupEmpty(game->contacts);
   }
   /* spawning: the projectiles of the last kLifetime frames in flight, so that every frame measured destroys one */
-  for (int slot = 0; spawning && slot < kLifetime; ++slot, ++game->frame)
+  for (int slot = 0; scene->spawning && slot < kLifetime; ++slot, ++game->frame)
     game->projectiles[slot] = makeProjectile(game, (kLifetime - slot) * kFrame_s);
   if (policy == NULL) return game;
   ssStepperDef def = ssDefaultStepperDef();
@@ -189,11 +219,10 @@ enum { kPairs = 10, kWarmFrames = 2 }; /* blocks of each copy a repeat; frames e
  * is built first moves a large world's ratio by several per cent either way, so the repeats take turns), each first
  * stepped kWarmFrames untimed, then through frames in kPairs blocks each, alternating: the ratio adopted / own of
  * each pair of blocks into ratios[0 .. kPairs), the own copy's CPU seconds returned. */
-static double measure(int boxes, int asleep, int spawning, int chunked, const char* policy, int frames, int own_first,
-                      double* ratios) {
+static double measure(const Scene* scene, int boxes, const char* policy, int frames, int own_first, double* ratios) {
   Game* games[2];
-  games[!own_first] = build(boxes, asleep, spawning, chunked, own_first ? NULL : policy);
-  games[own_first] = build(boxes, asleep, spawning, chunked, own_first ? policy : NULL);
+  games[!own_first] = build(scene, boxes, own_first ? NULL : policy);
+  games[own_first] = build(scene, boxes, own_first ? policy : NULL);
   for (int i = 0; i < kWarmFrames; ++i) gameFrameOwn(games[0]), gameFrameAdopted(games[1]);
   double own_s = 0;
   const int block = frames / kPairs;
@@ -219,33 +248,30 @@ static double measure(int boxes, int asleep, int spawning, int chunked, const ch
 /* The median ratio adopted / own over every pair of blocks of the repeats (a burst of another process' load spoils a
  * pair, not the figure), printed with the own frame's time, where the pairs' median lies with 95 % confidence (what
  * the run can tell from 1.02) and the middle half's range (how much one pair says). */
-static double reportScene(const char* name, int boxes, int asleep, int spawning, int chunked, const char* policy,
-                          int frames, int repeats) {
+static double reportScene(const Scene* scene, int boxes, const char* policy, int frames, int repeats) {
   static double ratios[64 * kPairs];
   double own_us = 0;
   for (int r = 0; r < repeats; ++r)
-    own_us += 1e6 * measure(boxes, asleep, spawning, chunked, policy, frames, r % 2 == 0, &ratios[r * kPairs]) /
-              frames / repeats;
+    own_us += 1e6 * measure(scene, boxes, policy, frames, r % 2 == 0, &ratios[r * kPairs]) / frames / repeats;
   const int count = repeats * kPairs;
   benchSort(ratios, count);
   double low, high;
   benchMedianInterval(ratios, count, &low, &high);
   printf("  %-22s %6d boxes  own %9.1f us/frame  adopted/own %.4f  (95 %% interval %.4f to %.4f, middle half %.4f "
-         "to %.4f)\n", name, boxes, own_us, ratios[count / 2], low, high, ratios[count / 4], ratios[(3 * count) / 4]);
+         "to %.4f)\n", scene->name, boxes, own_us, ratios[count / 2], low, high, ratios[count / 4], ratios[(3 * count) / 4]);
   return ratios[count / 2];
 }
 
-static const struct {
-  const char* name;
-  int asleep, spawning, chunked;
-} kScenes[] = {{"static", 0, 0, 0},
-               {"spawning", 0, 1, 0},
-               {"asleep", 1, 0, 0},
-               {"asleep, spawning", 1, 1, 0},
-               {"static, chunked", 0, 0, 1}}; /* the share's scene, timed under implicit-euler; counted as the others */
+static const Scene kScenes[] = {
+    {"static", 0, 0, 0, 0},
+    {"spawning", 0, 1, 0, 0},
+    {"asleep", 1, 0, 0, 0},
+    {"asleep, spawning", 1, 1, 0, 0},
+    {"jointed, spawning", 0, 1, 0, 1},
+    {"static, chunked", 0, 0, 1, 0}}; /* the share's scene, timed under implicit-euler; counted as the others */
 enum { kSceneCount = sizeof kScenes / sizeof kScenes[0], kGameScenes = kSceneCount - 1 };
 
-/* bench_games count own|adopted <scene 0-4> <boxes> <frames>: one copy stepped, untimed, for callgrind's counts; as
+/* bench_games count own|adopted <scene 0-5> <boxes> <frames>: one copy stepped, untimed, for callgrind's counts; as
  * in the timed runs, it first takes kWarmFrames uncounted (the stepper's first frame lists what it adopted: once, not
  * a frame's cost). Each copy is counted in a process of its own, as a program runs alone: stepped one after the
  * other in one process, the second copy's frames allocate from the heap the first's left, and pay for it (at 1,000
@@ -260,8 +286,7 @@ static int countInstructions(int argc, char** argv) {
     return 2;
   }
   dInitODE2(0);
-  Game* game = build(boxes, kScenes[scene].asleep, kScenes[scene].spawning, kScenes[scene].chunked,
-                     adopted ? "naive" : NULL);
+  Game* game = build(&kScenes[scene], boxes, adopted ? "naive" : NULL);
   for (int i = 0; i < kWarmFrames; ++i) adopted ? adoptedFrame(game) : ownFrame(game);
   for (int i = 0; i < frames; ++i) adopted ? gameFrameAdopted(game) : gameFrameOwn(game);
   destroy(game);
@@ -288,15 +313,14 @@ int main(int argc, char** argv) {
   if (!share_only) printf("adopted under naive against the program's own loop (target: at most 1.02)\n");
   for (int boxes = 1000; !share_only && boxes <= 10000; boxes *= 10)
     for (int s = 0; s < kGameScenes; ++s)
-      reportScene(kScenes[s].name, boxes, kScenes[s].asleep, kScenes[s].spawning, 0, "naive",
-                  boxes >= 10000 ? (frames / 4 + kPairs - 1) / kPairs * kPairs : frames, repeats);
+      reportScene(&kScenes[s], boxes, "naive", boxes >= 10000 ? (frames / 4 + kPairs - 1) / kPairs * kPairs : frames,
+                  repeats);
   printf("the library's share of a frame as the world grows, implicit-euler, static boxes in hash spaces of %d "
          "(target: the share at 100,000 at most 1.5 times the share at 1,000)\n", kChunk);
   for (int boxes = 10; boxes <= largest; boxes *= 10) {
     int scaled = boxes >= 100000 ? kPairs : boxes >= 10000 ? frames / 4 : frames; /* a few seconds a repeat */
     scaled = (scaled + kPairs - 1) / kPairs * kPairs;
-    double ratio = reportScene("static, chunked", boxes, 0, 0, 1, "implicit-euler", scaled,
-                               boxes >= 100000 ? 4 : repeats);
+    double ratio = reportScene(&kScenes[kGameScenes], boxes, "implicit-euler", scaled, boxes >= 100000 ? 4 : repeats);
     printf("    share %.2f %%\n", 100.0 * (ratio - 1.0));
   }
   benchPrintMachine("bench_games", "after");
