@@ -6,10 +6,20 @@
 
 #include "steadystep/registry.h"
 
-/* What Apply last wrote into the i-th bound joint row (ssRegistryJointRowAt), or into the world's ERP/CFM for
- * i = -1: {NAN, NAN} when nothing was written since the row was bound (or Apply's state could not be built: out of
- * memory, which the next Apply reports). A row without an erp (a motor's) holds only its cfm. */
-ssSoftness ssApplyLastWritten(ssRegistry* registry, int i);
+/* What Apply last wrote into the world's ERP/CFM: {NAN, NAN} when nothing was written since the world was bound (or
+ * Apply's state could not be built: out of memory, which the next Apply reports). */
+ssSoftness ssApplyWorldLastWritten(ssRegistry* registry);
+
+/* A row the program wrote over: i, its place among the bound joint rows (ssRegistryJointRowAt), and held, what ODE
+ * holds (a row without an erp, a motor's: erp 0). A status other than SS_OK stops the pass and is returned. */
+typedef ssStatus ssRowWrittenOver(void* context, int i, ssSoftness held);
+
+/* Calls visit, in the rows' order, for each bound joint row adopted from the program's numbers (a spring the program
+ * bound itself is its own to bind again) whose numbers in ODE differ from what Apply last wrote there: the program
+ * wrote them since. A row bound since the last Apply, a row ODE cannot read back (plane-2D), and every row when
+ * Apply's state cannot be built (out of memory, which the next Apply reports) are passed over. One pass over Apply's
+ * own rows, which hold each row's writer and getter: nothing looked up a row. */
+ssStatus ssApplyEachRowWrittenOver(ssRegistry* registry, ssRowWrittenOver* visit, void* context);
 
 /* Records that the i-th row (i = -1: the world) holds held, as the program wrote it and follow.c took it: the next
  * Apply compares its softness with held and writes where they differ. */

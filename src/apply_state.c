@@ -182,6 +182,7 @@ static int rebuild(ApplyState* state, ssRegistry* registry) {
                       .computed_previous_s = NAN,
                       .binding = *binding};
     ssJointRowWriterOfType(binding->joint_type, binding->param, binding->axis, &row->writer);
+    row->get = row->writer.set != NULL ? ssRowGetterOfType(binding->joint_type) : NULL;
     row->shares_previous_row = i > 0 && sharesRow(&rows[i - 1].binding, binding);
     if (binding->stamp > state->stamp) continue; /* bound since: nothing written */
     int k = old;
@@ -232,12 +233,28 @@ ApplyState* ssApplyStateOf(ssRegistry* registry) {
   return state;
 }
 
-ssSoftness ssApplyLastWritten(ssRegistry* registry, int i) {
+ssSoftness ssApplyWorldLastWritten(ssRegistry* registry) {
   ApplyState* state = ssApplyStateOf(registry);
-  if (state == NULL) return (ssSoftness){NAN, NAN};
-  if (i < 0) return state->world_written;
-  const ApplyRow* row = &state->rows[i];
-  return state->written_by_law && row->law_slot >= 0 ? state->law_written[row->law_slot] : row->written;
+  return state != NULL ? state->world_written : (ssSoftness){NAN, NAN};
+}
+
+ssStatus ssApplyEachRowWrittenOver(ssRegistry* registry, ssRowWrittenOver* visit, void* context) {
+  ApplyState* state = ssApplyStateOf(registry);
+  if (state == NULL) return SS_OK;
+  for (int i = 0; i < state->row_count; ++i) {
+    const ApplyRow* row = &state->rows[i];
+    if (row->get == NULL || row->binding.law.tuned_step_s == 0) continue;
+    const ssSoftness written =
+        state->written_by_law && row->law_slot >= 0 ? state->law_written[row->law_slot] : row->written;
+    if (isnan(written.cfm)) continue;
+    const int has_erp = row->writer.erp_number >= 0;
+    const double cfm = row->get(row->joint, row->writer.cfm_number);
+    const double erp = has_erp ? row->get(row->joint, row->writer.erp_number) : 0;
+    if (ssSameInOde(cfm, written.cfm) && (!has_erp || ssSameInOde(erp, written.erp))) continue;
+    ssStatus status = visit(context, i, (ssSoftness){erp, cfm});
+    if (status != SS_OK) return status;
+  }
+  return SS_OK;
 }
 
 void ssApplyTakeHeld(ssRegistry* registry, int i, ssSoftness held) {

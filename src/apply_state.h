@@ -43,6 +43,7 @@ enum { kLawTableSize = 16 };
 typedef struct ApplyRow {
   dJointID joint;
   ssRowWriter writer;
+  ssParamGetter get; /* reads the writer's numbers back (NULL: ODE cannot, or the row has no writer) */
   ssSoftness written;
   ssSoftness pending; /* this Apply's softness for the row, checked, after its load's fallback */
   ssSoftness computed;

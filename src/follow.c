@@ -33,45 +33,47 @@ static ssStatus lawOfWritten(const char* what, ssSoftness held, double step_s, s
   return status == SS_OK ? ssCheckLawForEveryStep(what, law) : status;
 }
 
-static ssStatus followRows(ssRegistry* registry, double step_s, FollowedRow** out, int* count) {
-  *out = NULL;
-  *count = 0;
-  int capacity = 0;
-  int rows = ssRegistry_JointBindingCount(registry);
-  for (int i = 0; i < rows; ++i) {
-    const ssJointRowBinding* binding = ssRegistryJointRowAt(registry, i);
-    if (binding->law.tuned_step_s == 0) continue; /* a spring the program bound itself: it binds another the same way */
-    ssRowWriter writer; /* the row's getter takes its writer's numbers: no lookup of the joint's type */
-    ssJointRowWriterOfType(binding->joint_type, binding->param, binding->axis, &writer);
-    ssParamGetter get = writer.set != NULL ? ssRowGetterOfType(binding->joint_type) : NULL;
-    if (get == NULL) continue; /* plane-2D: ODE cannot read it back */
-    ssSoftness written = ssApplyLastWritten(registry, i);
-    if (isnan(written.cfm)) continue;
-    int has_erp = writer.erp_number >= 0;
-    double cfm = get(binding->joint, writer.cfm_number);
-    double erp = has_erp ? get(binding->joint, writer.erp_number) : 0;
-    if (ssSameInOde(cfm, written.cfm) && (!has_erp || ssSameInOde(erp, written.erp))) continue;
-    /* a motor row (no erp) stands for a damper: its law is read with erp 0, as adoption reads it */
-    ssSoftness held = {has_erp ? erp : 0, cfm};
-    FollowedRow row = {i, held, {{0, 0}, 0, 0, 0, {0, 0}}};
-    char what[96];
-    snprintf(what, sizeof what, "%s joint %p, %s axis %d, as the program wrote it", ssJointTypeName(binding->joint),
-             (void*)binding->joint, ssJointParamName(binding->param), binding->axis);
-    ssStatus status = lawOfWritten(what, held, step_s, &row.law);
-    if (status == SS_OK && *count == capacity) {
-      capacity = capacity ? 2 * capacity : 8;
-      FollowedRow* larger = realloc(*out, (size_t)capacity * sizeof *larger);
-      if (larger == NULL) status = ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory following the program's writes");
-      else *out = larger;
-    }
-    if (status != SS_OK) {
-      free(*out);
-      *out = NULL;
-      return status;
-    }
-    (*out)[(*count)++] = row;
+/* The rows the program wrote over, each with the law it stands for, gathered by followRows. */
+typedef struct FollowedRows {
+  ssRegistry* registry;
+  double step_s;
+  FollowedRow* rows;
+  int count, capacity;
+} FollowedRows;
+
+static ssStatus takeRowWrittenOver(void* context, int i, ssSoftness held) {
+  FollowedRows* followed = context;
+  const ssJointRowBinding* binding = ssRegistryJointRowAt(followed->registry, i);
+  FollowedRow row = {i, held, {{0, 0}, 0, 0, 0, {0, 0}}};
+  char what[96];
+  snprintf(what, sizeof what, "%s joint %p, %s axis %d, as the program wrote it", ssJointTypeName(binding->joint),
+           (void*)binding->joint, ssJointParamName(binding->param), binding->axis);
+  /* a motor row (no erp) stands for a damper: its law is read with erp 0, as adoption reads it */
+  ssStatus status = lawOfWritten(what, held, followed->step_s, &row.law);
+  if (status != SS_OK) return status;
+  if (followed->count == followed->capacity) {
+    int capacity = followed->capacity ? 2 * followed->capacity : 8;
+    FollowedRow* larger = realloc(followed->rows, (size_t)capacity * sizeof *larger);
+    if (larger == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory following the program's writes");
+    followed->rows = larger;
+    followed->capacity = capacity;
   }
+  followed->rows[followed->count++] = row;
   return SS_OK;
+}
+
+/* Every row the program wrote over since Apply's last write (ssApplyEachRowWrittenOver), with its law, into *out
+ * (*count of them; free it); an error leaves *out NULL. */
+static ssStatus followRows(ssRegistry* registry, double step_s, FollowedRow** out, int* count) {
+  FollowedRows followed = {registry, step_s, NULL, 0, 0};
+  ssStatus status = ssApplyEachRowWrittenOver(registry, takeRowWrittenOver, &followed);
+  if (status != SS_OK) {
+    free(followed.rows);
+    followed.rows = NULL, followed.count = 0;
+  }
+  *out = followed.rows;
+  *count = followed.count;
+  return status;
 }
 
 /* A large world's body binding kPrefetchAhead places on asked for: its body's flags, and the auto-disable and damping
@@ -111,7 +113,7 @@ ssStatus ssRegistryFollowProgram(ssRegistry* registry, int with_bodies, int* fol
   ssSoftness world_held = {dWorldGetERP(world), dWorldGetCFM(world)};
   ssRowLaw bound_law;
   int world_bound = ssRegistryWorldBound(registry, &bound_law) && bound_law.tuned_step_s > 0;
-  ssSoftness world_written = world_bound ? ssApplyLastWritten(registry, -1) : (ssSoftness){NAN, NAN};
+  ssSoftness world_written = world_bound ? ssApplyWorldLastWritten(registry) : (ssSoftness){NAN, NAN};
   if (world_bound && !isnan(world_written.cfm) &&
       (!ssSameInOde(world_held.erp, world_written.erp) || !ssSameInOde(world_held.cfm, world_written.cfm))) {
     ssStatus status = lawOfWritten("world ERP/CFM, as the program wrote them,", world_held, step_s, &world_law);
