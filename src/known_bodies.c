@@ -69,7 +69,7 @@ static void visitBody(void* context, dBodyID body) {
 /* The body's joints as the stepper sees them (ssJointSignature): a step's contacts are made after the program's
  * joints and emptied after the step, and hide nothing. */
 static ssJointSignature signatureOf(dBodyID body, int joints) {
-  ssJointSignature signature = {0, 0};
+  ssJointSignature signature = {0, 0, joints};
   for (int i = 0; i < joints; ++i) {
     dJointID joint = dBodyGetJoint(body, i);
     if (dJointGetType(joint) == dJointTypeContact) continue;
@@ -284,8 +284,12 @@ SS_PREFETCH_HELPER void prefetchJoints(const ssKnownBodies* known, int k) {
 __attribute__((noinline))
 #endif
 static int signatureChanged(const ssKnownBodies* known, int k, int joints) {
+  /* listed with joints and no contact, as many now, the listed first at the head: the joints it had (ODE puts a joint
+   * attached since at the head, and one gone with none attached leaves fewer), known in one more read of ODE's */
+  const ssJointSignature* listed = &known->joints[k];
+  if (joints == listed->count && joints == listed->total && dBodyGetJoint(known->ids[k], 0) == listed->first) return 0;
   ssJointSignature now = signatureOf(known->ids[k], joints);
-  return now.first != known->joints[k].first || now.count != known->joints[k].count;
+  return now.first != listed->first || now.count != listed->count;
 }
 
 /* Most bodies have no joint, and had none (the first is 0 then too): one read of ODE's. */

@@ -46,6 +46,7 @@ typedef struct ssBodyValues {
 typedef struct ssJointSignature {
   dJointID first;
   int count;
+  int total; /* every joint of the body then, contacts too */
 } ssJointSignature;
 
 typedef struct ssKnownBodies {

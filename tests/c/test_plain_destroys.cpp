@@ -138,6 +138,31 @@ INSTANTIATE_TEST_SUITE_P(BetweenFramesAndInBeforeStep, PlainDestroyTest, ::testi
                            return std::string(info.param ? "InBeforeStep" : "BetweenFrames");
                          });
 
+// A joint made before the one it replaces is destroyed has another address, and is at the head of both bodies' lists:
+// they hold as many joints as before, none of them a contact, and the stepper tells the new one by the head (two reads
+// a body, not a walk of its list), adopts it and writes it for the frame's step.
+TEST_F(PlainDestroyTest, AJointMadeBeforeTheOneItReplacesIsDestroyedIsAdoptedAtTheNextFrame) {
+  ssStepperDef def = TestStepperDef();
+  def.world = world;
+  def.space = root;
+  def.tuned_step_s = kTunedStep;
+  ASSERT_EQ(ssStepper_Create(&def, &stepper), SS_OK) << ssLastError();
+  for (frame = 0; frame < 6; ++frame) {
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    dJointID replaced = joint;
+    MakeJoint();
+    ASSERT_NE(joint, replaced);
+    dJointDestroy(replaced);
+    ASSERT_EQ(dBodyGetNumJoints(a), 1);
+    const double frame_s = frame % 2 ? 1.0 / 60 : 1.0 / 50;
+    ASSERT_EQ(ssStepper_Step(stepper, frame_s, nullptr), SS_OK) << ssLastError();
+    double erp, cfm;
+    StopAt(frame_s, &erp, &cfm);
+    EXPECT_NEAR(dJointGetHingeParam(joint, dParamStopERP), erp, ReadBackTolerance(1e-13, erp));
+    EXPECT_NEAR(dJointGetHingeParam(joint, dParamStopCFM), cfm, ReadBackTolerance(1e-13 * cfm, cfm));
+  }
+}
+
 // A body destroyed with ODE's own calls and another made at once, as a pool or a game's debris does: the allocator
 // most often gives the new body the old one's address, which no ODE call tells from the old body (docs/adopting.md).
 // The new body is drawn where it was made, then blends its own two states, and ODE steps it with the damping the
