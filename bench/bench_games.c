@@ -22,7 +22,7 @@
  * Under valgrind, `callgrind --toggle-collect=gameFrameOwn` (or gameFrameAdopted) on `bench_games count` counts the
  * instructions of one copy (docs/measurements.md).
  *
- *   bench_games [frames] [repeats] [largest box count]   (default 120 frames, 5 repeats, 100000: about 10 min on
+ *   bench_games [frames] [repeats] [largest box count]   (default 120 frames, 5 repeats, 100000: about 5 min on
  *   a 2-core machine; 100,000 boxes take four repeats of 10 frames, two in each building order)
  *   bench_games share [frames] [repeats] [largest box count]   the share alone
  *   bench_games count own|adopted <scene 0-5> <boxes> <frames>   one copy, untimed, for callgrind */
