@@ -12,6 +12,7 @@
 #include <stdlib.h>
 
 #include "apply_internal.h"
+#include "array.h"
 #include "error.h"
 #include "joint_rows.h"
 #include "ode_bounds.h"
@@ -51,13 +52,8 @@ static ssStatus takeRowWrittenOver(void* context, int i, ssSoftness held) {
   /* a motor row (no erp) stands for a damper: its law is read with erp 0, as adoption reads it */
   ssStatus status = lawOfWritten(what, held, followed->step_s, &row.law);
   if (status != SS_OK) return status;
-  if (followed->count == followed->capacity) {
-    int capacity = followed->capacity ? 2 * followed->capacity : 8;
-    FollowedRow* larger = realloc(followed->rows, (size_t)capacity * sizeof *larger);
-    if (larger == NULL) return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory following the program's writes");
-    followed->rows = larger;
-    followed->capacity = capacity;
-  }
+  if (!ssReserveOne((void**)&followed->rows, followed->count, &followed->capacity, sizeof *followed->rows))
+    return ssFail(SS_ERROR_OUT_OF_MEMORY, "out of memory following the program's writes");
   followed->rows[followed->count++] = row;
   return SS_OK;
 }
